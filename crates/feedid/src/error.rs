@@ -1,0 +1,198 @@
+//! The one error type of the library.
+//!
+//! Every fallible library function returns [`Result`]. Variants carry the data
+//! a user needs to find the problem (file, column or variable, line or index,
+//! offending value); the `Display` text is a single line.
+
+use std::path::PathBuf;
+
+/// Result alias used throughout the library.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Everything that can go wrong in feedid.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    // ---------------------------------------------------------------- shapes
+    /// Two sequences that must have the same length do not.
+    #[error("length mismatch in {what}: expected {expected}, got {actual}")]
+    LengthMismatch {
+        /// What was being compared (e.g. `"command"`).
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Actual length.
+        actual: usize,
+    },
+
+    /// Not enough samples for the requested operation.
+    #[error("too few samples for {what}: need at least {needed}, got {actual}")]
+    TooFewSamples {
+        /// What needs the samples (e.g. `"window + horizon"`).
+        what: &'static str,
+        /// Minimum number of samples.
+        needed: usize,
+        /// Number available.
+        actual: usize,
+    },
+
+    // ------------------------------------------------------------ parameters
+    /// A numeric parameter or option is outside its valid range.
+    #[error("invalid value for `{name}`: {value} ({reason})")]
+    InvalidParameter {
+        /// Parameter name as the user writes it.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Why it is invalid (e.g. `"must be > 0"`).
+        reason: &'static str,
+    },
+
+    /// An option that is not a number is invalid (e.g. an unknown method name).
+    #[error("invalid {what} `{value}`; expected one of: {expected}")]
+    InvalidChoice {
+        /// What was chosen (e.g. `"method"`).
+        what: &'static str,
+        /// The offending choice.
+        value: String,
+        /// The accepted values, comma separated.
+        expected: &'static str,
+    },
+
+    /// A rig parameter file could not be parsed (unknown key, wrong type, ...).
+    #[error("{}: {message}", display_path(path))]
+    ParamsFile {
+        /// File the parameters came from, if any.
+        path: Option<PathBuf>,
+        /// Parser message (names the key and line).
+        message: String,
+    },
+
+    // ------------------------------------------------------------- recordings
+    /// A value is NaN or infinite.
+    #[error("non-finite value {value} in {channel} at sample {index}")]
+    NonFinite {
+        /// Channel name (column or variable).
+        channel: String,
+        /// Zero-based sample index.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+
+    /// Time stamps are not strictly increasing.
+    #[error("time is not strictly increasing at sample {index}: {previous} s followed by {value} s")]
+    NonMonotoneTime {
+        /// Zero-based index of the offending sample.
+        index: usize,
+        /// Time of the previous sample \[s\].
+        previous: f64,
+        /// Time of the offending sample \[s\].
+        value: f64,
+    },
+
+    /// Sampling interval deviates from the nominal one by more than the tolerance.
+    #[error("sampling jitter at sample {index}: interval {interval} s vs nominal {nominal} s ({relative_percent:.3} % > tolerance {tolerance_percent} %)")]
+    SamplingJitter {
+        /// Zero-based index of the sample ending the offending interval.
+        index: usize,
+        /// The interval \[s\].
+        interval: f64,
+        /// The nominal (median) interval \[s\].
+        nominal: f64,
+        /// Deviation relative to the nominal interval \[%\].
+        relative_percent: f64,
+        /// Allowed deviation \[%\].
+        tolerance_percent: f64,
+    },
+
+    // ------------------------------------------------------------------- I/O
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// A requested column or variable does not exist.
+    #[error("{}: no {kind} `{name}`; available: {available}", path.display())]
+    MissingChannel {
+        /// The file.
+        path: PathBuf,
+        /// `"column"` or `"variable"`.
+        kind: &'static str,
+        /// The requested name or index.
+        name: String,
+        /// What the file has, comma separated.
+        available: String,
+    },
+
+    /// A cell could not be parsed as a number.
+    #[error("{}: line {line}, column `{column}`: cannot read `{text}` as a number{hint}", path.display())]
+    BadNumber {
+        /// The file.
+        path: PathBuf,
+        /// One-based line number.
+        line: usize,
+        /// Column name or index.
+        column: String,
+        /// The cell text.
+        text: String,
+        /// Extra hint (e.g. about decimal commas), possibly empty.
+        hint: &'static str,
+    },
+
+    /// A text file is malformed (ragged rows, invalid UTF-8, empty, ...).
+    #[error("{}: line {line}: {reason}", path.display())]
+    Malformed {
+        /// The file.
+        path: PathBuf,
+        /// One-based line number (0 when the whole file is concerned).
+        line: usize,
+        /// What is wrong.
+        reason: String,
+    },
+
+    /// A MATLAB file is malformed or uses an unsupported feature.
+    #[error("{}: {reason}", path.display())]
+    MatFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+
+    // -------------------------------------------------------------- numerics
+    /// A linear system or least-squares problem is singular / rank deficient.
+    #[error("singular problem in {context}")]
+    Singular {
+        /// Where it happened.
+        context: &'static str,
+    },
+
+    /// A model is unusable (unstable, non-finite, wrong structure).
+    #[error("invalid model: {reason}")]
+    InvalidModel {
+        /// Why.
+        reason: &'static str,
+    },
+
+    /// An iterative algorithm did not converge.
+    #[error("{algorithm} did not converge after {iterations} iterations")]
+    NotConverged {
+        /// Algorithm name.
+        algorithm: &'static str,
+        /// Iterations performed.
+        iterations: usize,
+    },
+}
+
+fn display_path(path: &Option<PathBuf>) -> String {
+    match path {
+        Some(p) => p.display().to_string(),
+        None => "parameters".to_string(),
+    }
+}

@@ -1,0 +1,1 @@
+//! Reading recordings from CSV/text and MATLAB v5 files, and writing results.

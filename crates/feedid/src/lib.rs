@@ -1,0 +1,27 @@
+//! # feedid
+//!
+//! Short-time identification and prediction of machine-tool feed drives: the
+//! physical model of a ball-screw axis under P / PI / PI cascade control
+//! ([`drive`]), linear-system tools ([`lti`]), a nonlinear virtual rig and
+//! test commands ([`drive`], [`signal`]), the windowed identification methods
+//! and the sliding prediction engine ([`ident`]), solvers ([`solve`]) and
+//! file input ([`io`]).
+//!
+//! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
+//! Identification of Feed Drive Systems using Nonlinear Least Squares Method".
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+#![warn(missing_docs)]
+
+pub mod drive;
+pub mod error;
+pub mod ident;
+pub mod io;
+pub mod lti;
+pub mod plot;
+pub mod recording;
+pub mod signal;
+pub mod solve;
+pub mod stats;
+
+pub use error::{Error, Result};
+pub use recording::Recording;

@@ -1,0 +1,1 @@
+//! Real polynomials in descending powers: roots and construction from roots.

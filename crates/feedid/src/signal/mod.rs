@@ -1,0 +1,1 @@
+//! Command trajectories: ramp, step, jerk-limited move, chirp, PRBS, multisine.

@@ -1,0 +1,1 @@
+//! Error statistics and information criteria.

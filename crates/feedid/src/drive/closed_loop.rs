@@ -115,21 +115,41 @@ pub fn closed_loop_coefficients_with_stiffness(
 
     let d7 = j * l * m;
     let d6 = c1 * l * m + c2 * j * l + j * m * (res + kpi);
-    let d5 = c1 * c2 * l + c1 * m * res + c2 * j * res + j * k * l + k * l * m * r2 + ke * kt * m
+    let d5 = c1 * c2 * l
+        + c1 * m * res
+        + c2 * j * res
+        + j * k * l
+        + k * l * m * r2
+        + ke * kt * m
         + kpi * (c1 * m + c2 * j + j * kii * m + kp * kt * m * r);
-    let d4 = c1 * c2 * res + c1 * k * l + c2 * k * l * r2 + c2 * ke * kt + j * k * res
+    let d4 = c1 * c2 * res
+        + c1 * k * l
+        + c2 * k * l * r2
+        + c2 * ke * kt
+        + j * k * res
         + k * m * res * r2
         + kpi
-            * (c1 * c2 + c1 * kii * m + c2 * j * kii + c2 * kp * kt * r + j * k + k * m * r2
+            * (c1 * c2
+                + c1 * kii * m
+                + c2 * j * kii
+                + c2 * kp * kt * r
+                + j * k
+                + k * m * r2
                 + (ki + kii) * kp * kt * m * r);
     let d3 = k * (c1 * res + c2 * res * r2 + ke * kt)
         + kpi
-            * (c1 * c2 * kii + c1 * k + c2 * k * r2 + c2 * (ki + kii) * kp * kt * r + j * k * kii
+            * (c1 * c2 * kii
+                + c1 * k
+                + c2 * k * r2
+                + c2 * (ki + kii) * kp * kt * r
+                + j * k * kii
                 + k * kii * m * r2
                 + k * kp * kt * r
                 + ki * kii * kp * kt * m * r);
     let d2 = kpi
-        * (c1 * k * kii + c2 * k * kii * r2 + c2 * ki * kii * kp * kt * r
+        * (c1 * k * kii
+            + c2 * k * kii * r2
+            + c2 * ki * kii * kp * kt * r
             + k * kp * kt * r * (ki + kii + kv));
     let d1 = match variant {
         D1Variant::Corrected => k * kp * kpi * kt * r * (ki * kii + kv * (ki + kii)),

@@ -4,6 +4,8 @@
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
 //! shifts by a hop.
 
+pub mod engine;
 mod estimator;
 
+pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};

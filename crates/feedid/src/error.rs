@@ -190,6 +190,14 @@ pub enum Error {
         /// Iterations performed.
         iterations: usize,
     },
+
+    // --- plot
+    /// A figure could not be rendered.
+    #[error("cannot render figure: {reason}")]
+    Plot {
+        /// Renderer message.
+        reason: String,
+    },
 }
 
 fn display_path(path: &Option<PathBuf>) -> String {

@@ -12,6 +12,8 @@
 //! assert!((r.rate_hz() - 5000.0).abs() < 1e-6);
 //! ```
 
+use serde::Serialize;
+
 use crate::error::{Error, Result};
 use crate::ident::Signals;
 
@@ -203,6 +205,43 @@ impl Recording {
         self.motion_start_index(MOTION_THRESHOLD).is_some()
     }
 
+    /// Stretches where the command moves (see [`MotionSegment`]).
+    ///
+    /// A step `k → k+1` is moving when `|c[k+1] − c[k]| > step_threshold` \[m\];
+    /// runs of moving steps separated by a standstill shorter than
+    /// `min_standstill_s` \[s\] are merged into one segment. A segment runs
+    /// from the last rest sample before its first moving step to the sample
+    /// after its last moving step. Empty when the command never moves.
+    pub fn motion_segments(&self, step_threshold: f64, min_standstill_s: f64) -> Vec<MotionSegment> {
+        let (t, c) = (&self.time, &self.command);
+        // Runs of moving steps as (first step, last step).
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        for k in 0..c.len().saturating_sub(1) {
+            if (c[k + 1] - c[k]).abs() <= step_threshold {
+                continue;
+            }
+            match runs.last_mut() {
+                Some((_, last)) if *last + 1 == k || t[k] - t[*last + 1] < min_standstill_s => {
+                    *last = k
+                }
+                _ => runs.push((k, k)),
+            }
+        }
+        runs.into_iter()
+            .map(|(a, b)| {
+                let peak = (a..=b)
+                    .map(|k| (c[k + 1] - c[k]).abs() / (t[k + 1] - t[k]))
+                    .fold(0.0, f64::max);
+                MotionSegment {
+                    start_s: t[a],
+                    end_s: t[b + 1],
+                    distance_m: c[b + 1] - c[a],
+                    peak_speed_m_per_s: peak,
+                }
+            })
+            .collect()
+    }
+
     /// The whole recording as an estimator view.
     pub fn signals(&self) -> Signals<'_> {
         Signals::new(
@@ -213,6 +252,19 @@ impl Recording {
             self.motion_start_time(),
         )
     }
+}
+
+/// A stretch of the recording where the command moves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MotionSegment {
+    /// Time of the last rest sample before the motion \[s\].
+    pub start_s: f64,
+    /// Time of the first sample after the last moving step \[s\].
+    pub end_s: f64,
+    /// Net command displacement over the segment, signed \[m\].
+    pub distance_m: f64,
+    /// Largest command speed `|Δc|/Δt` in the segment \[m/s\].
+    pub peak_speed_m_per_s: f64,
 }
 
 /// Command change that counts as motion \[m\] (1 nm).
@@ -286,6 +338,39 @@ mod tests {
         let r = Recording::new(t(5), c, vec![0.0; 5]).unwrap();
         assert_eq!(r.motion_start_index(1e-9), Some(2));
         assert!((r.motion_start_time() - 2e-3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn motion_segments_merge_short_pauses_and_split_long_ones() {
+        // 1 kHz: rest 10, ramp +1 mm/s for 10 steps, pause 5 (short), ramp 5,
+        // pause 200 (long), ramp back -2 mm/s for 10 steps, rest.
+        let mut c = vec![0.0; 10];
+        let mut x = 0.0;
+        let mut push = |steps: usize, dx: f64, c: &mut Vec<f64>| {
+            for _ in 0..steps {
+                x += dx;
+                c.push(x);
+            }
+        };
+        push(10, 1e-6, &mut c);
+        push(5, 0.0, &mut c);
+        push(5, 1e-6, &mut c);
+        push(200, 0.0, &mut c);
+        push(10, -2e-6, &mut c);
+        push(10, 0.0, &mut c);
+        let n = c.len();
+        let r = Recording::new(t(n), c, vec![0.0; n]).unwrap();
+        let s = r.motion_segments(1e-9, 0.05);
+        assert_eq!(s.len(), 2, "{s:?}");
+        assert!((s[0].start_s - 0.009).abs() < 1e-12 && (s[0].end_s - 0.029).abs() < 1e-12);
+        assert!((s[0].distance_m - 15e-6).abs() < 1e-15);
+        assert!((s[0].peak_speed_m_per_s - 1e-3).abs() < 1e-9);
+        assert!((s[1].distance_m + 20e-6).abs() < 1e-15);
+        assert!((s[1].peak_speed_m_per_s - 2e-3).abs() < 1e-9);
+        // A long minimum standstill merges everything into one segment.
+        assert_eq!(r.motion_segments(1e-9, 1.0).len(), 1);
+        // A short one splits the first segment at the 5-sample pause.
+        assert_eq!(r.motion_segments(1e-9, 0.001).len(), 3);
     }
 
     #[test]

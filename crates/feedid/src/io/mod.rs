@@ -1,1 +1,21 @@
-//! Reading recordings from CSV/text and MATLAB v5 files, and writing results.
+//! Reading recordings from CSV/text and MATLAB v5 files ([`read_recording`]
+//! dispatches), the options that pick columns and units ([`ReadOptions`]),
+//! and the summary a user checks before identifying ([`recording_info`]).
+
+mod csv;
+mod info;
+mod mat;
+mod options;
+mod read;
+
+pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
+pub use self::info::{recording_info, ChannelStats, RecordingInfo};
+pub use self::mat::{
+    list_mat_variables, list_mat_variables_from_bytes, read_mat, read_mat_from_bytes,
+    MatVariableInfo,
+};
+pub use self::options::{
+    ChannelRef, ReadOptions, TimeUnit, Unit, DEFAULT_COMMAND_COLUMN, DEFAULT_POSITION_COLUMN,
+    DEFAULT_TIME_COLUMN,
+};
+pub use self::read::{read_recording, read_recording_from_bytes};

@@ -212,7 +212,11 @@ impl Recording {
     /// `min_standstill_s` \[s\] are merged into one segment. A segment runs
     /// from the last rest sample before its first moving step to the sample
     /// after its last moving step. Empty when the command never moves.
-    pub fn motion_segments(&self, step_threshold: f64, min_standstill_s: f64) -> Vec<MotionSegment> {
+    pub fn motion_segments(
+        &self,
+        step_threshold: f64,
+        min_standstill_s: f64,
+    ) -> Vec<MotionSegment> {
         let (t, c) = (&self.time, &self.command);
         // Runs of moving steps as (first step, last step).
         let mut runs: Vec<(usize, usize)> = Vec::new();
@@ -229,13 +233,17 @@ impl Recording {
         }
         runs.into_iter()
             .map(|(a, b)| {
-                let peak = (a..=b)
-                    .map(|k| (c[k + 1] - c[k]).abs() / (t[k + 1] - t[k]))
-                    .fold(0.0, f64::max);
+                let (mut peak, mut travel) = (0.0_f64, 0.0);
+                for k in a..=b {
+                    let d = (c[k + 1] - c[k]).abs();
+                    travel += d;
+                    peak = peak.max(d / (t[k + 1] - t[k]));
+                }
                 MotionSegment {
                     start_s: t[a],
                     end_s: t[b + 1],
                     distance_m: c[b + 1] - c[a],
+                    travel_m: travel,
                     peak_speed_m_per_s: peak,
                 }
             })
@@ -263,6 +271,8 @@ pub struct MotionSegment {
     pub end_s: f64,
     /// Net command displacement over the segment, signed \[m\].
     pub distance_m: f64,
+    /// Path length of the command over the segment, `Σ|Δc|` \[m\].
+    pub travel_m: f64,
     /// Largest command speed `|Δc|/Δt` in the segment \[m/s\].
     pub peak_speed_m_per_s: f64,
 }
@@ -300,7 +310,14 @@ mod tests {
     #[test]
     fn rejects_mismatched_lengths() {
         let e = Recording::new(t(4), vec![0.0; 3], vec![0.0; 4]).unwrap_err();
-        assert!(matches!(e, Error::LengthMismatch { expected: 4, actual: 3, .. }));
+        assert!(matches!(
+            e,
+            Error::LengthMismatch {
+                expected: 4,
+                actual: 3,
+                ..
+            }
+        ));
     }
 
     #[test]
@@ -325,7 +342,9 @@ mod tests {
         tt[5] += 1e-4; // 10 % of the interval
         let e = Recording::new(tt, vec![0.0; 10], vec![0.0; 10]).unwrap_err();
         match e {
-            Error::SamplingJitter { relative_percent, .. } => {
+            Error::SamplingJitter {
+                relative_percent, ..
+            } => {
                 assert!((relative_percent - 10.0).abs() < 1e-6)
             }
             other => panic!("unexpected {other}"),
@@ -366,6 +385,7 @@ mod tests {
         assert!((s[0].distance_m - 15e-6).abs() < 1e-15);
         assert!((s[0].peak_speed_m_per_s - 1e-3).abs() < 1e-9);
         assert!((s[1].distance_m + 20e-6).abs() < 1e-15);
+        assert!((s[1].travel_m - 20e-6).abs() < 1e-15);
         assert!((s[1].peak_speed_m_per_s - 2e-3).abs() < 1e-9);
         // A long minimum standstill merges everything into one segment.
         assert_eq!(r.motion_segments(1e-9, 1.0).len(), 1);

@@ -8,7 +8,9 @@
 //! - **Delimiter** ([`ReadOptions::delimiter`], default detected): the first of
 //!   tab, `;`, `,`, runs of whitespace that splits the first 50 rows into the
 //!   same number (> 1) of fields; failing that, the first that splits the first
-//!   row into more than one field. Cells are trimmed; a cell may be quoted
+//!   row into more than one field (`,` is skipped when it would leave cells
+//!   like `5 1`, the mark of decimal commas in a whitespace-separated file).
+//!   Cells are trimmed; a cell may be quoted
 //!   (`"1.5"`); quotes are removed, with no escape sequences inside.
 //! - **Header** ([`ReadOptions::header`], default detected): the first row is
 //!   a header when one of its cells is not a number while the cell below it is
@@ -48,8 +50,7 @@ use crate::io::read::{build_recording, failing_sample, in_file, read_file, Role}
 use crate::recording::Recording;
 
 /// Hint appended to [`Error::BadNumber`] when a cell looks like a decimal comma.
-pub const DECIMAL_COMMA_HINT: &str =
-    "; decimal comma is not supported; convert to a decimal point";
+pub const DECIMAL_COMMA_HINT: &str = "; decimal comma is not supported; convert to a decimal point";
 
 /// Number of rows looked at to detect the delimiter.
 const DETECT_ROWS: usize = 50;
@@ -104,9 +105,10 @@ pub fn read_csv_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
         None => {
             if let Some(second) = lines.get(1) {
                 split_checked(second, delim, path, &mut below)?;
-                fields.iter().enumerate().any(|(i, c)| {
-                    !number_like(c) && below.get(i).is_some_and(|b| number_like(b))
-                })
+                fields
+                    .iter()
+                    .enumerate()
+                    .any(|(i, c)| !number_like(c) && below.get(i).is_some_and(|b| number_like(b)))
             } else {
                 fields.iter().any(|c| !number_like(c))
             }
@@ -291,7 +293,11 @@ fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
         }
     }
     for d in CANDIDATES {
-        if sample.first().and_then(|l| count(l, d)).is_some_and(|n| n > 1) {
+        if sample
+            .first()
+            .and_then(|l| count(l, d))
+            .is_some_and(|n| n > 1)
+        {
             return d;
         }
     }
@@ -299,12 +305,7 @@ fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
 }
 
 /// Split a line, mapping quote errors to [`Error::Malformed`].
-fn split_checked<'a>(
-    line: &Line<'a>,
-    d: Delim,
-    path: &Path,
-    out: &mut Vec<&'a str>,
-) -> Result<()> {
+fn split_checked<'a>(line: &Line<'a>, d: Delim, path: &Path, out: &mut Vec<&'a str>) -> Result<()> {
     split_fields(line.text, d, out).map_err(|reason| Error::Malformed {
         path: path.to_path_buf(),
         line: line.no,
@@ -528,8 +529,12 @@ mod tests {
                 position: Some(ChannelRef::Index(3)),
                 ..Default::default()
             };
-            let e = if text.starts_with("time") { read(text) } else { read_with(text, opts) }
-                .unwrap_err();
+            let e = if text.starts_with("time") {
+                read(text)
+            } else {
+                read_with(text, opts)
+            }
+            .unwrap_err();
             match &e {
                 Error::BadNumber { hint, .. } => assert_eq!(*hint, DECIMAL_COMMA_HINT, "{e}"),
                 other => panic!("{text:?}: unexpected {other}"),
@@ -542,9 +547,16 @@ mod tests {
         let e = read("time_s,command_m,position_m\n0,0,0\n\n0.001,abc,0\n").unwrap_err();
         match e {
             Error::BadNumber {
-                line, column, text, hint, ..
+                line,
+                column,
+                text,
+                hint,
+                ..
             } => {
-                assert_eq!((line, column.as_str(), text.as_str(), hint), (4, "command_m", "abc", ""));
+                assert_eq!(
+                    (line, column.as_str(), text.as_str(), hint),
+                    (4, "command_m", "abc", "")
+                );
             }
             other => panic!("unexpected {other}"),
         }
@@ -554,25 +566,46 @@ mod tests {
     fn nan_is_refused_with_file_line_and_column() {
         let e = read("time_s,command_m,position_m\n0,0,0\n0.001,0,NaN\n0.002,0,0\n").unwrap_err();
         let msg = e.to_string();
-        assert!(matches!(e.root(), Error::NonFinite { index: 1, .. }), "{msg}");
-        assert!(msg.starts_with("t.csv: line 3, column `position_m`"), "{msg}");
+        assert!(
+            matches!(e.root(), Error::NonFinite { index: 1, .. }),
+            "{msg}"
+        );
+        assert!(
+            msg.starts_with("t.csv: line 3, column `position_m`"),
+            "{msg}"
+        );
     }
 
     #[test]
     fn decreasing_and_duplicate_time_name_line_and_values() {
         let e = read("time_s,command_m,position_m\n0,0,0\n0.002,0,0\n0.001,0,0\n").unwrap_err();
         let msg = e.to_string();
-        assert!(matches!(e.root(), Error::NonMonotoneTime { index: 2, .. }), "{msg}");
-        assert!(msg.contains("line 4, column `time_s`") && msg.contains("0.002") && msg.contains("0.001"), "{msg}");
+        assert!(
+            matches!(e.root(), Error::NonMonotoneTime { index: 2, .. }),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("line 4, column `time_s`")
+                && msg.contains("0.002")
+                && msg.contains("0.001"),
+            "{msg}"
+        );
         let e = read("time_s,command_m,position_m\n0,0,0\n0.001,0,0\n0.001,0,0\n").unwrap_err();
-        assert!(matches!(e.root(), Error::NonMonotoneTime { index: 2, .. }), "{e}");
+        assert!(
+            matches!(e.root(), Error::NonMonotoneTime { index: 2, .. }),
+            "{e}"
+        );
     }
 
     #[test]
     fn jitter_beyond_tolerance_is_reported_with_line_and_tolerance_option_works() {
-        let text = "time_s,command_m,position_m\n0,0,0\n0.001,0,0\n0.002,0,0\n0.0032,0,0\n0.0042,0,0\n";
+        let text =
+            "time_s,command_m,position_m\n0,0,0\n0.001,0,0\n0.002,0,0\n0.0032,0,0\n0.0042,0,0\n";
         let e = read(text).unwrap_err();
-        assert!(matches!(e.root(), Error::SamplingJitter { index: 3, .. }), "{e}");
+        assert!(
+            matches!(e.root(), Error::SamplingJitter { index: 3, .. }),
+            "{e}"
+        );
         assert!(e.to_string().contains("line 5"), "{e}");
         let opts = ReadOptions {
             jitter_tolerance: 0.25,
@@ -595,16 +628,23 @@ mod tests {
         let e = read("\n# comment\n  \n").unwrap_err();
         assert!(e.to_string().contains("empty"), "{e}");
         let e = read("time_s,command_m,position_m\n").unwrap_err();
-        assert!(matches!(e, Error::Malformed { line: 1, .. }) && e.to_string().contains("header only"), "{e}");
+        assert!(
+            matches!(e, Error::Malformed { line: 1, .. }) && e.to_string().contains("header only"),
+            "{e}"
+        );
         let e = read("time_s,command_m,position_m\n0,0,0\n").unwrap_err();
-        assert!(matches!(e.root(), Error::TooFewSamples { actual: 1, .. }), "{e}");
+        assert!(
+            matches!(e.root(), Error::TooFewSamples { actual: 1, .. }),
+            "{e}"
+        );
         assert!(e.to_string().starts_with("t.csv: "), "{e}");
     }
 
     #[test]
     fn invalid_utf8_is_malformed_with_line() {
         let bytes = b"time_s,command_m,position_m\n0,0,0\n0.001,\xff\xfe,0\n";
-        let e = read_csv_from_bytes(bytes, Path::new("b.csv"), &ReadOptions::default()).unwrap_err();
+        let e =
+            read_csv_from_bytes(bytes, Path::new("b.csv"), &ReadOptions::default()).unwrap_err();
         assert!(matches!(e, Error::Malformed { line: 3, .. }), "{e}");
     }
 
@@ -612,7 +652,9 @@ mod tests {
     fn missing_column_lists_available_ones() {
         let e = read("t,u,y\n0,0,0\n1,1,1\n").unwrap_err();
         match e {
-            Error::MissingChannel { name, available, .. } => {
+            Error::MissingChannel {
+                name, available, ..
+            } => {
                 assert_eq!(name, "time_s");
                 assert_eq!(available, "t, u, y");
             }

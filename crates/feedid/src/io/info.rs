@@ -9,7 +9,8 @@
 //! - tracking error `e = c − x`: `rms(e)` and `max |e|`;
 //! - motion segments ([`Recording::motion_segments`]): a step is moving when
 //!   `|Δc| > max(1 nm, 1e-6 · (max c − min c))` ([`SEGMENT_STEP_RELATIVE`]);
-//!   pauses shorter than [`SEGMENT_MIN_STANDSTILL_S`] = 0.1 s do not split a segment.
+//!   pauses shorter than [`SEGMENT_MIN_STANDSTILL_S`] = 0.1 s do not split a
+//!   segment; each segment has its net distance, travel `Σ|Δc|` and peak speed.
 //!
 //! Warnings: the command or the position never moves (by more than 1 nm);
 //! the command moves from the first sample (no rest phase); position and
@@ -200,11 +201,11 @@ impl fmt::Display for RecordingInfo {
         )?;
         writeln!(
             f,
-            "sampling    {} Hz, dt {} s, jitter max {:.4} % ({} s)",
+            "sampling    {} Hz, dt {} ms, jitter max {:.4} % ({} µs)",
             fmt_num(self.rate_hz),
-            fmt_num(self.dt_s),
+            fmt_num(self.dt_s * 1e3),
             100.0 * self.jitter_max_relative,
-            fmt_num(self.jitter_max_abs_s)
+            fmt_num(self.jitter_max_abs_s * 1e6)
         )?;
         writeln!(
             f,
@@ -238,17 +239,18 @@ impl fmt::Display for RecordingInfo {
         if !self.segments.is_empty() {
             writeln!(
                 f,
-                "  {:>4} {:>12} {:>12} {:>14} {:>16}",
-                "#", "start [s]", "end [s]", "distance [mm]", "peak [mm/s]"
+                "  {:>4} {:>12} {:>12} {:>14} {:>14} {:>14}",
+                "#", "start [s]", "end [s]", "distance [mm]", "travel [mm]", "peak [mm/s]"
             )?;
             for (i, s) in self.segments.iter().enumerate() {
                 writeln!(
                     f,
-                    "  {:>4} {:>12} {:>12} {:>14} {:>16}",
+                    "  {:>4} {:>12} {:>12} {:>14} {:>14} {:>14}",
                     i + 1,
                     fmt_num(s.start_s),
                     fmt_num(s.end_s),
                     fmt_num(s.distance_m * 1e3),
+                    fmt_num(s.travel_m * 1e3),
                     fmt_num(s.peak_speed_m_per_s * 1e3)
                 )?;
             }
@@ -287,6 +289,7 @@ mod tests {
         assert_eq!(i.segments.len(), 1);
         assert!((i.segments[0].distance_m - 2e-3).abs() < 1e-15);
         assert!((i.segments[0].peak_speed_m_per_s - 1.0).abs() < 1e-9);
+        assert!((i.segments[0].travel_m - 2e-3).abs() < 1e-15);
         assert!(i.warnings.is_empty(), "{:?}", i.warnings);
     }
 
@@ -304,8 +307,16 @@ mod tests {
         let c: Vec<f64> = (0..10).map(|k| k as f64 * 1e-6).collect();
         let x: Vec<f64> = c.iter().map(|v| v * 1e3).collect();
         let i = recording_info(&rec(c, x));
-        assert!(i.warnings.iter().any(|w| w.contains("same unit")), "{:?}", i.warnings);
-        assert!(i.warnings.iter().any(|w| w.contains("first sample")), "{:?}", i.warnings);
+        assert!(
+            i.warnings.iter().any(|w| w.contains("same unit")),
+            "{:?}",
+            i.warnings
+        );
+        assert!(
+            i.warnings.iter().any(|w| w.contains("first sample")),
+            "{:?}",
+            i.warnings
+        );
     }
 
     #[test]
@@ -316,7 +327,10 @@ mod tests {
         let i = recording_info(&r);
         let text = i.to_string();
         assert!(text.contains("samples     4"), "{text}");
-        assert!(text.contains("command [mm]") && text.contains("u "), "{text}");
+        assert!(
+            text.contains("command [mm]") && text.contains("u "),
+            "{text}"
+        );
         assert!(text.contains("motion segments: 1"), "{text}");
         assert!(text.lines().count() < 20, "{text}");
         let json = serde_json::to_string(&i).unwrap();

@@ -286,10 +286,16 @@ fn parse_file(bytes: &[u8], path: &Path) -> Result<Vec<RawVar>> {
             if rest.iter().all(|&b| b == 0) {
                 break;
             }
-            return Err(err(format!("truncated: {} stray bytes at byte {pos}", rest.len())));
+            return Err(err(format!(
+                "truncated: {} stray bytes at byte {pos}",
+                rest.len()
+            )));
         }
-        let (dtype, body, consumed) = element(rest, big)
-            .map_err(|reason| err(format!("truncated or corrupted element at byte {pos}: {reason}")))?;
+        let (dtype, body, consumed) = element(rest, big).map_err(|reason| {
+            err(format!(
+                "truncated or corrupted element at byte {pos}: {reason}"
+            ))
+        })?;
         let parsed = match dtype {
             MI_MATRIX => Some(parse_matrix(body, big)),
             MI_COMPRESSED => Some(inflate(body).and_then(|inner| {
@@ -328,7 +334,12 @@ fn element(buf: &[u8], big: bool) -> std::result::Result<(u32, &[u8], usize), St
             buf.len().saturating_sub(8)
         )
     })?;
-    let consumed = 8 + n.div_ceil(8) * 8;
+    // Padding to 8 bytes; top-level compressed elements are not padded.
+    let consumed = if w0 == MI_COMPRESSED {
+        8 + n
+    } else {
+        8 + n.div_ceil(8) * 8
+    };
     Ok((w0, data, consumed.min(buf.len())))
 }
 
@@ -351,7 +362,10 @@ fn inflate(data: &[u8]) -> std::result::Result<Vec<u8>, String> {
     let le = u32::from_le_bytes([tag[4], tag[5], tag[6], tag[7]]) as usize;
     let be = u32::from_be_bytes([tag[4], tag[5], tag[6], tag[7]]) as usize;
     let declared = le.min(be);
-    let limit = data.len().saturating_mul(MAX_INFLATE_RATIO).saturating_add(64);
+    let limit = data
+        .len()
+        .saturating_mul(MAX_INFLATE_RATIO)
+        .saturating_add(64);
     if declared > limit {
         return Err(format!(
             "compressed element declares {declared} bytes, impossible for {} compressed bytes",
@@ -376,7 +390,10 @@ fn parse_matrix(body: &[u8], big: bool) -> std::result::Result<RawVar, String> {
     };
     let (t, flags) = next("array flags")?;
     if t != 6 || flags.len() < 4 {
-        return Err(format!("array flags have type {t} and {} bytes", flags.len()));
+        return Err(format!(
+            "array flags have type {t} and {} bytes",
+            flags.len()
+        ));
     }
     let f0 = u32_at(flags, 0, big).unwrap_or(0);
     let class = (f0 & 0xff) as u8;
@@ -478,10 +495,11 @@ fn vector_of(v: &RawVar) -> std::result::Result<Vec<f64>, String> {
 fn decode(dtype: u32, b: &[u8], big: bool) -> std::result::Result<Vec<f64>, String> {
     macro_rules! conv {
         ($t:ty, $n:expr) => {{
-            if b.len() % $n != 0 {
+            let chunks = b.chunks_exact($n);
+            if !chunks.remainder().is_empty() {
                 return Err(format!("{} data bytes, not a multiple of {}", b.len(), $n));
             }
-            b.chunks_exact($n)
+            chunks
                 .map(|c| {
                     let mut a = [0u8; $n];
                     a.copy_from_slice(c);
@@ -507,4 +525,130 @@ fn decode(dtype: u32, b: &[u8], big: bool) -> std::result::Result<Vec<f64>, Stri
         13 => conv!(u64, 8),
         t => return Err(format!("unsupported numeric storage type {t}")),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture(name: &str) -> Vec<u8> {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../tests/data")
+            .join(name);
+        std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+    }
+
+    fn le_header() -> Vec<u8> {
+        let mut h = b"MATLAB 5.0 MAT-file, test".to_vec();
+        h.resize(116, b' ');
+        h.extend_from_slice(&[0; 8]);
+        h.extend_from_slice(&0x0100u16.to_le_bytes());
+        h.extend_from_slice(b"IM");
+        h
+    }
+
+    fn tag(t: u32, n: u32) -> Vec<u8> {
+        let mut v = t.to_le_bytes().to_vec();
+        v.extend_from_slice(&n.to_le_bytes());
+        v
+    }
+
+    #[test]
+    fn lists_supported_and_unsupported_variables() {
+        let vars = list_mat_variables_from_bytes(&fixture("compressed_v7.mat"), Path::new("c.mat"))
+            .unwrap();
+        let get = |n: &str| vars.iter().find(|v| v.name == n).unwrap();
+        assert_eq!(get("t").dims, vec![1, 40]);
+        assert_eq!(get("qg").dims, vec![40, 1]);
+        assert!(get("t").supported && get("t").is_vector() && get("kp").is_vector());
+        assert!(get("M").supported && !get("M").is_vector());
+        assert_eq!(get("label").class, "char");
+        assert_eq!(get("z").class, "complex double");
+        assert_eq!(get("s").class, "struct");
+        assert_eq!(get("c").class, "cell");
+        for n in ["label", "z", "s", "c"] {
+            assert!(!get(n).supported, "{n}");
+        }
+        assert_eq!(get("c").to_string(), "c (cell 1×2, unsupported)");
+    }
+
+    #[test]
+    fn decodes_every_storage_type_both_endiannesses() {
+        let v = decode(5, &(-7i32).to_le_bytes(), false).unwrap();
+        assert_eq!(v, vec![-7.0]);
+        let v = decode(4, &[0x01, 0x02], true).unwrap();
+        assert_eq!(v, vec![258.0]);
+        let v = decode(7, &1.5f32.to_be_bytes(), true).unwrap();
+        assert_eq!(v, vec![1.5]);
+        let v = decode(13, &u64::MAX.to_le_bytes(), false).unwrap();
+        assert_eq!(v, vec![u64::MAX as f64]);
+        assert!(decode(9, &[0; 7], false).is_err());
+        assert!(decode(99, &[0; 8], false).is_err());
+    }
+
+    #[test]
+    fn huge_declared_sizes_are_errors_not_allocations() {
+        let mut b = le_header();
+        b.extend(tag(MI_MATRIX, 0xFFFF_FFF0));
+        b.extend([0u8; 16]);
+        let e = list_mat_variables_from_bytes(&b, Path::new("h.mat")).unwrap_err();
+        assert!(e.to_string().contains("declares 4294967280 bytes"), "{e}");
+
+        // A tiny zlib stream whose inner tag claims 4 GB.
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        std::io::Write::write_all(&mut z, &tag(MI_MATRIX, 0xFFFF_FFF0)).unwrap();
+        let z = z.finish().unwrap();
+        let mut b = le_header();
+        b.extend(tag(MI_COMPRESSED, z.len() as u32));
+        b.extend(&z);
+        let e = list_mat_variables_from_bytes(&b, Path::new("h.mat")).unwrap_err();
+        assert!(e.to_string().contains("impossible"), "{e}");
+    }
+
+    #[test]
+    fn non_mat_and_v73_files_are_refused_with_reason() {
+        let e = list_mat_variables_from_bytes(b"time,x\n1,2\n", Path::new("a.mat")).unwrap_err();
+        assert!(e.to_string().contains("not a MATLAB v5 MAT-file"), "{e}");
+        let e = list_mat_variables_from_bytes(&fixture("v73.mat"), Path::new("v.mat")).unwrap_err();
+        assert!(
+            e.to_string().contains("v7.3 (HDF5)") && e.to_string().contains("-v7"),
+            "{e}"
+        );
+        assert!(is_mat_bytes(&fixture("v73.mat")) && is_mat_bytes(&fixture("double_v6.mat")));
+    }
+
+    #[test]
+    fn every_truncation_and_byte_flip_gives_a_result_never_a_panic() {
+        for name in [
+            "compressed_v7.mat",
+            "double_v6.mat",
+            "big_endian.mat",
+            "int_types.mat",
+        ] {
+            let data = fixture(name);
+            for cut in 0..data.len() {
+                let _ = list_mat_variables_from_bytes(&data[..cut], Path::new(name));
+            }
+            for pos in 0..data.len() {
+                for flip in [0xFFu8, 0x80, 0x01] {
+                    let mut d = data.clone();
+                    d[pos] ^= flip;
+                    if let Ok(vars) = parse_file(&d, Path::new(name)) {
+                        for v in &vars {
+                            let _ = vector_of(v);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn truncated_file_is_reported_as_truncated() {
+        let e = list_mat_variables_from_bytes(&fixture("truncated.mat"), Path::new("t.mat"))
+            .unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::MatFile { .. }), "{msg}");
+        assert!(msg.contains("truncated"), "{msg}");
+    }
 }

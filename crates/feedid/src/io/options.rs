@@ -303,8 +303,14 @@ mod tests {
     #[test]
     fn channel_ref_digits_are_one_based_indices_else_names() {
         assert_eq!(ChannelRef::parse("3").unwrap(), ChannelRef::Index(3));
-        assert_eq!(ChannelRef::parse(" qm ").unwrap(), ChannelRef::Name("qm".into()));
-        assert_eq!(ChannelRef::parse("x3").unwrap(), ChannelRef::Name("x3".into()));
+        assert_eq!(
+            ChannelRef::parse(" qm ").unwrap(),
+            ChannelRef::Name("qm".into())
+        );
+        assert_eq!(
+            ChannelRef::parse("x3").unwrap(),
+            ChannelRef::Name("x3".into())
+        );
         assert!(ChannelRef::parse("0").is_err());
         assert!(ChannelRef::parse("").is_err());
     }
@@ -328,7 +334,10 @@ mod tests {
             position_unit: Unit::Mm,
             ..Default::default()
         };
-        assert!(matches!(o.validate(), Err(Error::InvalidParameter { name: "scale", .. })));
+        assert!(matches!(
+            o.validate(),
+            Err(Error::InvalidParameter { name: "scale", .. })
+        ));
         let o = ReadOptions {
             scale: Some(1e-7),
             ..Default::default()

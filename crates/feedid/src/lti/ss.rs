@@ -368,3 +368,327 @@ fn strictly_proper_numerator(sys: &StateSpace) -> Result<Vec<f64>> {
     let zeros = eigenvalues(&z)?;
     Ok(poly_from_roots(&zeros).iter().map(|c| c * g).collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Default rig of NOTES.md §1.
+    struct Rig {
+        r: f64,
+        k: f64,
+        j: f64,
+        m: f64,
+        kt: f64,
+        ke: f64,
+        res: f64,
+        l: f64,
+        c1: f64,
+        c2: f64,
+        kv: f64,
+        kp: f64,
+        ki: f64,
+        kpi: f64,
+        kii: f64,
+    }
+
+    const RIG: Rig = Rig {
+        r: 0.010 / (2.0 * std::f64::consts::PI),
+        k: 3.0e7,
+        j: 1.6e-5,
+        m: 3.0,
+        kt: 0.06,
+        ke: 0.06,
+        res: 1.2,
+        l: 3.5e-4,
+        c1: 5e-5,
+        c2: 100.0,
+        kv: 700.0,
+        kp: 465.8,
+        ki: 471.2,
+        kpi: 4.398,
+        kii: 3428.6,
+    };
+
+    /// The 7-state cascade [z_v, z_i, i, θ, ω, x_a, v_a] of NOTES.md §1, input x_s, output x_a.
+    fn feed_drive_ss(p: &Rig) -> StateSpace {
+        let mut a = DMatrix::<f64>::zeros(7, 7);
+        let mut b = DVector::<f64>::zeros(7);
+        // ż_v = e_v = Kv·(x_s − x_a) − r·ω
+        a[(0, 4)] = -p.r;
+        a[(0, 5)] = -p.kv;
+        b[0] = p.kv;
+        // ż_i = i_ref − i, i_ref = Kp·(e_v + Ki·z_v)
+        a[(1, 0)] = p.kp * p.ki;
+        a[(1, 2)] = -1.0;
+        a[(1, 4)] = -p.kp * p.r;
+        a[(1, 5)] = -p.kp * p.kv;
+        b[1] = p.kp * p.kv;
+        // L·di/dt = Kpi·(i_ref − i + Kii·z_i) − R·i − Ke·ω
+        a[(2, 0)] = p.kpi * p.kp * p.ki / p.l;
+        a[(2, 1)] = p.kpi * p.kii / p.l;
+        a[(2, 2)] = -(p.kpi + p.res) / p.l;
+        a[(2, 4)] = -(p.kpi * p.kp * p.r + p.ke) / p.l;
+        a[(2, 5)] = -p.kpi * p.kp * p.kv / p.l;
+        b[2] = p.kpi * p.kp * p.kv / p.l;
+        // θ̇ = ω; J·ω̇ = Kt·i − C1·ω − r·K·(r·θ − x_a)
+        a[(3, 4)] = 1.0;
+        a[(4, 2)] = p.kt / p.j;
+        a[(4, 3)] = -p.r * p.r * p.k / p.j;
+        a[(4, 4)] = -p.c1 / p.j;
+        a[(4, 5)] = p.r * p.k / p.j;
+        // ẋ_a = v_a; M·v̇_a = K·(r·θ − x_a) − C2·v_a
+        a[(5, 6)] = 1.0;
+        a[(6, 3)] = p.k * p.r / p.m;
+        a[(6, 5)] = -p.k / p.m;
+        a[(6, 6)] = -p.c2 / p.m;
+        let mut c = RowDVector::<f64>::zeros(7);
+        c[5] = 1.0;
+        StateSpace::new(a, b, c, 0.0).unwrap()
+    }
+
+    /// N and D of NOTES.md §1 (corrected appendix), normalised so that D7 = J·L·M.
+    fn feed_drive_coefficients(p: &Rig) -> (Vec<f64>, Vec<f64>) {
+        let Rig {
+            r,
+            k,
+            j,
+            m,
+            kt,
+            ke,
+            res,
+            l,
+            c1,
+            c2,
+            kv,
+            kp,
+            ki,
+            kpi,
+            kii,
+        } = *p;
+        let n2 = k * kp * kpi * kt * kv * r;
+        let n1 = n2 * (ki + kii);
+        let n0 = n2 * ki * kii;
+        let d7 = j * l * m;
+        let d6 = c1 * l * m + c2 * j * l + j * m * (res + kpi);
+        let d5 = c1 * c2 * l
+            + c1 * m * res
+            + c2 * j * res
+            + j * k * l
+            + k * l * m * r * r
+            + ke * kt * m
+            + kpi * (c1 * m + c2 * j + j * kii * m + kp * kt * m * r);
+        let d4 = c1 * c2 * res
+            + c1 * k * l
+            + c2 * k * l * r * r
+            + c2 * ke * kt
+            + j * k * res
+            + k * m * res * r * r
+            + kpi
+                * (c1 * c2
+                    + c1 * kii * m
+                    + c2 * j * kii
+                    + c2 * kp * kt * r
+                    + j * k
+                    + k * m * r * r
+                    + (ki + kii) * kp * kt * m * r);
+        let d3 = k * (c1 * res + c2 * res * r * r + ke * kt)
+            + kpi
+                * (c1 * c2 * kii
+                    + c1 * k
+                    + c2 * k * r * r
+                    + c2 * (ki + kii) * kp * kt * r
+                    + j * k * kii
+                    + k * kii * m * r * r
+                    + k * kp * kt * r
+                    + ki * kii * kp * kt * m * r);
+        let d2 = kpi
+            * (c1 * k * kii
+                + c2 * k * kii * r * r
+                + c2 * ki * kii * kp * kt * r
+                + k * kp * kt * r * (ki + kii + kv));
+        let d1 = k * kp * kpi * kt * r * (ki * kii + kv * (ki + kii));
+        let d0 = n0;
+        (vec![n2, n1, n0], vec![d7, d6, d5, d4, d3, d2, d1, d0])
+    }
+
+    fn assert_coeffs_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
+        assert_eq!(a.len(), b.len(), "{what}: {a:?} vs {b:?}");
+        for (k, (x, y)) in a.iter().zip(b).enumerate() {
+            assert!(
+                (x - y).abs() <= tol * y.abs(),
+                "{what}[{k}]: {x:e} vs {y:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn feed_drive_state_space_to_tf_matches_hand_derived_coefficients() {
+        let sys = feed_drive_ss(&RIG);
+        let (num, den) = feed_drive_coefficients(&RIG);
+        let tf = sys.to_tf().unwrap();
+        let scale = den[0];
+        let got_num: Vec<f64> = tf.num().iter().map(|c| c * scale).collect();
+        let got_den: Vec<f64> = tf.den().iter().map(|c| c * scale).collect();
+        assert_coeffs_close(&got_den, &den, 1e-9, "den");
+        assert_coeffs_close(&got_num, &num, 1e-9, "num");
+        // And the rounded test values of NOTES.md, to half a unit of the 6th digit.
+        let notes_num: [f64; 3] = [4.10814e9, 1.60209e13, 6.63693e15];
+        let notes_den: [f64; 8] = [
+            1.68000e-8, 2.69316e-4, 1.57906, 6.30146e3, 1.77277e7, 2.71640e10, 2.55023e13,
+            6.63693e15,
+        ];
+        for (x, p) in got_num
+            .iter()
+            .chain(&got_den)
+            .zip(notes_num.iter().chain(&notes_den))
+        {
+            let half_unit = 0.5 * 10f64.powf(p.abs().log10().floor() - 5.0);
+            assert!((x - p).abs() <= half_unit * 1.0001, "{x:e} vs NOTES {p:e}");
+        }
+    }
+
+    #[test]
+    fn feed_drive_dc_gain_is_one_and_poles_are_stable() {
+        let sys = feed_drive_ss(&RIG);
+        assert!((sys.dc_gain().unwrap() - 1.0).abs() < 1e-12);
+        assert!(sys.is_stable().unwrap());
+        let tf_poles = sys.to_tf().unwrap().poles().unwrap();
+        let ss_poles = sys.poles().unwrap();
+        for (a, b) in tf_poles.iter().zip(&ss_poles) {
+            assert!((a - b).norm() < 1e-9 * b.norm(), "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn balance_preserves_transfer_function_and_reduces_spread() {
+        let sys = feed_drive_ss(&RIG);
+        let bal = sys.balance();
+        for w in [0.0, 10.0, 3e3, 1e5] {
+            let s = Complex::new(0.0, w);
+            let a = sys.eval_direct(s).unwrap();
+            let b = bal.eval_direct(s).unwrap();
+            assert!((a - b).norm() <= 1e-12 * b.norm(), "w={w}: {a} vs {b}");
+        }
+        let spread = |m: &DMatrix<f64>| {
+            let nz: Vec<f64> = m.iter().filter(|v| **v != 0.0).map(|v| v.abs()).collect();
+            nz.iter().cloned().fold(0.0, f64::max)
+                / nz.iter().cloned().fold(f64::INFINITY, f64::min)
+        };
+        assert!(
+            spread(&bal.a) < 1e-3 * spread(&sys.a),
+            "{} vs {}",
+            spread(&bal.a),
+            spread(&sys.a)
+        );
+        // Balancing twice changes nothing.
+        assert_eq!(bal.balance(), bal);
+    }
+
+    #[test]
+    fn zoh_of_first_order_matches_closed_form() {
+        let (tau, k, dt) = (0.02, 3.0, 1e-3);
+        let sys = StateSpace::new(
+            DMatrix::from_element(1, 1, -1.0 / tau),
+            DVector::from_element(1, 1.0 / tau),
+            RowDVector::from_element(1, k),
+            0.0,
+        )
+        .unwrap();
+        let d = sys.discretize_zoh(dt).unwrap();
+        let e = (-dt / tau).exp();
+        assert!((d.a[(0, 0)] - e).abs() <= 1e-15 * e);
+        assert!((d.b[0] - (1.0 - e)).abs() <= 1e-14 * (1.0 - e));
+        assert_eq!(d.c[0], k);
+        assert_eq!(d.dt, dt);
+    }
+
+    #[test]
+    fn zoh_poles_are_exponentials_of_continuous_poles() {
+        let sys = feed_drive_ss(&RIG);
+        let dt = 2e-4;
+        let d = sys.discretize_zoh(dt).unwrap();
+        let mut want: Vec<Complex<f64>> = sys
+            .poles()
+            .unwrap()
+            .iter()
+            .map(|p| (p * dt).exp())
+            .collect();
+        crate::lti::poly::sort_roots(&mut want);
+        for (a, b) in d.poles().unwrap().iter().zip(&want) {
+            assert!((a - b).norm() < 1e-12, "{a} vs {b}");
+        }
+        assert!(d.is_stable().unwrap());
+        assert!((d.dc_gain().unwrap() - 1.0).abs() < 1e-10);
+    }
+
+    #[test]
+    fn simulate_of_constant_input_equals_scaled_step_response() {
+        let sys = feed_drive_ss(&RIG);
+        let dt = 2e-4;
+        let step = sys.step_response(dt, 300).unwrap();
+        let y = sys.simulate(&[1e-3; 300], dt, None).unwrap();
+        for (a, b) in y.iter().zip(&step) {
+            assert!((a - 1e-3 * b).abs() < 1e-15, "{a} vs {b}");
+        }
+        // Superposition: starting from the state reached after 150 samples continues the response.
+        let d = sys.discretize_zoh(dt).unwrap();
+        let mut x = vec![0.0; 7];
+        let mut y1 = vec![0.0; 150];
+        let mut scratch = vec![0.0; 7];
+        d.simulate_into(&[1.0; 150], &mut x, &mut y1, &mut scratch)
+            .unwrap();
+        let y2 = sys.simulate(&[1.0; 150], dt, Some(&x)).unwrap();
+        for (k, (a, b)) in y1.iter().chain(&y2).zip(&step).enumerate() {
+            assert!((a - b).abs() < 1e-12, "{k}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn eval_matches_transfer_function_and_rejects_poles() {
+        let sys = feed_drive_ss(&RIG);
+        let tf = sys.to_tf().unwrap();
+        for f in [1.0, 60.0, 561.0, 2e3, 5e4] {
+            let s = Complex::new(0.0, 2.0 * std::f64::consts::PI * f);
+            let a = sys.eval(s).unwrap();
+            let b = tf.eval(s);
+            assert!((a - b).norm() <= 1e-9 * b.norm(), "f={f}: {a} vs {b}");
+        }
+        let integ = StateSpace::new(
+            DMatrix::zeros(1, 1),
+            DVector::from_element(1, 1.0),
+            RowDVector::from_element(1, 1.0),
+            0.0,
+        )
+        .unwrap();
+        assert!(matches!(
+            integ.eval(Complex::new(0.0, 0.0)),
+            Err(Error::Singular { .. })
+        ));
+        assert!(matches!(integ.dc_gain(), Err(Error::Singular { .. })));
+        assert!(!integ.is_stable().unwrap());
+    }
+
+    #[test]
+    fn to_tf_handles_zero_output_and_static_gain() {
+        let sys = StateSpace::new(
+            DMatrix::from_element(1, 1, -2.0),
+            DVector::from_element(1, 1.0),
+            RowDVector::from_element(1, 0.0),
+            0.0,
+        )
+        .unwrap();
+        let tf = sys.to_tf().unwrap();
+        assert_eq!(tf.num(), &[0.0]);
+        assert_eq!(tf.den(), &[1.0, 2.0]);
+        let stat = StateSpace::new(
+            DMatrix::zeros(0, 0),
+            DVector::zeros(0),
+            RowDVector::zeros(0),
+            4.0,
+        )
+        .unwrap();
+        assert_eq!(stat.to_tf().unwrap().num(), &[4.0]);
+        assert_eq!(stat.step_response(0.1, 3).unwrap(), vec![4.0; 3]);
+    }
+}

@@ -504,7 +504,7 @@ mod tests {
         for case in 0..200 {
             let n = rng.random_range(1..=8);
             let m = rng.random_range(0..n);
-            let mut roots = |count: usize, rng: &mut ChaCha8Rng| {
+            let roots = |count: usize, rng: &mut ChaCha8Rng| {
                 let mut r = Vec::new();
                 while r.len() < count {
                     let wn = 10f64.powf(rng.random_range(0.0..4.0));
@@ -545,7 +545,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(99);
         for case in 0..100 {
             let n = rng.random_range(1..=7);
-            let mut real_roots = |rng: &mut ChaCha8Rng| -> Vec<Complex<f64>> {
+            let real_roots = |rng: &mut ChaCha8Rng| -> Vec<Complex<f64>> {
                 (0..n)
                     .map(|_| Complex::new(-10f64.powf(rng.random_range(2.0..3.0)), 0.0))
                     .collect()

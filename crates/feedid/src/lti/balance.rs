@@ -41,7 +41,7 @@ pub(crate) fn balance_scaling(m: &DMatrix<f64>, n_free: usize) -> Vec<f64> {
     let sfmax2 = 1.0 / sfmin2;
     for _ in 0..MAX_SWEEPS {
         let mut changed = false;
-        for i in 0..n_free {
+        for (i, di) in d.iter_mut().enumerate().take(n_free) {
             let mut c = a.column(i).norm();
             let mut r = a.row(i).norm();
             let mut ca = a.column(i).amax();
@@ -72,13 +72,13 @@ pub(crate) fn balance_scaling(m: &DMatrix<f64>, n_free: usize) -> Vec<f64> {
             if c + r >= FACTOR * s {
                 continue;
             }
-            if f < 1.0 && d[i] < 1.0 && f * d[i] <= sfmin1 {
+            if f < 1.0 && *di < 1.0 && f * *di <= sfmin1 {
                 continue;
             }
-            if f > 1.0 && d[i] > 1.0 && d[i] >= sfmax1 / f {
+            if f > 1.0 && *di > 1.0 && *di >= sfmax1 / f {
                 continue;
             }
-            d[i] *= f;
+            *di *= f;
             a.row_mut(i).scale_mut(1.0 / f);
             a.column_mut(i).scale_mut(f);
             changed = true;

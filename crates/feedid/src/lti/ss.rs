@@ -23,9 +23,14 @@
 //!   rounding); the zeros zᵢ are the eigenvalues of
 //!   A_z = A − B·C·A^r/g restricted to its invariant subspace
 //!   ker[C; C·A; …; C·A^(r−1)] (orthonormal basis from a QR factorisation).
-//!   The feed-through adds D·det(sI − A). For stable systems with real
-//!   coefficients of one sign this gives every coefficient to near machine
-//!   relative accuracy, unlike det(sI − A + BC) − det(sI − A), which cancels.
+//!   The feed-through adds D·det(sI − A); if that sum cancels by more than a
+//!   factor 1e3 the numerator is taken as D·det(sI − A + B·C/D) instead. For
+//!   stable systems with coefficients of one sign this gives every coefficient
+//!   to near machine relative accuracy (the 7-state feed-drive model: < 1e-12),
+//!   unlike det(sI − A + BC) − det(sI − A), which cancels. Limits: a cluster of
+//!   several zeros far below the pole magnitudes loses digits (seen: 1e-7), and
+//!   a biproper model realised in companion form already carries the
+//!   cancellation of N − D·den in its C row.
 //!
 //! References: MATLAB `ssbal`; LAPACK `dgebal`; A. Emami-Naeini, P. Van Dooren,
 //! "Computation of zeros of linear multivariable systems", Automatica 18 (1982);

@@ -297,12 +297,20 @@ mod tests {
             let scale = c.den[0] / tf.den()[0];
             assert_eq!(tf.den().len(), 8);
             for (k, (&got, &want)) in tf.den().iter().zip(c.den.iter()).enumerate() {
-                assert!(rel(got * scale, want) < 1e-9, "case {case} D{}: {got} vs {want}", 7 - k);
+                assert!(
+                    rel(got * scale, want) < 1e-9,
+                    "case {case} D{}: {got} vs {want}",
+                    7 - k
+                );
             }
             let num = tf.num();
             assert_eq!(num.len(), 3, "relative degree 5: {num:?}");
             for (k, (&got, &want)) in num.iter().zip(c.num.iter()).enumerate() {
-                assert!(rel(got * scale, want) < 1e-9, "case {case} N{}: {got} vs {want}", 2 - k);
+                assert!(
+                    rel(got * scale, want) < 1e-9,
+                    "case {case} N{}: {got} vs {want}",
+                    2 - k
+                );
             }
             p.control.kv *= 1.3;
             p.damping.c2 *= 2.0;

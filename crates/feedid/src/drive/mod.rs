@@ -11,9 +11,9 @@ pub use closed_loop::{
     closed_loop_coefficients, closed_loop_coefficients_with_stiffness, closed_loop_state_space,
     closed_loop_state_space_with_stiffness, ClosedLoopCoefficients, D1Variant,
 };
+pub use nominal::simulate_nominal;
 pub use params::{
     equivalent_stiffness, screw_inertia, screw_stiffness, total_inertia, Control, Damping,
     Geometry, Inertia, Material, Motor, RigParams, Stiffness, Table,
 };
-pub use nominal::simulate_nominal;
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

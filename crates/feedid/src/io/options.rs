@@ -224,7 +224,7 @@ pub struct ReadOptions {
     pub scale: Option<f64>,
     /// Unit of the time column. Default: s.
     pub time_unit: TimeUnit,
-    /// Allowed relative deviation of a sampling interval from the median one. Default: 0.01.
+    /// Allowed relative deviation of a sampling interval from the mean one. Default: 0.01.
     pub jitter_tolerance: f64,
 }
 

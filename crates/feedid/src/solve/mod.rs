@@ -3,6 +3,8 @@
 //! Levenberg–Marquardt. Each iterative solver returns a report with its
 //! termination reason.
 
+mod qr;
 mod termination;
 
+pub use qr::{lstsq, lstsq_in_place, lstsq_with, LstsqInfo, LstsqOptions, LstsqSolution, QrWorkspace};
 pub use termination::Termination;

@@ -5,5 +5,10 @@
 //! shifts by a hop.
 
 mod estimator;
+mod paper;
 
 pub use estimator::{Estimator, Signals, WindowFit};
+pub use paper::{
+    coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
+    PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,
+};

@@ -184,7 +184,13 @@ impl LevenbergMarquardt {
         self.run(residual, Some(jacobian), p, config)
     }
 
-    fn run<R, J>(&mut self, mut residual: R, mut jacobian: Option<J>, p: &mut [f64], config: &LmConfig) -> Result<LmReport>
+    fn run<R, J>(
+        &mut self,
+        mut residual: R,
+        mut jacobian: Option<J>,
+        p: &mut [f64],
+        config: &LmConfig,
+    ) -> Result<LmReport>
     where
         R: FnMut(&[f64], &mut [f64]),
         J: FnMut(&[f64], &mut [f64]),
@@ -244,7 +250,11 @@ impl LevenbergMarquardt {
                 None => {
                     for j in 0..n {
                         let pj = p[j];
-                        let h = if pj == 0.0 { config.fd_step } else { config.fd_step * pj.abs() };
+                        let h = if pj == 0.0 {
+                            config.fd_step
+                        } else {
+                            config.fd_step * pj.abs()
+                        };
                         p[j] = pj + h;
                         let h = p[j] - pj; // exactly representable step
                         residual(p, &mut self.r_tmp);
@@ -321,9 +331,14 @@ impl LevenbergMarquardt {
                     .map(|(d, s)| (d * s) * (d * s))
                     .sum::<f64>()
                     .sqrt();
-                let x_norm = p.iter().zip(&self.diag).map(|(d, s)| (d * s) * (d * s)).sum::<f64>().sqrt();
-                for j in 0..n {
-                    self.p_new[j] = p[j] + self.delta[j];
+                let x_norm = p
+                    .iter()
+                    .zip(&self.diag)
+                    .map(|(d, s)| (d * s) * (d * s))
+                    .sum::<f64>()
+                    .sqrt();
+                for ((pn, pj), dj) in self.p_new.iter_mut().zip(p.iter()).zip(&self.delta) {
+                    *pn = pj + dj;
                 }
                 residual(&self.p_new, &mut self.r_new);
                 evaluations += 1;
@@ -335,14 +350,19 @@ impl LevenbergMarquardt {
                 let actual = cost - new_cost;
                 let predicted = cost - pred_cost;
                 if new_cost < cost {
-                    let rho = if predicted > 0.0 { actual / predicted } else { 1.0 };
+                    let rho = if predicted > 0.0 {
+                        actual / predicted
+                    } else {
+                        1.0
+                    };
                     mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
                     nu = 2.0;
                     p.copy_from_slice(&self.p_new);
                     std::mem::swap(&mut self.r, &mut self.r_new);
                     cost = new_cost;
                     self.jac_at_p = false;
-                    let f_conv = actual <= config.ftol * (cost + actual) && predicted.abs() <= config.ftol * (cost + actual);
+                    let f_conv = actual <= config.ftol * (cost + actual)
+                        && predicted.abs() <= config.ftol * (cost + actual);
                     let x_conv = dx_norm <= config.xtol * x_norm;
                     if f_conv || x_conv || cost == 0.0 {
                         break 'outer Termination::Converged;
@@ -365,7 +385,11 @@ impl LevenbergMarquardt {
                 None => {
                     for j in 0..n {
                         let pj = p[j];
-                        let h = if pj == 0.0 { config.fd_step } else { config.fd_step * pj.abs() };
+                        let h = if pj == 0.0 {
+                            config.fd_step
+                        } else {
+                            config.fd_step * pj.abs()
+                        };
                         p[j] = pj + h;
                         let h = p[j] - pj;
                         residual(p, &mut self.r_tmp);
@@ -427,7 +451,10 @@ mod tests {
             )
             .unwrap();
         assert_eq!(rep.termination, Termination::Converged);
-        assert!((p[0] - 3.0).abs() < 1e-10 && (p[1] - 0.8).abs() < 1e-10 && (p[2] - 0.5).abs() < 1e-10, "{p:?}");
+        assert!(
+            (p[0] - 3.0).abs() < 1e-10 && (p[1] - 0.8).abs() < 1e-10 && (p[2] - 0.5).abs() < 1e-10,
+            "{p:?}"
+        );
         assert!(rep.residual_norm < 1e-10);
     }
 
@@ -452,7 +479,9 @@ mod tests {
         let mut p_fd = [1.0, 0.3, 0.0];
         lm.minimize(res, &mut p_fd, &LmConfig::default()).unwrap();
         let mut p_an = [1.0, 0.3, 0.0];
-        let rep = lm.minimize_with_jacobian(res, jac, &mut p_an, &LmConfig::default()).unwrap();
+        let rep = lm
+            .minimize_with_jacobian(res, jac, &mut p_an, &LmConfig::default())
+            .unwrap();
         assert_eq!(rep.termination, Termination::Converged);
         for k in 0..3 {
             assert!((p_fd[k] - p_an[k]).abs() < 1e-7, "{p_fd:?} {p_an:?}");
@@ -489,7 +518,10 @@ mod tests {
             )
             .unwrap();
         assert_eq!(rep.termination, Termination::Converged);
-        assert!((p[0] - 1.0).abs() < 1e-10 && (p[1] - 1.0).abs() < 1e-10, "{p:?}");
+        assert!(
+            (p[0] - 1.0).abs() < 1e-10 && (p[1] - 1.0).abs() < 1e-10,
+            "{p:?}"
+        );
     }
 
     #[test]
@@ -519,7 +551,10 @@ mod tests {
         // y = a·t⁵ + b·exp(−c·t) with a ~ 1e10 and t in ms-range seconds
         let t: Vec<f64> = (1..30).map(|i| i as f64 * 2e-4).collect();
         let truth = [3e10, 1e-3, 500.0];
-        let y: Vec<f64> = t.iter().map(|&t| truth[0] * t.powi(5) + truth[1] * (-truth[2] * t).exp()).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|&t| truth[0] * t.powi(5) + truth[1] * (-truth[2] * t).exp())
+            .collect();
         let mut lm = LevenbergMarquardt::new(t.len(), 3);
         let mut p = [1e10, 2e-3, 300.0];
         let rep = lm
@@ -544,7 +579,11 @@ mod tests {
         let mut lm = LevenbergMarquardt::new(1, 1);
         let mut p = [0.0];
         assert!(matches!(
-            lm.minimize(|_: &[f64], r: &mut [f64]| r[0] = f64::NAN, &mut p, &LmConfig::default()),
+            lm.minimize(
+                |_: &[f64], r: &mut [f64]| r[0] = f64::NAN,
+                &mut p,
+                &LmConfig::default()
+            ),
             Err(Error::NonFinite { .. })
         ));
     }

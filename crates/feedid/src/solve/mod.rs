@@ -10,5 +10,7 @@ mod termination;
 
 pub use lm::{LevenbergMarquardt, LmConfig, LmReport};
 pub use nelder_mead::{nelder_mead, NelderMead, NelderMeadConfig, NelderMeadReport};
-pub use qr::{lstsq, lstsq_in_place, lstsq_with, LstsqInfo, LstsqOptions, LstsqSolution, QrWorkspace};
+pub use qr::{
+    lstsq, lstsq_in_place, lstsq_with, LstsqInfo, LstsqOptions, LstsqSolution, QrWorkspace,
+};
 pub use termination::Termination;

@@ -17,7 +17,7 @@
 //! The start simplex is `x₀` plus the vertices `x₀ + h_j·e_j` with caller
 //! supplied per-coordinate steps `h_j ≠ 0`. It stops, like SciPy's
 //! `fmin(xatol, fatol)`, when **both** the spread of `f` over the simplex
-//! `max_i |f_i − f₀| ≤ ftol` and the simplex size
+//! `max_i |f_i − f₀| ≤ ftol` (optionally `+ ftol_rel·|f₀| + ftol_root·√|f₀|`) and the simplex size
 //! `max_i ‖x_i − x₀‖_∞ ≤ xtol` hold ([`Termination::Converged`]), or at the
 //! iteration or evaluation cap ([`Termination::MaxIterations`]).
 //! A NaN objective value is treated as `+∞` (the point is rejected).
@@ -48,6 +48,16 @@ pub struct NelderMeadConfig {
     /// Absolute tolerance on the spread `max_i |f_i − f₀|` of the objective
     /// over the simplex (units of `f`). Default `1e-4` (SciPy's `fatol`).
     pub ftol: f64,
+    /// Relative tolerance on the spread: the test is
+    /// `max_i |f_i − f₀| ≤ ftol + ftol_rel·|f₀|`, which can be met when the
+    /// minimum value is large compared with its rounding error. Default 0
+    /// (SciPy's absolute test).
+    pub ftol_rel: f64,
+    /// Tolerance on the spread proportional to `√|f₀|`: the test becomes
+    /// `max_i |f_i − f₀| ≤ ftol + ftol_rel·|f₀| + ftol_root·√|f₀|`. Meant
+    /// for sums of squares `f = ‖r‖²`, whose rounding error is
+    /// `≈ 2‖r‖·δr`, i.e. proportional to `√f`. Default 0.
+    pub ftol_root: f64,
     /// Iteration cap. Default 1000.
     pub max_iterations: usize,
     /// Objective-evaluation cap. Default 2000.
@@ -59,6 +69,8 @@ impl Default for NelderMeadConfig {
         Self {
             xtol: 1e-4,
             ftol: 1e-4,
+            ftol_rel: 0.0,
+            ftol_root: 0.0,
             max_iterations: 1000,
             max_evaluations: 2000,
         }
@@ -83,9 +95,11 @@ pub struct NelderMeadReport {
 #[derive(Debug, Clone)]
 pub struct NelderMead {
     n: usize,
-    /// `(n+1)` vertices, row `i` = `simplex[i·n..(i+1)·n]`, sorted by `fvals`.
+    /// `(n+1)` vertices, row `i` = `simplex[i·n..(i+1)·n]`, objective `fvals[i]`.
     simplex: Vec<f64>,
     fvals: Vec<f64>,
+    /// Vertex indices sorted by objective value (best first).
+    order: Vec<usize>,
     centroid: Vec<f64>,
     xr: Vec<f64>,
     xe: Vec<f64>,
@@ -99,6 +113,7 @@ impl NelderMead {
             n,
             simplex: vec![0.0; (n + 1) * n],
             fvals: vec![0.0; n + 1],
+            order: (0..=n).collect(),
             centroid: vec![0.0; n],
             xr: vec![0.0; n],
             xe: vec![0.0; n],
@@ -173,10 +188,18 @@ impl NelderMead {
                 reason: "must be finite",
             });
         }
-        if !(config.xtol >= 0.0 && config.ftol >= 0.0) {
+        if !(config.xtol >= 0.0
+            && config.ftol >= 0.0
+            && config.ftol_rel >= 0.0
+            && config.ftol_root >= 0.0)
+        {
             return Err(Error::InvalidParameter {
                 name: "Nelder-Mead tolerance",
-                value: config.xtol.min(config.ftol),
+                value: config
+                    .xtol
+                    .min(config.ftol)
+                    .min(config.ftol_rel)
+                    .min(config.ftol_root),
                 reason: "must be >= 0",
             });
         }
@@ -198,7 +221,7 @@ impl NelderMead {
         };
 
         let mut evaluations = 0;
-        // start simplex
+        // start simplex (vertex rows in place; `order` sorts them by f)
         self.simplex[..n].copy_from_slice(x);
         self.fvals[0] = eval(x, &mut evaluations);
         if !self.fvals[0].is_finite() {
@@ -213,6 +236,9 @@ impl NelderMead {
             row.copy_from_slice(x);
             row[j] += steps[j];
             self.fvals[j + 1] = eval(&self.simplex[(j + 1) * n..(j + 2) * n], &mut evaluations);
+        }
+        for (i, o) in self.order.iter_mut().enumerate() {
+            *o = i;
         }
         self.sort();
 
@@ -230,74 +256,90 @@ impl NelderMead {
             for v in self.centroid.iter_mut() {
                 *v = 0.0;
             }
-            for i in 0..n {
-                for (c, s) in self.centroid.iter_mut().zip(&self.simplex[i * n..(i + 1) * n]) {
+            for &i in &self.order[..n] {
+                for (c, s) in self
+                    .centroid
+                    .iter_mut()
+                    .zip(&self.simplex[i * n..(i + 1) * n])
+                {
                     *c += s;
                 }
             }
+            let inv_n = 1.0 / n as f64;
             for c in self.centroid.iter_mut() {
-                *c /= n as f64;
+                *c *= inv_n;
             }
-            let worst = n * n..(n + 1) * n;
-            for j in 0..n {
-                let c = self.centroid[j];
-                self.xr[j] = c + RHO * (c - self.simplex[worst.start + j]);
+            let iw = self.order[n];
+            let worst = iw * n..(iw + 1) * n;
+            for ((r, c), w) in self
+                .xr
+                .iter_mut()
+                .zip(&self.centroid)
+                .zip(&self.simplex[worst.clone()])
+            {
+                *r = c + RHO * (c - w);
             }
             let fr = eval(&self.xr, &mut evaluations);
-            let f0 = self.fvals[0];
-            let fworst = self.fvals[n];
-            let fsecond = self.fvals[n - 1];
+            let f0 = self.fvals[self.order[0]];
+            let fworst = self.fvals[iw];
+            let fsecond = self.fvals[self.order[n - 1]];
 
             if fr < f0 {
-                for j in 0..n {
-                    let c = self.centroid[j];
-                    self.xe[j] = c + CHI * (self.xr[j] - c);
+                for ((e, c), r) in self.xe.iter_mut().zip(&self.centroid).zip(&self.xr) {
+                    *e = c + CHI * (r - c);
                 }
                 let fe = eval(&self.xe, &mut evaluations);
                 if fe < fr {
                     self.simplex[worst].copy_from_slice(&self.xe);
-                    self.fvals[n] = fe;
+                    self.fvals[iw] = fe;
                 } else {
                     self.simplex[worst].copy_from_slice(&self.xr);
-                    self.fvals[n] = fr;
+                    self.fvals[iw] = fr;
                 }
             } else if fr < fsecond {
                 self.simplex[worst].copy_from_slice(&self.xr);
-                self.fvals[n] = fr;
+                self.fvals[iw] = fr;
             } else {
                 let mut do_shrink = false;
                 if fr < fworst {
                     // outside contraction
-                    for j in 0..n {
-                        let c = self.centroid[j];
-                        self.xe[j] = c + GAMMA * (self.xr[j] - c);
+                    for ((e, c), r) in self.xe.iter_mut().zip(&self.centroid).zip(&self.xr) {
+                        *e = c + GAMMA * (r - c);
                     }
                     let fc = eval(&self.xe, &mut evaluations);
                     if fc <= fr {
                         self.simplex[worst].copy_from_slice(&self.xe);
-                        self.fvals[n] = fc;
+                        self.fvals[iw] = fc;
                     } else {
                         do_shrink = true;
                     }
                 } else {
                     // inside contraction
-                    for j in 0..n {
-                        let c = self.centroid[j];
-                        self.xe[j] = c - GAMMA * (c - self.simplex[worst.start + j]);
+                    for ((e, c), w) in self
+                        .xe
+                        .iter_mut()
+                        .zip(&self.centroid)
+                        .zip(&self.simplex[worst.clone()])
+                    {
+                        *e = c - GAMMA * (c - w);
                     }
                     let fcc = eval(&self.xe, &mut evaluations);
                     if fcc < fworst {
                         self.simplex[worst].copy_from_slice(&self.xe);
-                        self.fvals[n] = fcc;
+                        self.fvals[iw] = fcc;
                     } else {
                         do_shrink = true;
                     }
                 }
                 if do_shrink {
-                    for i in 1..=n {
-                        for j in 0..n {
-                            let b = self.simplex[j];
-                            let v = &mut self.simplex[i * n + j];
+                    let ib = self.order[0];
+                    self.row
+                        .copy_from_slice(&self.simplex[ib * n..(ib + 1) * n]);
+                    for i in 0..=n {
+                        if i == ib {
+                            continue;
+                        }
+                        for (v, b) in self.simplex[i * n..(i + 1) * n].iter_mut().zip(&self.row) {
                             *v = b + SIGMA * (*v - b);
                         }
                         self.fvals[i] = eval(&self.simplex[i * n..(i + 1) * n], &mut evaluations);
@@ -306,9 +348,10 @@ impl NelderMead {
             }
             self.sort();
         };
-        x.copy_from_slice(&self.simplex[..n]);
+        let ib = self.order[0];
+        x.copy_from_slice(&self.simplex[ib * n..(ib + 1) * n]);
         Ok(NelderMeadReport {
-            f: self.fvals[0],
+            f: self.fvals[ib],
             iterations,
             evaluations,
             termination,
@@ -318,30 +361,34 @@ impl NelderMead {
     /// Both tolerances met.
     fn converged(&self, config: &NelderMeadConfig) -> bool {
         let n = self.n;
-        let f0 = self.fvals[0];
-        if self.fvals[1..].iter().any(|&fi| !((fi - f0).abs() <= config.ftol)) {
+        let ib = self.order[0];
+        let f0 = self.fvals[ib];
+        let ftol = config.ftol + config.ftol_rel * f0.abs() + config.ftol_root * f0.abs().sqrt();
+        let outside = |d: f64, tol: f64| d.is_nan() || d > tol;
+        if self.fvals.iter().any(|&fi| outside((fi - f0).abs(), ftol)) {
             return false;
         }
-        let best = &self.simplex[..n];
-        for i in 1..=n {
+        let best = &self.simplex[ib * n..(ib + 1) * n];
+        for i in 0..=n {
             let row = &self.simplex[i * n..(i + 1) * n];
-            if row.iter().zip(best).any(|(a, b)| !((a - b).abs() <= config.xtol)) {
+            if row
+                .iter()
+                .zip(best)
+                .any(|(a, b)| outside((a - b).abs(), config.xtol))
+            {
                 return false;
             }
         }
         true
     }
 
-    /// Stable insertion sort of the vertices by objective value.
+    /// Stable insertion sort of the vertex indices by objective value.
     fn sort(&mut self) {
         let n = self.n;
         for i in 1..=n {
             let mut k = i;
-            while k > 0 && self.fvals[k] < self.fvals[k - 1] {
-                self.fvals.swap(k, k - 1);
-                self.row.copy_from_slice(&self.simplex[k * n..(k + 1) * n]);
-                self.simplex.copy_within((k - 1) * n..k * n, k * n);
-                self.simplex[(k - 1) * n..k * n].copy_from_slice(&self.row);
+            while k > 0 && self.fvals[self.order[k]] < self.fvals[self.order[k - 1]] {
+                self.order.swap(k, k - 1);
                 k -= 1;
             }
         }
@@ -374,12 +421,17 @@ mod tests {
         let cfg = NelderMeadConfig {
             xtol: 1e-10,
             ftol: 1e-14,
+            ftol_rel: 0.0,
+            ftol_root: 0.0,
             max_iterations: 5000,
             max_evaluations: 10000,
         };
         let (x, rep) = nelder_mead(rosenbrock, &[-1.2, 1.0], &[0.1, 0.1], &cfg).unwrap();
         assert_eq!(rep.termination, Termination::Converged);
-        assert!((x[0] - 1.0).abs() < 1e-7 && (x[1] - 1.0).abs() < 1e-7, "{x:?}");
+        assert!(
+            (x[0] - 1.0).abs() < 1e-7 && (x[1] - 1.0).abs() < 1e-7,
+            "{x:?}"
+        );
         assert!(rep.f < 1e-14);
         assert!(rep.evaluations >= rep.iterations);
     }
@@ -391,7 +443,10 @@ mod tests {
         let cfg = NelderMeadConfig::default();
         let (x, rep) = nelder_mead(rosenbrock, &[-1.2, 1.0], &[-0.06, 0.05], &cfg).unwrap();
         assert_eq!(rep.termination, Termination::Converged);
-        assert!((x[0] - 1.0).abs() < 1e-3 && (x[1] - 1.0).abs() < 1e-3, "{x:?}");
+        assert!(
+            (x[0] - 1.0).abs() < 1e-3 && (x[1] - 1.0).abs() < 1e-3,
+            "{x:?}"
+        );
     }
 
     #[test]
@@ -409,6 +464,8 @@ mod tests {
         let cfg = NelderMeadConfig {
             xtol: 1e-9,
             ftol: 1e-16,
+            ftol_rel: 0.0,
+            ftol_root: 0.0,
             max_iterations: 20000,
             max_evaluations: 40000,
         };
@@ -424,6 +481,8 @@ mod tests {
         let cfg = NelderMeadConfig {
             xtol: 1e-12,
             ftol: 1e-12,
+            ftol_rel: 0.0,
+            ftol_root: 0.0,
             max_iterations: 10,
             max_evaluations: 1000,
         };
@@ -470,6 +529,32 @@ mod tests {
         let (x, rep) = nelder_mead(f, &[0.0, 0.0], &[0.8, 0.8], &cfg).unwrap();
         assert!(rep.f.is_finite());
         assert!((x[0] - 0.3).abs() < 1e-6 && (x[1] - 0.3).abs() < 1e-6);
+    }
+
+    #[test]
+    fn relative_function_tolerance_stops_at_a_large_minimum_value() {
+        // minimum value 1e6: an absolute spread of 1e-12 is below its rounding
+        let f = |p: &[f64]| 1e6 + (p[0] - 1.0).powi(2) + (p[1] - 2.0).powi(2);
+        let strict = NelderMeadConfig {
+            xtol: 1e-9,
+            ftol: 1e-12,
+            ftol_rel: 0.0,
+            ftol_root: 0.0,
+            max_iterations: 5000,
+            max_evaluations: 10000,
+        };
+        let (_, rep) = nelder_mead(f, &[0.0, 0.0], &[0.5, 0.5], &strict).unwrap();
+        let relative = NelderMeadConfig {
+            ftol_rel: 1e-14,
+            ..strict
+        };
+        let (x, rep_rel) = nelder_mead(f, &[0.0, 0.0], &[0.5, 0.5], &relative).unwrap();
+        assert_eq!(rep_rel.termination, Termination::Converged);
+        assert!(rep_rel.iterations <= rep.iterations);
+        assert!(
+            (x[0] - 1.0).abs() < 1e-4 && (x[1] - 2.0).abs() < 1e-4,
+            "{x:?}"
+        );
     }
 
     #[test]

@@ -372,7 +372,11 @@ pub fn lstsq(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<LstsqSolution> {
 }
 
 /// Least squares with options (ridge, rank tolerance); allocating wrapper.
-pub fn lstsq_with(a: &DMatrix<f64>, b: &DVector<f64>, options: &LstsqOptions) -> Result<LstsqSolution> {
+pub fn lstsq_with(
+    a: &DMatrix<f64>,
+    b: &DVector<f64>,
+    options: &LstsqOptions,
+) -> Result<LstsqSolution> {
     let (m, n) = a.shape();
     check_len("least-squares right-hand side", m, b.len())?;
     let mut abuf: Vec<f64> = a.as_slice().to_vec();
@@ -387,7 +391,13 @@ pub fn lstsq_with(a: &DMatrix<f64>, b: &DVector<f64>, options: &LstsqOptions) ->
 }
 
 /// Unpivoted Householder solve of a small full-rank problem (used for the ridge system).
-fn householder_solve(m: usize, n: usize, a: &mut [f64], b: &mut [f64], z: &mut [f64]) -> Result<()> {
+fn householder_solve(
+    m: usize,
+    n: usize,
+    a: &mut [f64],
+    b: &mut [f64],
+    z: &mut [f64],
+) -> Result<()> {
     for k in 0..n {
         let xn = norm2(&a[k * m + k..(k + 1) * m]);
         if xn == 0.0 {
@@ -454,7 +464,11 @@ fn norm2(v: &[f64]) -> f64 {
 
 fn check_len(what: &'static str, expected: usize, actual: usize) -> Result<()> {
     if expected != actual {
-        return Err(Error::LengthMismatch { what, expected, actual });
+        return Err(Error::LengthMismatch {
+            what,
+            expected,
+            actual,
+        });
     }
     Ok(())
 }
@@ -536,10 +550,12 @@ mod tests {
         let t: Vec<f64> = (0..m).map(|k| 2e-4 * k as f64).collect();
         let coef = [3.4e7, 2.2e10, 1.3e12];
         let a = DMatrix::from_fn(m, 3, |i, j| t[i].powi(5 + j as i32));
-        let b = DVector::from_fn(m, |i, _| (0..3).map(|j| coef[j] * t[i].powi(5 + j as i32)).sum());
+        let b = DVector::from_fn(m, |i, _| {
+            (0..3).map(|j| coef[j] * t[i].powi(5 + j as i32)).sum()
+        });
         let sol = lstsq(&a, &b).unwrap();
-        for j in 0..3 {
-            assert!((sol.x[j] - coef[j]).abs() < 1e-9 * coef[j], "{j}: {}", sol.x[j]);
+        for (j, c) in coef.iter().enumerate() {
+            assert!((sol.x[j] - c).abs() < 1e-9 * c, "{j}: {}", sol.x[j]);
         }
         assert_eq!(sol.info.rank, 3);
     }
@@ -555,7 +571,11 @@ mod tests {
         let sol = lstsq(&a, &b).unwrap();
         let reference = svd_solve(&a, &b);
         assert_eq!(sol.info.rank, n);
-        assert!(sol.info.cond_estimate > 1e4, "cond {}", sol.info.cond_estimate);
+        assert!(
+            sol.info.cond_estimate > 1e4,
+            "cond {}",
+            sol.info.cond_estimate
+        );
         let fit_qr = &a * &sol.x;
         let fit_ref = &a * &reference;
         assert!((&fit_qr - &fit_ref).amax() < 1e-9);
@@ -565,7 +585,11 @@ mod tests {
         let c_true = DVector::from_fn(n, |j, _| 1.0 / (1.0 + j as f64));
         let b2 = &a * &c_true;
         let sol2 = lstsq(&a, &b2).unwrap();
-        assert!((&sol2.x - &c_true).amax() < 1e-6, "{}", (&sol2.x - &c_true).amax());
+        assert!(
+            (&sol2.x - &c_true).amax() < 1e-6,
+            "{}",
+            (&sol2.x - &c_true).amax()
+        );
     }
 
     #[test]
@@ -626,7 +650,15 @@ mod tests {
         let a = DMatrix::from_row_slice(3, 2, &[1.0, 1.0, 2.0, 2.0, 3.0, 3.0]);
         let b = DVector::from_vec(vec![1.0, 2.0, 3.0]);
         let lambda = 0.5;
-        let sol = lstsq_with(&a, &b, &LstsqOptions { ridge: lambda, ..Default::default() }).unwrap();
+        let sol = lstsq_with(
+            &a,
+            &b,
+            &LstsqOptions {
+                ridge: lambda,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         // symmetric solution x1 = x2 = 14 / (28 + λ)
         let expected = 14.0 / (28.0 + lambda);
         assert!((sol.x[0] - expected).abs() < 1e-14 && (sol.x[1] - expected).abs() < 1e-14);

@@ -4,9 +4,11 @@
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
 //! shifts by a hop.
 
+pub mod engine;
 mod estimator;
 mod paper;
 
+pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,

@@ -1,0 +1,20 @@
+//! One module per subcommand.
+
+mod model;
+
+use crate::args::{Cli, Command};
+
+/// Dispatch a parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Model(a) => model::run(&a),
+    }
+}
+
+/// The rig parameters from a TOML file, or the built-in default rig.
+pub fn load_params(path: Option<&std::path::Path>) -> anyhow::Result<feedid::drive::RigParams> {
+    Ok(match path {
+        Some(p) => feedid::drive::RigParams::load(p)?,
+        None => feedid::drive::RigParams::default(),
+    })
+}

@@ -1,0 +1,26 @@
+//! `feedid model`: the nominal model in numbers.
+
+use anyhow::Result;
+use feedid::drive::{D1Variant, ModelSummary};
+
+use crate::args::{D1Arg, ModelArgs};
+use crate::cmd::load_params;
+
+/// Print the model summary as text or JSON.
+pub fn run(a: &ModelArgs) -> Result<()> {
+    let params = load_params(a.params.as_deref())?;
+    let variant = match a.d1 {
+        D1Arg::Corrected => D1Variant::Corrected,
+        D1Arg::Paper => D1Variant::PaperPrinted,
+    };
+    let summary = ModelSummary::new(&params, variant)?;
+    if let Some(p) = &a.save_params {
+        feedid::io::write_string_atomic(p, &params.to_toml_string())?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        println!("{summary}");
+    }
+    Ok(())
+}

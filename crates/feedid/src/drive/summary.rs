@@ -1,0 +1,179 @@
+//! A summary of the nominal model for people: stiffness and inertia, N and D,
+//! poles with frequency and damping, bandwidth and following error.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::drive::{closed_loop_coefficients, D1Variant, RigParams};
+use crate::error::Result;
+use crate::lti::{Complex, TransferFunction};
+
+/// One pole with its natural frequency and damping ratio.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PoleInfo {
+    /// Real part \[rad/s\].
+    pub re: f64,
+    /// Imaginary part \[rad/s\].
+    pub im: f64,
+    /// Natural frequency |p|/2π \[Hz\].
+    pub freq_hz: f64,
+    /// Damping ratio −Re(p)/|p| (1 for a real stable pole).
+    pub damping: f64,
+}
+
+impl PoleInfo {
+    /// Describe a pole.
+    pub fn new(p: Complex<f64>) -> Self {
+        let w = p.norm();
+        Self {
+            re: p.re,
+            im: p.im,
+            freq_hz: w / (2.0 * std::f64::consts::PI),
+            damping: if w > 0.0 { -p.re / w } else { 1.0 },
+        }
+    }
+}
+
+/// Everything `feedid model` prints.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModelSummary {
+    /// Equivalent axial stiffness K \[N/m\] (eq. 1).
+    #[serde(rename = "K")]
+    pub k: f64,
+    /// Total inertia J \[kg·m²\] (eq. 2).
+    #[serde(rename = "J")]
+    pub j: f64,
+    /// Screw stiffness E·A/l \[N/m\].
+    pub k_screw: f64,
+    /// Screw inertia \[kg·m²\].
+    pub j_screw: f64,
+    /// Transmission ratio r = lead/2π \[m/rad\].
+    pub r: f64,
+    /// Numerator `[N2, N1, N0]`, descending powers of s, normalised so D7 = J·L·M.
+    pub num: Vec<f64>,
+    /// Denominator `[D7, …, D0]`, descending powers of s.
+    pub den: Vec<f64>,
+    /// Poles as `[re, im]` pairs \[rad/s\].
+    pub poles: Vec<[f64; 2]>,
+    /// Poles with frequency and damping, sorted by frequency.
+    pub pole_details: Vec<PoleInfo>,
+    /// −3 dB bandwidth of Xa/Xs \[Hz\].
+    pub bandwidth_hz: f64,
+    /// DC gain (1 for the corrected coefficients).
+    pub dc_gain: f64,
+    /// Steady ramp following error per command velocity `(D1 − N1)/D0` \[s\] (= 1/Kv).
+    pub following_error_s: f64,
+    /// Which D1 was used.
+    pub d1_variant: String,
+}
+
+impl ModelSummary {
+    /// Summarise the nominal model of `params`.
+    pub fn new(params: &RigParams, variant: D1Variant) -> Result<Self> {
+        let c = closed_loop_coefficients(params, variant);
+        let tf = c.transfer_function()?;
+        let mut poles = tf.poles()?;
+        poles.sort_by(|a, b| a.norm().total_cmp(&b.norm()).then(a.im.total_cmp(&b.im)));
+        Ok(Self {
+            k: params.stiffness_k(),
+            j: params.inertia_j(),
+            k_screw: params.screw_stiffness(),
+            j_screw: params.screw_inertia(),
+            r: params.r(),
+            num: c.num.to_vec(),
+            den: c.den.to_vec(),
+            poles: poles.iter().map(|p| [p.re, p.im]).collect(),
+            pole_details: poles.iter().map(|&p| PoleInfo::new(p)).collect(),
+            bandwidth_hz: bandwidth_hz(&tf),
+            dc_gain: c.dc_gain(),
+            following_error_s: c.following_error_per_velocity(),
+            d1_variant: match variant {
+                D1Variant::Corrected => "corrected".to_string(),
+                D1Variant::PaperPrinted => "paper-printed".to_string(),
+            },
+        })
+    }
+}
+
+/// −3 dB bandwidth \[Hz\]: first frequency where |G| falls below |G(0)|/√2
+/// (log scan 0.01 Hz … 100 kHz, refined by bisection); `f64::INFINITY` if none.
+pub fn bandwidth_hz(tf: &TransferFunction) -> f64 {
+    let g0 = tf.dc_gain().abs();
+    let target = g0 / std::f64::consts::SQRT_2;
+    let mag = |f: f64| {
+        tf.eval(Complex::new(0.0, 2.0 * std::f64::consts::PI * f))
+            .norm()
+    };
+    let mut lo = 0.01;
+    if !(g0.is_finite()) || mag(lo) < target {
+        return f64::INFINITY;
+    }
+    let steps = 700;
+    for k in 1..=steps {
+        let f = 0.01 * 10f64.powf(7.0 * k as f64 / steps as f64);
+        if mag(f) < target {
+            let mut hi = f;
+            for _ in 0..60 {
+                let mid = (lo * hi).sqrt();
+                if mag(mid) < target {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return (lo * hi).sqrt();
+        }
+        lo = f;
+    }
+    f64::INFINITY
+}
+
+impl fmt::Display for ModelSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "Mechanics (paper eq. 1, 2)")?;
+        writeln!(
+            f,
+            "  equivalent stiffness K  {:.4e} N/m   (screw E·A/l {:.4e} N/m)",
+            self.k, self.k_screw
+        )?;
+        writeln!(
+            f,
+            "  total inertia J         {:.4e} kg·m² (screw {:.4e} kg·m²)",
+            self.j, self.j_screw
+        )?;
+        writeln!(f, "  r = lead/2π             {:.6e} m/rad", self.r)?;
+        writeln!(
+            f,
+            "Closed loop Xa/Xs = N(s)/D(s), normalised D7 = J·L·M (D1: {})",
+            self.d1_variant
+        )?;
+        for (k, v) in self.num.iter().enumerate() {
+            writeln!(f, "  N{} = {:.6e}", 2 - k, v)?;
+        }
+        for (k, v) in self.den.iter().enumerate() {
+            writeln!(f, "  D{} = {:.6e}", 7 - k, v)?;
+        }
+        writeln!(f, "Poles")?;
+        writeln!(
+            f,
+            "  {:>14} {:>14} {:>10} {:>8}",
+            "re [rad/s]", "im [rad/s]", "f [Hz]", "zeta"
+        )?;
+        for p in &self.pole_details {
+            writeln!(
+                f,
+                "  {:>14.3} {:>14.3} {:>10.1} {:>8.3}",
+                p.re, p.im, p.freq_hz, p.damping
+            )?;
+        }
+        writeln!(f, "Bandwidth (−3 dB)         {:.1} Hz", self.bandwidth_hz)?;
+        writeln!(f, "DC gain                   {:.9}", self.dc_gain)?;
+        write!(
+            f,
+            "Following error           {:.4} ms × velocity ({:.1} µm at 50 mm/s)",
+            1e3 * self.following_error_s,
+            0.05 * self.following_error_s * 1e6
+        )
+    }
+}

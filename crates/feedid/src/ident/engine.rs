@@ -1,0 +1,463 @@
+//! The sliding prediction engine, generic over [`Estimator`]s.
+//!
+//! Windows of `W` samples start at `s = warm_up + estimator.warm_up()` and
+//! advance by `hop` samples: window `[s, s+W)`, horizon `[s+W, s+W+H)`
+//! (shortened at the end of the recording). For each window the estimator
+//! fits, then predicts the horizon. With `hop = H` (the paper's setting) every
+//! sample after the first window is predicted exactly once; with `hop < H`
+//! horizons overlap and the most recent prediction of a sample is kept.
+//!
+//! A window whose fit or prediction fails (singular problem, non-finite
+//! result) gives no prediction and is recorded with
+//! [`Termination::Failed`]; no NaN ever reaches the prediction series.
+//!
+//! ```
+//! # use feedid::ident::{engine::{run, EngineConfig}, Estimator, Signals, WindowFit};
+//! # use feedid::solve::Termination;
+//! /// Predicts the last measured value (a "hold" estimator).
+//! struct Hold;
+//! impl Estimator for Hold {
+//!     fn name(&self) -> &'static str { "hold" }
+//!     fn coefficient_names(&self) -> Vec<String> { vec![] }
+//!     fn fit(&mut self, _: &Signals<'_>, _: std::ops::Range<usize>, _: &mut [f64]) -> feedid::Result<WindowFit> {
+//!         Ok(WindowFit { residual_rms: 0.0, iterations: 0, termination: Termination::Exact })
+//!     }
+//!     fn predict(&mut self, s: &Signals<'_>, w: std::ops::Range<usize>, _: std::ops::Range<usize>, out: &mut [f64]) -> feedid::Result<()> {
+//!         out.fill(s.position(w.end - 1..w.end)[0]);
+//!         Ok(())
+//!     }
+//! }
+//! let t: Vec<f64> = (0..100).map(|k| k as f64 * 1e-3).collect();
+//! let y = vec![1.0; 100];
+//! let res = run(&mut Hold, &Signals::new(&t, &y, &y, 1e-3, 0.0), &EngineConfig::default()).unwrap();
+//! assert_eq!(res.stats.rms, 0.0);
+//! assert_eq!(res.stats.samples, 80);
+//! ```
+
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+use crate::error::{Error, Result};
+use crate::ident::{Estimator, Signals, WindowFit};
+use crate::solve::Termination;
+use crate::stats::{ErrorAccumulator, ErrorStats};
+
+/// Sliding-window settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EngineConfig {
+    /// Window length W \[samples\]; default 20 (4 ms at 5 kHz, the paper's).
+    pub window: usize,
+    /// Prediction horizon H \[samples\]; default 10 (2 ms at 5 kHz).
+    pub horizon: usize,
+    /// Shift between windows \[samples\]; `None` = the horizon (default).
+    pub hop: Option<usize>,
+    /// Samples skipped before the first window (in addition to the estimator's own); default 0.
+    pub warm_up: usize,
+}
+
+impl Default for EngineConfig {
+    fn default() -> Self {
+        Self {
+            window: 20,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        }
+    }
+}
+
+impl EngineConfig {
+    /// The effective hop.
+    pub fn hop(&self) -> usize {
+        self.hop.unwrap_or(self.horizon)
+    }
+
+    /// Check the settings against a recording of `n` samples and an estimator warm-up.
+    pub fn validate(&self, n: usize, estimator_warm_up: usize) -> Result<()> {
+        for (name, v) in [
+            ("window", self.window),
+            ("horizon", self.horizon),
+            ("hop", self.hop()),
+        ] {
+            if v == 0 {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: 0.0,
+                    reason: "must be at least 1 sample",
+                });
+            }
+        }
+        let needed = self.warm_up + estimator_warm_up + self.window + self.horizon;
+        if n < needed {
+            return Err(Error::TooFewSamples {
+                what: "warm-up + window + horizon",
+                needed,
+                actual: n,
+            });
+        }
+        Ok(())
+    }
+
+    /// The window and horizon ranges visited over `n` samples.
+    pub fn windows(&self, n: usize, estimator_warm_up: usize) -> WindowIter {
+        WindowIter {
+            next: self.warm_up + estimator_warm_up,
+            window: self.window,
+            horizon: self.horizon,
+            hop: self.hop().max(1),
+            n,
+        }
+    }
+}
+
+/// Iterator over `(window, horizon)` ranges.
+#[derive(Debug, Clone)]
+pub struct WindowIter {
+    next: usize,
+    window: usize,
+    horizon: usize,
+    hop: usize,
+    n: usize,
+}
+
+impl Iterator for WindowIter {
+    type Item = (Range<usize>, Range<usize>);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let s = self.next;
+        let we = s.checked_add(self.window)?;
+        if we >= self.n {
+            return None;
+        }
+        let he = (we + self.horizon).min(self.n);
+        self.next = s + self.hop;
+        Some((s..we, we..he))
+    }
+}
+
+/// One visited window.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WindowRecord {
+    /// Samples fitted.
+    pub window: Range<usize>,
+    /// Samples predicted.
+    pub horizon: Range<usize>,
+    /// Fit outcome (`Termination::Failed` if the fit or prediction failed).
+    pub fit: WindowFit,
+}
+
+/// Everything a sliding run produces.
+#[derive(Debug, Clone)]
+pub struct SlidingResult {
+    /// Method name.
+    pub method: &'static str,
+    /// Coefficient names (columns of [`SlidingResult::coefficients`]).
+    pub coefficient_names: Vec<String>,
+    /// Per-window coefficients, row-major `windows.len() × coefficient_names.len()`.
+    pub coefficients: Vec<f64>,
+    /// Visited windows.
+    pub windows: Vec<WindowRecord>,
+    /// Predicted position per sample \[m\]; meaningful only where `has_prediction`.
+    pub predicted: Vec<f64>,
+    /// Whether sample k was predicted.
+    pub has_prediction: Vec<bool>,
+    /// Error statistics over all predicted samples.
+    pub stats: ErrorStats,
+    /// Wall time of identification and prediction only (no I/O).
+    pub elapsed: Duration,
+}
+
+impl SlidingResult {
+    /// Prediction at sample `k`, if there is one.
+    pub fn prediction(&self, k: usize) -> Option<f64> {
+        match self.has_prediction.get(k) {
+            Some(true) => self.predicted.get(k).copied(),
+            _ => None,
+        }
+    }
+
+    /// Coefficients of window `w`.
+    pub fn window_coefficients(&self, w: usize) -> &[f64] {
+        let n = self.coefficient_names.len();
+        &self.coefficients[w * n..(w + 1) * n]
+    }
+
+    /// Number of windows whose fit or prediction failed.
+    pub fn failed_windows(&self) -> usize {
+        self.windows
+            .iter()
+            .filter(|w| w.fit.termination == Termination::Failed)
+            .count()
+    }
+
+    /// Mean wall time per window \[µs\].
+    pub fn per_window_us(&self) -> f64 {
+        if self.windows.is_empty() {
+            0.0
+        } else {
+            self.elapsed.as_secs_f64() * 1e6 / self.windows.len() as f64
+        }
+    }
+}
+
+/// Slide `estimator` over `signals` (offset 0) and collect predictions and statistics.
+pub fn run<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    config: &EngineConfig,
+) -> Result<SlidingResult> {
+    let n = signals.time.len();
+    if signals.command.len() != n || signals.position.len() != n {
+        return Err(Error::LengthMismatch {
+            what: "signals",
+            expected: n,
+            actual: signals.command.len().min(signals.position.len()),
+        });
+    }
+    let est_warm = estimator.warm_up();
+    config.validate(n, est_warm)?;
+    let names = estimator.coefficient_names();
+    let nc = names.len();
+    let windows_expected = config.windows(n, est_warm).count();
+
+    let mut coefficients = vec![0.0; windows_expected * nc];
+    let mut windows = Vec::with_capacity(windows_expected);
+    let mut predicted = vec![0.0; n];
+    let mut has_prediction = vec![false; n];
+    let mut buf = vec![0.0; config.horizon];
+
+    estimator.reset();
+    let start = Instant::now();
+    for (w, (window, horizon)) in config.windows(n, est_warm).enumerate() {
+        let coef = &mut coefficients[w * nc..(w + 1) * nc];
+        let out = &mut buf[..horizon.len()];
+        let fit = match estimator.fit(signals, window.clone(), coef) {
+            Ok(fit) => match estimator.predict(signals, window.clone(), horizon.clone(), out) {
+                Ok(()) if out.iter().all(|v| v.is_finite()) => {
+                    predicted[horizon.clone()].copy_from_slice(out);
+                    has_prediction[horizon.clone()].fill(true);
+                    fit
+                }
+                _ => failed(fit.residual_rms),
+            },
+            Err(_) => failed(f64::NAN),
+        };
+        if !coef.iter().all(|c| c.is_finite()) {
+            coef.fill(0.0);
+        }
+        windows.push(WindowRecord {
+            window,
+            horizon,
+            fit,
+        });
+    }
+    let elapsed = start.elapsed();
+
+    let mut acc = ErrorAccumulator::default();
+    for k in 0..n {
+        if has_prediction[k] {
+            acc.push(signals.position[k], predicted[k]);
+        }
+    }
+    Ok(SlidingResult {
+        method: estimator.name(),
+        coefficient_names: names,
+        coefficients,
+        windows,
+        predicted,
+        has_prediction,
+        stats: acc.finish(),
+        elapsed,
+    })
+}
+
+fn failed(residual_rms: f64) -> WindowFit {
+    WindowFit {
+        residual_rms: if residual_rms.is_finite() {
+            residual_rms
+        } else {
+            0.0
+        },
+        iterations: 0,
+        termination: Termination::Failed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Predicts a straight line through the last two samples of the window;
+    /// writes [last value, slope] as coefficients.
+    struct Linear {
+        calls: usize,
+    }
+
+    impl Estimator for Linear {
+        fn name(&self) -> &'static str {
+            "linear"
+        }
+        fn coefficient_names(&self) -> Vec<String> {
+            vec!["last".into(), "slope".into()]
+        }
+        fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, coef: &mut [f64]) -> Result<WindowFit> {
+            self.calls += 1;
+            let y = s.position(w.end - 2..w.end);
+            coef[0] = y[1];
+            coef[1] = y[1] - y[0];
+            Ok(WindowFit {
+                residual_rms: 0.0,
+                iterations: 0,
+                termination: Termination::Exact,
+            })
+        }
+        fn predict(
+            &mut self,
+            s: &Signals<'_>,
+            w: Range<usize>,
+            h: Range<usize>,
+            out: &mut [f64],
+        ) -> Result<()> {
+            let y = s.position(w.end - 2..w.end);
+            assert_eq!(h.start, w.end);
+            for (j, o) in out.iter_mut().enumerate() {
+                *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);
+            }
+            Ok(())
+        }
+    }
+
+    /// Fails on every other window and returns NaN predictions on the rest.
+    struct Broken {
+        k: usize,
+    }
+
+    impl Estimator for Broken {
+        fn name(&self) -> &'static str {
+            "broken"
+        }
+        fn coefficient_names(&self) -> Vec<String> {
+            vec!["c".into()]
+        }
+        fn fit(&mut self, _: &Signals<'_>, _: Range<usize>, coef: &mut [f64]) -> Result<WindowFit> {
+            self.k += 1;
+            coef[0] = f64::NAN;
+            if self.k % 2 == 0 {
+                Err(Error::Singular { context: "test" })
+            } else {
+                Ok(WindowFit {
+                    residual_rms: 0.0,
+                    iterations: 0,
+                    termination: Termination::Exact,
+                })
+            }
+        }
+        fn predict(
+            &mut self,
+            _: &Signals<'_>,
+            _: Range<usize>,
+            _: Range<usize>,
+            out: &mut [f64],
+        ) -> Result<()> {
+            out.fill(f64::NAN);
+            Ok(())
+        }
+    }
+
+    fn ramp(n: usize) -> (Vec<f64>, Vec<f64>) {
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 2e-4).collect();
+        let y: Vec<f64> = t.iter().map(|&t| 0.05 * t).collect();
+        (t, y)
+    }
+
+    #[test]
+    fn linear_estimator_predicts_a_ramp_exactly() {
+        let (t, y) = ramp(105);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let mut est = Linear { calls: 0 };
+        let r = run(&mut est, &s, &EngineConfig::default()).unwrap();
+        // windows at 0,10,...,80 (window end 20..100 < 105) → 9 windows
+        assert_eq!(r.windows.len(), 9);
+        assert_eq!(est.calls, 9);
+        assert_eq!(r.stats.samples, 85);
+        assert!(r.stats.rms < 1e-15);
+        assert!(r.prediction(19).is_none());
+        assert!(r.prediction(20).is_some());
+        assert!(r.prediction(104).is_some());
+        // last window's horizon is shortened
+        assert_eq!(r.windows[8].horizon, 100..105);
+        assert!((r.window_coefficients(0)[1] - 0.05 * 2e-4).abs() < 1e-18);
+    }
+
+    #[test]
+    fn every_sample_after_first_window_is_predicted_once_with_hop_equal_horizon() {
+        let cfg = EngineConfig {
+            window: 7,
+            horizon: 3,
+            hop: None,
+            warm_up: 2,
+        };
+        let mut count = vec![0; 50];
+        for (_, h) in cfg.windows(50, 1) {
+            for k in h {
+                count[k] += 1;
+            }
+        }
+        assert!(count[..10].iter().all(|&c| c == 0));
+        assert!(count[10..].iter().all(|&c| c == 1));
+    }
+
+    #[test]
+    fn overlapping_horizons_keep_the_latest_prediction() {
+        let (t, y) = ramp(60);
+        // position quadratic so predictions from different windows differ
+        let yq: Vec<f64> = t.iter().map(|&t| t * t).collect();
+        let s = Signals::new(&t, &y, &yq, 2e-4, 0.0);
+        let cfg = EngineConfig {
+            window: 10,
+            horizon: 5,
+            hop: Some(1),
+            warm_up: 0,
+        };
+        let r = run(&mut Linear { calls: 0 }, &s, &cfg).unwrap();
+        // sample 30 was last predicted by the window ending at 30 (one step ahead)
+        let y1 = yq[29];
+        let y0 = yq[28];
+        assert!((r.prediction(30).unwrap() - (2.0 * y1 - y0)).abs() < 1e-18);
+    }
+
+    #[test]
+    fn failed_windows_give_no_prediction_and_no_nan() {
+        let (t, y) = ramp(100);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let r = run(&mut Broken { k: 0 }, &s, &EngineConfig::default()).unwrap();
+        assert_eq!(r.failed_windows(), r.windows.len());
+        assert_eq!(r.stats.samples, 0);
+        assert!(r.coefficients.iter().all(|c| c.is_finite()));
+        assert!((0..100).all(|k| r.prediction(k).is_none()));
+    }
+
+    #[test]
+    fn too_short_recording_is_an_error() {
+        let (t, y) = ramp(29);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let e = run(&mut Linear { calls: 0 }, &s, &EngineConfig::default()).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::TooFewSamples {
+                needed: 30,
+                actual: 29,
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn zero_window_is_rejected() {
+        let cfg = EngineConfig {
+            window: 0,
+            ..EngineConfig::default()
+        };
+        assert!(cfg.validate(100, 0).is_err());
+    }
+}

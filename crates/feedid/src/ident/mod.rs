@@ -6,6 +6,11 @@
 
 pub mod engine;
 mod estimator;
+mod paper;
 
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
+pub use paper::{
+    coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
+    PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,
+};

@@ -81,7 +81,9 @@ pub enum Error {
     },
 
     /// Time stamps are not strictly increasing.
-    #[error("time is not strictly increasing at sample {index}: {previous} s followed by {value} s")]
+    #[error(
+        "time is not strictly increasing at sample {index}: {previous} s followed by {value} s"
+    )]
     NonMonotoneTime {
         /// Zero-based index of the offending sample.
         index: usize,

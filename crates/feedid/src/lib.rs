@@ -9,7 +9,10 @@
 //!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
 //! Identification of Feed Drive Systems using Nonlinear Least Squares Method".
-#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
+)]
 #![warn(missing_docs)]
 
 pub mod drive;

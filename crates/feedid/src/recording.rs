@@ -248,7 +248,14 @@ mod tests {
     #[test]
     fn rejects_mismatched_lengths() {
         let e = Recording::new(t(4), vec![0.0; 3], vec![0.0; 4]).unwrap_err();
-        assert!(matches!(e, Error::LengthMismatch { expected: 4, actual: 3, .. }));
+        assert!(matches!(
+            e,
+            Error::LengthMismatch {
+                expected: 4,
+                actual: 3,
+                ..
+            }
+        ));
     }
 
     #[test]
@@ -273,7 +280,9 @@ mod tests {
         tt[5] += 1e-4; // 10 % of the interval
         let e = Recording::new(tt, vec![0.0; 10], vec![0.0; 10]).unwrap_err();
         match e {
-            Error::SamplingJitter { relative_percent, .. } => {
+            Error::SamplingJitter {
+                relative_percent, ..
+            } => {
                 assert!((relative_percent - 10.0).abs() < 1e-6)
             }
             other => panic!("unexpected {other}"),

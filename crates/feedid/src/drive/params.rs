@@ -190,7 +190,10 @@ impl Default for Table {
 
 impl Default for Damping {
     fn default() -> Self {
-        Self { c1: 5e-5, c2: 100.0 }
+        Self {
+            c1: 5e-5,
+            c2: 100.0,
+        }
     }
 }
 
@@ -358,7 +361,14 @@ impl RigParams {
             message: one_line(&e.to_string()),
         })?;
         params.validate().map_err(|e| match (e, path) {
-            (Error::InvalidParameter { name, value, reason }, Some(p)) => Error::ParamsFile {
+            (
+                Error::InvalidParameter {
+                    name,
+                    value,
+                    reason,
+                },
+                Some(p),
+            ) => Error::ParamsFile {
                 path: Some(p.to_path_buf()),
                 message: format!("invalid value for `{name}`: {value} ({reason})"),
             },

@@ -31,7 +31,13 @@ pub struct Signals<'a> {
 
 impl<'a> Signals<'a> {
     /// A view of whole arrays (offset 0).
-    pub fn new(time: &'a [f64], command: &'a [f64], position: &'a [f64], dt: f64, motion_start: f64) -> Self {
+    pub fn new(
+        time: &'a [f64],
+        command: &'a [f64],
+        position: &'a [f64],
+        dt: f64,
+        motion_start: f64,
+    ) -> Self {
         Self {
             offset: 0,
             time,
@@ -98,7 +104,12 @@ pub trait Estimator {
 
     /// Identify from the samples `window` (absolute indices) and write the
     /// coefficients into `coef` (length `coefficient_names().len()`).
-    fn fit(&mut self, signals: &Signals<'_>, window: Range<usize>, coef: &mut [f64]) -> Result<WindowFit>;
+    fn fit(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        coef: &mut [f64],
+    ) -> Result<WindowFit>;
 
     /// Predict the measured position over `horizon` (which starts at
     /// `window.end`) into `out` (length `horizon.len()`), from the last fit.

@@ -42,7 +42,12 @@ impl StateSpace {
                 actual: c.len(),
             });
         }
-        if a.iter().chain(b.iter()).chain(c.iter()).any(|v| !v.is_finite()) || !d.is_finite() {
+        if a.iter()
+            .chain(b.iter())
+            .chain(c.iter())
+            .any(|v| !v.is_finite())
+            || !d.is_finite()
+        {
             return Err(Error::InvalidModel {
                 reason: "non-finite state-space entry",
             });

@@ -10,11 +10,10 @@
 //! ```
 //!
 //! so position, speed and acceleration start and end at zero. Defaults:
-//! amplitude `A` = 0.1 mm, `f0` = 1 Hz, `f1` = 200 Hz, logarithmic sweep,
-//! taper `T_w` = 0.05 s, rest `t_r` = 0.010 s. Note that 0.1 mm at 200 Hz asks
-//! for 126 mm/s and 158 m/s², which drives the default rig into its 10 A
-//! current limit at the top of the sweep; use a smaller amplitude (or
-//! `linear` effects) when a strictly linear response is wanted.
+//! amplitude `A` = 0.03 mm, `f0` = 1 Hz, `f1` = 200 Hz, logarithmic sweep,
+//! taper `T_w` = 0.05 s, rest `t_r` = 0.010 s. The amplitude keeps the default
+//! rig inside its 10 A current limit (linear model: 7.4 A peak at the top of
+//! the sweep); 0.1 mm would ask for 25 A and saturate the drive.
 
 use serde::{Deserialize, Serialize};
 
@@ -36,7 +35,7 @@ pub enum Sweep {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Chirp {
-    /// Amplitude A \[m\]; default 1e-4.
+    /// Amplitude A \[m\]; default 3e-5.
     pub amplitude: f64,
     /// Start frequency f0 \[Hz\]; default 1.
     pub f_start: f64,
@@ -53,7 +52,7 @@ pub struct Chirp {
 impl Default for Chirp {
     fn default() -> Self {
         Self {
-            amplitude: 1e-4,
+            amplitude: 3e-5,
             f_start: 1.0,
             f_end: 200.0,
             sweep: Sweep::Logarithmic,
@@ -132,12 +131,12 @@ impl Chirp {
     }
 }
 
-/// The default chirp (0.1 mm, 1 → 200 Hz logarithmic) filling `duration` s at `rate_hz`.
+/// The default chirp (0.03 mm, 1 → 200 Hz logarithmic) filling `duration` s at `rate_hz`.
 ///
 /// ```
 /// let x = feedid::signal::chirp(5000.0, 2.0).unwrap();
 /// assert_eq!(x.len(), 10_000);
-/// assert!(x.iter().all(|v| v.abs() <= 1e-4));
+/// assert!(x.iter().all(|v| v.abs() <= 3e-5));
 /// ```
 pub fn chirp(rate_hz: f64, duration: f64) -> Result<Vec<f64>> {
     Chirp::default().generate(rate_hz, duration)
@@ -154,8 +153,8 @@ mod tests {
         assert!(x[..=50].iter().all(|&v| v == 0.0));
         // smooth onset: the first samples after the rest are tiny (taper ~ τ²)
         assert!(x[51].abs() < 1e-9, "{}", x[51]);
-        assert!(x.iter().all(|v| v.abs() <= 1e-4 + 1e-18));
-        assert!(x.iter().any(|v| v.abs() > 0.9e-4));
+        assert!(x.iter().all(|v| v.abs() <= 3e-5 + 1e-18));
+        assert!(x.iter().any(|v| v.abs() > 0.9 * 3e-5));
         assert!(x.last().unwrap().abs() < 1e-12);
     }
 
@@ -181,7 +180,10 @@ mod tests {
         let x = c.generate(50_000.0, 1.0).unwrap();
         let crossings = x.windows(2).filter(|w| w[0] * w[1] < 0.0).count() as f64;
         let expected = 2.0 * 10.0 * 4.0 / 5f64.ln();
-        assert!((crossings - expected).abs() <= 1.5, "{crossings} vs {expected}");
+        assert!(
+            (crossings - expected).abs() <= 1.5,
+            "{crossings} vs {expected}"
+        );
         assert!((c.frequency_at(0.5, 1.0) - 10.0 * 5f64.sqrt()).abs() < 1e-12);
     }
 

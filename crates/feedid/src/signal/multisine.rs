@@ -9,7 +9,7 @@
 //! ```
 //!
 //! `max|s|` is taken over one period `1/f_res` sampled at the given rate, so
-//! the steady part peaks at exactly `A`. Defaults: `A` = 0.05 mm, band
+//! the steady part peaks at exactly `A`. Defaults: `A` = 0.03 mm (linear default rig: 8.3 A peak current), band
 //! 1 … 200 Hz, `f_res` = 1 Hz (period 1 s), onset `T_w` = 0.05 s, rest 0.010 s.
 //! Reference: M.R. Schroeder, "Synthesis of low-peak-factor signals and
 //! binary sequences with low autocorrelation", IEEE Trans. Inf. Theory 16 (1970) 85–89.
@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Multisine {
-    /// Peak amplitude A \[m\]; default 5e-5.
+    /// Peak amplitude A \[m\]; default 3e-5.
     pub amplitude: f64,
     /// Lower band edge f_lo \[Hz\]; default 1.
     pub f_low: f64,
@@ -40,7 +40,7 @@ pub struct Multisine {
 impl Default for Multisine {
     fn default() -> Self {
         Self {
-            amplitude: 5e-5,
+            amplitude: 3e-5,
             f_low: 1.0,
             f_high: 200.0,
             resolution: 1.0,
@@ -138,11 +138,11 @@ impl Multisine {
     }
 }
 
-/// The default multisine (0.05 mm peak, 1 … 200 Hz, 1 Hz lines) at `rate_hz`.
+/// The default multisine (0.03 mm peak, 1 … 200 Hz, 1 Hz lines) at `rate_hz`.
 ///
 /// ```
 /// let x = feedid::signal::multisine(5000.0, 1.1).unwrap();
-/// assert!(x.iter().all(|v| v.abs() <= 5e-5 + 1e-18));
+/// assert!(x.iter().all(|v| v.abs() <= 3e-5 + 1e-18));
 /// ```
 pub fn multisine(rate_hz: f64, duration: f64) -> Result<Vec<f64>> {
     Multisine::default().generate(rate_hz, duration)
@@ -183,7 +183,7 @@ mod tests {
             assert!(mag(k) < 1e-9 * ref_mag, "k={k}");
         }
         let peak = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        assert!((peak - 5e-5).abs() < 1e-18);
+        assert!((peak - 3e-5).abs() < 1e-18);
     }
 
     #[test]
@@ -195,7 +195,7 @@ mod tests {
         };
         let x = m.generate(5000.0, 1.0).unwrap();
         let rms = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
-        let crest = 5e-5 / rms;
+        let crest = 3e-5 / rms;
         // zero-phase multisine of 200 lines has crest 20; Schroeder about 1.7
         assert!(crest < 2.0, "crest factor {crest}");
     }

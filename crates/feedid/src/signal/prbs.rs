@@ -13,7 +13,7 @@
 //! the raw sequence. Its spectrum is flat within 3 dB up to about
 //! `0.44·rate/clock`.
 //!
-//! Defaults: `A` = 0.05 mm, `clock` = 10 samples (2 ms at 5 kHz), `n` = 9
+//! Defaults: `A` = 0.03 mm (linear default rig: 8.3 A peak, inside the 10 A limit), `clock` = 10 samples (2 ms at 5 kHz), `n` = 9
 //! (period 511 bits = 1.022 s at 5 kHz), `smoothing` = 5 samples, rest 0.010 s.
 //! Supported register lengths 2 … 24. Reference: L. Ljung, *System
 //! Identification*, 2nd ed., §13.3; tap table after Xilinx XAPP 052.
@@ -27,7 +27,7 @@ use crate::error::{Error, Result};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Prbs {
-    /// Level of a 1 bit A \[m\] (a 0 bit is at 0); default 5e-5.
+    /// Level of a 1 bit A \[m\] (a 0 bit is at 0); default 3e-5.
     pub amplitude: f64,
     /// Samples per bit (clock period); default 10.
     pub clock: usize,
@@ -42,7 +42,7 @@ pub struct Prbs {
 impl Default for Prbs {
     fn default() -> Self {
         Self {
-            amplitude: 5e-5,
+            amplitude: 3e-5,
             clock: 10,
             register: 9,
             smoothing: 5,
@@ -188,11 +188,11 @@ impl Prbs {
     }
 }
 
-/// The default PRBS (0.05 mm, 10-sample clock, 9-bit register, smoothed) at `rate_hz`.
+/// The default PRBS (0.03 mm, 10-sample clock, 9-bit register, smoothed) at `rate_hz`.
 ///
 /// ```
 /// let x = feedid::signal::prbs(5000.0, 1.1, 7).unwrap();
-/// assert!(x.iter().all(|&v| (0.0..=5e-5).contains(&v)));
+/// assert!(x.iter().all(|&v| (0.0..=3e-5).contains(&v)));
 /// ```
 pub fn prbs(rate_hz: f64, duration: f64, seed: u64) -> Result<Vec<f64>> {
     Prbs::default().generate(rate_hz, duration, seed)
@@ -243,9 +243,12 @@ mod tests {
         let x = prbs(5000.0, 1.1, 1).unwrap();
         assert!(x[..=50].iter().all(|&v| v == 0.0));
         // largest sample-to-sample change: raised cosine over 5 samples
-        let max_step = x.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
-        let expected = 5e-5 * (std::f64::consts::PI / 5.0 * 3.0).cos().mul_add(-0.5, 0.5)
-            - 5e-5 * (std::f64::consts::PI / 5.0 * 2.0).cos().mul_add(-0.5, 0.5);
+        let max_step = x
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        let expected = 3e-5 * (std::f64::consts::PI / 5.0 * 3.0).cos().mul_add(-0.5, 0.5)
+            - 3e-5 * (std::f64::consts::PI / 5.0 * 2.0).cos().mul_add(-0.5, 0.5);
         assert!((max_step - expected).abs() < 1e-15, "{max_step} {expected}");
     }
 

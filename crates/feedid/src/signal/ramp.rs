@@ -52,7 +52,12 @@ impl Ramp {
 
     /// Command position at time `t` \[s\] → \[m\].
     pub fn value_at(&self, t: f64) -> f64 {
-        linear_rise(t, self.rest, self.distance.abs() / self.velocity, self.distance)
+        linear_rise(
+            t,
+            self.rest,
+            self.distance.abs() / self.velocity,
+            self.distance,
+        )
     }
 
     /// Write the command sampled at `rate_hz` (times `k/rate_hz`) into `out`.

@@ -5,12 +5,14 @@
 //! | `ramp`      | 30 mm at 50 mm/s (paper)                             | 0.8 s            |
 //! | `step`      | 1 mm in 0.2 ms (paper)                               | 0.05 s           |
 //! | `scurve`    | 20 mm, 100 mm/s, 2 m/s², 200 m/s³                    | 0.4 s            |
-//! | `chirp`     | 0.1 mm, 1 → 200 Hz logarithmic                       | 2.0 s            |
-//! | `prbs`      | 0.05 mm, 10-sample clock, 9-bit register, smoothed  | 1.1 s            |
-//! | `multisine` | 0.05 mm peak, 1 … 200 Hz, Schroeder phases          | 1.1 s            |
+//! | `chirp`     | 0.03 mm, 1 → 200 Hz logarithmic                      | 2.0 s            |
+//! | `prbs`      | 0.03 mm, 10-sample clock, 9-bit register, smoothed  | 1.1 s            |
+//! | `multisine` | 0.03 mm peak, 1 … 200 Hz, Schroeder phases          | 1.1 s            |
 //!
 //! Every command rests 10 ms at 0 before it moves; the default rate is 5 kHz
-//! ([`DEFAULT_RATE_HZ`]).
+//! ([`DEFAULT_RATE_HZ`]). The excitation amplitudes (chirp, PRBS, multisine)
+//! keep the default rig inside its 10 A current limit; the paper step
+//! deliberately does not (its linear response would need 256 A).
 
 use std::fmt;
 use std::str::FromStr;

@@ -242,14 +242,20 @@ mod tests {
             apk = apk.max(a.abs());
             jpk = jpk.max(j.abs());
         }
-        assert!(vpk <= s.max_velocity * (1.0 + 1e-6), "v {vpk} plan {plan:?}");
+        assert!(
+            vpk <= s.max_velocity * (1.0 + 1e-6),
+            "v {vpk} plan {plan:?}"
+        );
         assert!(apk <= s.max_acceleration * (1.0 + 1e-3), "a {apk}");
         // third differences straddling a jerk switch average the jerk; never exceed it
         assert!(jpk <= s.jerk * (1.0 + 1e-2), "j {jpk}");
         // analytic state: continuous speed / acceleration, exact end point
         let st = s.state_at(end - 1e-12);
         assert!((st.position - s.distance).abs() < 1e-12, "{st:?}");
-        assert!(st.velocity.abs() < 1e-8 && st.acceleration.abs() < 1e-6, "{st:?}");
+        assert!(
+            st.velocity.abs() < 1e-8 && st.acceleration.abs() < 1e-6,
+            "{st:?}"
+        );
         assert_eq!(s.value_at(end), s.distance);
         assert_eq!(*x.last().unwrap(), s.distance);
         for k in 0..200 {

@@ -1058,6 +1058,15 @@ mod tests {
     }
 
     #[test]
+    fn default_step_gives_twenty_substeps_at_five_kilohertz() {
+        let rig = VirtualRig::new(RigParams::default());
+        assert_eq!(rig.substeps(5000.0), 20);
+        assert_eq!(rig.substeps(1000.0), 100);
+        assert_eq!(rig.substeps(1e6), 1);
+        assert_eq!(rig.clone().with_max_step(3e-5).substeps(5000.0), 7);
+    }
+
+    #[test]
     fn plant_stiffness_equals_params_stiffness_at_nut_position() {
         let p = RigParams::default();
         let plant = Plant::new(&p, &RigEffects::default());

@@ -5,6 +5,7 @@
 mod closed_loop;
 mod nominal;
 mod params;
+mod rig;
 mod summary;
 
 pub use closed_loop::{
@@ -16,4 +17,5 @@ pub use params::{
     equivalent_stiffness, screw_inertia, screw_stiffness, total_inertia, Control, Damping,
     Geometry, Inertia, Material, Motor, RigParams, Stiffness, Table,
 };
+pub use rig::{Friction, PositionLoop, RigEffects, RigOutput, VirtualRig, DEFAULT_MAX_STEP};
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

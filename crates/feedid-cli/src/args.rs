@@ -16,6 +16,12 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Simulate a scenario on the virtual rig and write a recording.
+    Simulate(SimulateArgs),
+    /// Identify over sliding windows and predict the next samples.
+    Identify(IdentifyArgs),
+    /// Run the paper's experiments (ramp and step) end to end on the virtual rig.
+    Reproduce(ReproduceArgs),
     /// Summarise a recording: samples, rate and jitter, channel ranges, motion segments.
     Info(InfoArgs),
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
@@ -97,4 +103,109 @@ pub struct InfoArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `feedid simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Command: ramp (30 mm at 50 mm/s), step (1 mm in 0.2 ms), scurve, chirp, prbs, multisine.
+    #[arg(long, value_name = "NAME")]
+    pub scenario: String,
+    /// Rig parameters (TOML); default: the built-in default rig.
+    #[arg(long, value_name = "rig.toml")]
+    pub params: Option<PathBuf>,
+    /// Nonlinear effects of the virtual rig (TOML, see `feedid simulate --help`); default: all on.
+    #[arg(long, value_name = "effects.toml", conflicts_with = "linear")]
+    pub effects: Option<PathBuf>,
+    /// Seed of the measurement noise (and of the PRBS).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Switch every nonlinear effect off (continuous linear cascade, no noise).
+    #[arg(long)]
+    pub linear: bool,
+    /// Duration [s]; default: the scenario's.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Sampling rate [Hz].
+    #[arg(long, value_name = "HZ", default_value_t = 5000.0)]
+    pub rate: f64,
+    /// Output CSV: time_s,command_m,position_m,true_position_m,current_a,velocity_m_per_s.
+    #[arg(short, long, value_name = "out.csv")]
+    pub output: PathBuf,
+}
+
+/// Method options shared by identify and stream.
+#[derive(Debug, Clone, Args)]
+pub struct MethodArgs {
+    /// Identification method.
+    #[arg(long, default_value = "paper", value_name = "NAME")]
+    pub method: String,
+    /// Solver of the paper method: qr (exact least squares) or simplex (Nelder–Mead, as in the paper).
+    #[arg(long, default_value = "qr", value_name = "NAME")]
+    pub solver: String,
+    /// Time origin of the paper method: motion (start of motion) or window (each window's first sample).
+    #[arg(long, default_value = "motion", value_name = "NAME")]
+    pub time_origin: String,
+    /// Prediction of the paper method: polynomial (fitted output continued) or tf (identified Tf on the next command).
+    #[arg(long, default_value = "polynomial", value_name = "NAME")]
+    pub prediction: String,
+}
+
+/// Sliding-window options.
+#[derive(Debug, Clone, Args)]
+pub struct WindowArgs {
+    /// Window length W [samples].
+    #[arg(long, default_value_t = 20)]
+    pub window: usize,
+    /// Prediction horizon H [samples].
+    #[arg(long, default_value_t = 10)]
+    pub horizon: usize,
+    /// Shift between windows [samples]; default: the horizon.
+    #[arg(long)]
+    pub hop: Option<usize>,
+}
+
+/// `feedid identify`.
+#[derive(Debug, Args)]
+pub struct IdentifyArgs {
+    /// Recording: CSV/text or MATLAB v5 .mat file.
+    pub input: PathBuf,
+    /// How to read it.
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// Method.
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// Windows.
+    #[command(flatten)]
+    pub windows: WindowArgs,
+    /// Rig parameters of the nominal simulation model (TOML); default: the built-in rig.
+    #[arg(long, value_name = "rig.toml")]
+    pub params: Option<PathBuf>,
+    /// Predictions CSV: time_s,command_m,measured_m,predicted_m,simulated_m.
+    #[arg(short, long, value_name = "predictions.csv")]
+    pub output: PathBuf,
+    /// Per-window coefficients CSV.
+    #[arg(long, value_name = "coef.csv")]
+    pub coefficients: Option<PathBuf>,
+    /// Summary JSON.
+    #[arg(long, value_name = "summary.json")]
+    pub summary: Option<PathBuf>,
+}
+
+/// `feedid reproduce`.
+#[derive(Debug, Args)]
+pub struct ReproduceArgs {
+    /// Output directory for figures and summary.md.
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    pub out: PathBuf,
+    /// Rig parameters (TOML); default: the built-in default rig.
+    #[arg(long, value_name = "rig.toml")]
+    pub params: Option<PathBuf>,
+    /// Seed of the measurement noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Solver of the paper method: qr or simplex.
+    #[arg(long, default_value = "simplex", value_name = "NAME")]
+    pub solver: String,
 }

@@ -17,6 +17,7 @@
 
 pub mod drive;
 pub mod error;
+pub mod experiment;
 pub mod ident;
 pub mod io;
 pub mod lti;

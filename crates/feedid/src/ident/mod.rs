@@ -6,6 +6,7 @@
 
 pub mod engine;
 mod estimator;
+mod identify;
 mod model;
 mod paper;
 
@@ -16,3 +17,4 @@ pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
     PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,
 };
+pub use identify::{identify, Identification, IdentifySummary};

@@ -1,0 +1,149 @@
+//! One identification run over a recording: the sliding prediction of an
+//! estimator, the nominal simulation model next to it (the paper's third
+//! curve), and the summary that `feedid identify` writes.
+//!
+//! ```
+//! use feedid::ident::{identify, EngineConfig, PaperConfig};
+//! use feedid::{drive::RigParams, Recording};
+//! let t: Vec<f64> = (0..200).map(|k| k as f64 * 2e-4).collect();
+//! let u: Vec<f64> = t.iter().map(|&t| 0.05 * t).collect();
+//! let rec = Recording::new(t, u.clone(), u).unwrap();
+//! let mut est = PaperConfig::default().build().unwrap();
+//! let run = identify(&rec, &mut est, &EngineConfig::default(), Some(&RigParams::default())).unwrap();
+//! let s = run.summary();
+//! assert_eq!(s.method, "paper");
+//! assert!(s.samples_predicted > 0);
+//! ```
+
+use serde::Serialize;
+
+use crate::drive::{simulate_nominal, RigParams};
+use crate::error::Result;
+use crate::ident::engine::{run as run_engine, EngineConfig, SlidingResult};
+use crate::ident::Estimator;
+use crate::recording::Recording;
+use crate::solve::Termination;
+use crate::stats::ErrorStats;
+
+/// The outcome of identifying one recording.
+#[derive(Debug, Clone)]
+pub struct Identification {
+    /// The sliding-window predictions and per-window coefficients.
+    pub sliding: SlidingResult,
+    /// Nominal linear model driven by the measured command (if parameters were given).
+    pub simulated: Option<Vec<f64>>,
+    /// Error of the nominal model against the measurement over the same samples
+    /// as the predictions (all samples if nothing was predicted).
+    pub simulation_stats: Option<ErrorStats>,
+    /// The engine settings used.
+    pub config: EngineConfig,
+    /// Samples in the recording.
+    pub samples: usize,
+    /// Sampling rate \[Hz\].
+    pub rate_hz: f64,
+}
+
+/// Slide `estimator` over `recording` and compare with the nominal model of `params`.
+pub fn identify<E: Estimator + ?Sized>(
+    recording: &Recording,
+    estimator: &mut E,
+    config: &EngineConfig,
+    params: Option<&RigParams>,
+) -> Result<Identification> {
+    let signals = recording.signals();
+    let sliding = run_engine(estimator, &signals, config)?;
+    let simulated = match params {
+        Some(p) => Some(simulate_nominal(p, recording.command(), recording.dt())?),
+        None => None,
+    };
+    let simulation_stats = simulated.as_ref().map(|sim| {
+        let y = recording.position();
+        let any = sliding.stats.samples > 0;
+        ErrorStats::from_pairs(
+            (0..y.len())
+                .filter(|&k| !any || sliding.has_prediction[k])
+                .map(|k| (y[k], sim[k])),
+        )
+    });
+    Ok(Identification {
+        sliding,
+        simulated,
+        simulation_stats,
+        config: *config,
+        samples: recording.len(),
+        rate_hz: recording.rate_hz(),
+    })
+}
+
+/// The machine-readable summary of a run (`summary.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct IdentifySummary {
+    /// Method name.
+    pub method: String,
+    /// Samples in the recording.
+    pub samples: usize,
+    /// Sampling rate \[Hz\].
+    pub rate_hz: f64,
+    /// Window W \[samples\].
+    pub window: usize,
+    /// Horizon H \[samples\].
+    pub horizon: usize,
+    /// Hop \[samples\].
+    pub hop: usize,
+    /// Windows visited.
+    pub windows: usize,
+    /// Windows whose fit or prediction failed (no prediction).
+    pub failed_windows: usize,
+    /// Windows that kept the previous model (not informative).
+    pub fallback_windows: usize,
+    /// Samples with a prediction.
+    pub samples_predicted: usize,
+    /// RMS prediction error \[m\].
+    pub rms_error_m: f64,
+    /// Largest absolute prediction error \[m\].
+    pub max_abs_error_m: f64,
+    /// NRMSE fit of the k-step (k = horizon) predictions \[%\].
+    pub fit_percent: f64,
+    /// RMS error of the nominal simulation model over the predicted samples \[m\].
+    pub sim_rms_error_m: Option<f64>,
+    /// Largest absolute error of the nominal simulation model \[m\].
+    pub sim_max_abs_error_m: Option<f64>,
+    /// NRMSE fit of the nominal simulation model \[%\].
+    pub nominal_fit_percent: Option<f64>,
+    /// Wall time of identification and prediction only (no I/O) \[s\].
+    pub identification_seconds: f64,
+    /// Mean wall time per window \[µs\].
+    pub per_window_us: f64,
+}
+
+impl Identification {
+    /// The summary of this run.
+    pub fn summary(&self) -> IdentifySummary {
+        let s = &self.sliding;
+        let fallback = s
+            .windows
+            .iter()
+            .filter(|w| w.fit.termination == Termination::Fallback)
+            .count();
+        IdentifySummary {
+            method: s.method.to_string(),
+            samples: self.samples,
+            rate_hz: self.rate_hz,
+            window: self.config.window,
+            horizon: self.config.horizon,
+            hop: self.config.hop(),
+            windows: s.windows.len(),
+            failed_windows: s.failed_windows(),
+            fallback_windows: fallback,
+            samples_predicted: s.stats.samples,
+            rms_error_m: s.stats.rms,
+            max_abs_error_m: s.stats.max_abs,
+            fit_percent: s.stats.fit_percent,
+            sim_rms_error_m: self.simulation_stats.map(|x| x.rms),
+            sim_max_abs_error_m: self.simulation_stats.map(|x| x.max_abs),
+            nominal_fit_percent: self.simulation_stats.map(|x| x.fit_percent),
+            identification_seconds: s.elapsed.as_secs_f64(),
+            per_window_us: s.per_window_us(),
+        }
+    }
+}

@@ -16,6 +16,8 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Summarise a recording: samples, rate and jitter, channel ranges, motion segments.
+    Info(InfoArgs),
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),
 }
@@ -44,4 +46,55 @@ pub struct ModelArgs {
     /// Write the parameters used as TOML to this file (a template to edit).
     #[arg(long, value_name = "rig.toml")]
     pub save_params: Option<PathBuf>,
+}
+
+/// How to read a recording (every command that reads one uses these).
+#[derive(Debug, Clone, Args)]
+pub struct RecordingArgs {
+    /// Time column/variable, by name or 1-based index [default: time_s in text files].
+    #[arg(long, value_name = "NAME|N")]
+    pub time: Option<String>,
+    /// Command (set-point) column/variable [default: command_m in text files].
+    #[arg(long, value_name = "NAME|N")]
+    pub command: Option<String>,
+    /// Measured-position column/variable [default: position_m in text files].
+    #[arg(long, value_name = "NAME|N")]
+    pub position: Option<String>,
+    /// Sampling rate when the file has no time column [Hz].
+    #[arg(long, value_name = "HZ")]
+    pub rate: Option<f64>,
+    /// Delimiter of text files: ',', ';', 'tab', 'space' [default: detected].
+    #[arg(long, value_name = "CHAR")]
+    pub delimiter: Option<String>,
+    /// The first row is data, not a header [default: detected].
+    #[arg(long, conflicts_with = "header")]
+    pub no_header: bool,
+    /// The first row is a header [default: detected].
+    #[arg(long)]
+    pub header: bool,
+    /// Unit of command and position in the file: m, mm, um, nm.
+    #[arg(long, value_name = "UNIT", default_value = "m")]
+    pub unit: String,
+    /// Metres per file unit of command and position (e.g. encoder counts → m).
+    #[arg(long, value_name = "M_PER_UNIT")]
+    pub scale: Option<f64>,
+    /// Unit of the time column: s, ms, us.
+    #[arg(long, value_name = "UNIT", default_value = "s")]
+    pub time_unit: String,
+    /// Allowed relative deviation of a sampling interval from the mean one.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
+    pub jitter_tol: f64,
+}
+
+/// `feedid info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Recording: CSV/text or MATLAB v5 .mat file.
+    pub input: PathBuf,
+    /// How to read it.
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -16,8 +16,9 @@ fn main() -> ExitCode {
     match cmd::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-            eprintln!("error: {}", chain.join(": ").replace('\n', " "));
+            // The library's messages already carry their causes (file, line,
+            // column, value): print the outermost one, on one line.
+            eprintln!("error: {}", e.to_string().replace('\n', " "));
             ExitCode::from(2)
         }
     }

@@ -198,6 +198,39 @@ pub enum Error {
         /// Renderer message.
         reason: String,
     },
+
+    // --- io
+    /// An error found in a recording file, with the place it was found: the
+    /// wrapped error (e.g. [`Error::NonFinite`], [`Error::NonMonotoneTime`])
+    /// prefixed by the file and the line / column or variable.
+    #[error("{}", display_in_file(path, location, source))]
+    InFile {
+        /// The file.
+        path: PathBuf,
+        /// Where in the file, e.g. ``"line 7, column `position_m`"``; may be empty.
+        location: String,
+        /// The underlying error.
+        #[source]
+        source: Box<Error>,
+    },
+}
+
+impl Error {
+    /// The innermost error: the wrapped one for [`Error::InFile`], else `self`.
+    pub fn root(&self) -> &Error {
+        match self {
+            Error::InFile { source, .. } => source.root(),
+            other => other,
+        }
+    }
+}
+
+fn display_in_file(path: &std::path::Path, location: &str, source: &Error) -> String {
+    if location.is_empty() {
+        format!("{}: {source}", path.display())
+    } else {
+        format!("{}: {location}: {source}", path.display())
+    }
 }
 
 fn display_path(path: &Option<PathBuf>) -> String {

@@ -3,7 +3,7 @@
 //!
 //! Checks: equal lengths, every value finite, time strictly increasing, and
 //! uniform sampling — every interval within `jitter_tolerance` (relative) of
-//! the median interval. Nothing is dropped or reordered.
+//! the mean interval. Nothing is dropped or reordered.
 //!
 //! ```
 //! use feedid::Recording;
@@ -11,6 +11,8 @@
 //! let r = Recording::new(t, vec![0.0; 5], vec![0.0; 5]).unwrap();
 //! assert!((r.rate_hz() - 5000.0).abs() < 1e-6);
 //! ```
+
+use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::ident::Signals;
@@ -88,7 +90,7 @@ impl Recording {
                 });
             }
         }
-        let dt = median_interval(&time);
+        let dt = mean_interval(&time);
         let mut max_jitter = 0.0_f64;
         let mut worst = 0;
         for k in 1..time.len() {
@@ -161,7 +163,7 @@ impl Recording {
         &self.extra
     }
 
-    /// Nominal (median) sample interval \[s\].
+    /// Nominal (mean) sample interval \[s\].
     pub fn dt(&self) -> f64 {
         self.dt
     }
@@ -203,6 +205,51 @@ impl Recording {
         self.motion_start_index(MOTION_THRESHOLD).is_some()
     }
 
+    /// Stretches where the command moves (see [`MotionSegment`]).
+    ///
+    /// A step `k → k+1` is moving when `|c[k+1] − c[k]| > step_threshold` \[m\];
+    /// runs of moving steps separated by a standstill shorter than
+    /// `min_standstill_s` \[s\] are merged into one segment. A segment runs
+    /// from the last rest sample before its first moving step to the sample
+    /// after its last moving step. Empty when the command never moves.
+    pub fn motion_segments(
+        &self,
+        step_threshold: f64,
+        min_standstill_s: f64,
+    ) -> Vec<MotionSegment> {
+        let (t, c) = (&self.time, &self.command);
+        // Runs of moving steps as (first step, last step).
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        for k in 0..c.len().saturating_sub(1) {
+            if (c[k + 1] - c[k]).abs() <= step_threshold {
+                continue;
+            }
+            match runs.last_mut() {
+                Some((_, last)) if *last + 1 == k || t[k] - t[*last + 1] < min_standstill_s => {
+                    *last = k
+                }
+                _ => runs.push((k, k)),
+            }
+        }
+        runs.into_iter()
+            .map(|(a, b)| {
+                let (mut peak, mut travel) = (0.0_f64, 0.0);
+                for k in a..=b {
+                    let d = (c[k + 1] - c[k]).abs();
+                    travel += d;
+                    peak = peak.max(d / (t[k + 1] - t[k]));
+                }
+                MotionSegment {
+                    start_s: t[a],
+                    end_s: t[b + 1],
+                    distance_m: c[b + 1] - c[a],
+                    travel_m: travel,
+                    peak_speed_m_per_s: peak,
+                }
+            })
+            .collect()
+    }
+
     /// The whole recording as an estimator view.
     pub fn signals(&self) -> Signals<'_> {
         Signals::new(
@@ -213,6 +260,21 @@ impl Recording {
             self.motion_start_time(),
         )
     }
+}
+
+/// A stretch of the recording where the command moves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MotionSegment {
+    /// Time of the last rest sample before the motion \[s\].
+    pub start_s: f64,
+    /// Time of the first sample after the last moving step \[s\].
+    pub end_s: f64,
+    /// Net command displacement over the segment, signed \[m\].
+    pub distance_m: f64,
+    /// Path length of the command over the segment, `Σ|Δc|` \[m\].
+    pub travel_m: f64,
+    /// Largest command speed `|Δc|/Δt` in the segment \[m/s\].
+    pub peak_speed_m_per_s: f64,
 }
 
 /// Command change that counts as motion \[m\] (1 nm).
@@ -229,12 +291,11 @@ fn check_finite(channel: &str, v: &[f64]) -> Result<()> {
     }
 }
 
-/// Median of the intervals of a strictly increasing sequence (len ≥ 2).
-fn median_interval(time: &[f64]) -> f64 {
-    let mut d: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
-    let mid = d.len() / 2;
-    let (_, m, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
-    *m
+/// Mean interval `(t_last − t_first)/(n − 1)` of a strictly increasing
+/// sequence (len ≥ 2): exact for alternating time-stamp jitter such as the
+/// EMPS file's 1.000024 / 0.999984 ms, where the median would be biased.
+fn mean_interval(time: &[f64]) -> f64 {
+    (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64
 }
 
 #[cfg(test)]
@@ -295,6 +356,40 @@ mod tests {
         let r = Recording::new(t(5), c, vec![0.0; 5]).unwrap();
         assert_eq!(r.motion_start_index(1e-9), Some(2));
         assert!((r.motion_start_time() - 2e-3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn motion_segments_merge_short_pauses_and_split_long_ones() {
+        // 1 kHz: rest 10, ramp +1 mm/s for 10 steps, pause 5 (short), ramp 5,
+        // pause 200 (long), ramp back -2 mm/s for 10 steps, rest.
+        let mut c = vec![0.0; 10];
+        let mut x = 0.0;
+        let mut push = |steps: usize, dx: f64, c: &mut Vec<f64>| {
+            for _ in 0..steps {
+                x += dx;
+                c.push(x);
+            }
+        };
+        push(10, 1e-6, &mut c);
+        push(5, 0.0, &mut c);
+        push(5, 1e-6, &mut c);
+        push(200, 0.0, &mut c);
+        push(10, -2e-6, &mut c);
+        push(10, 0.0, &mut c);
+        let n = c.len();
+        let r = Recording::new(t(n), c, vec![0.0; n]).unwrap();
+        let s = r.motion_segments(1e-9, 0.05);
+        assert_eq!(s.len(), 2, "{s:?}");
+        assert!((s[0].start_s - 0.009).abs() < 1e-12 && (s[0].end_s - 0.029).abs() < 1e-12);
+        assert!((s[0].distance_m - 15e-6).abs() < 1e-15);
+        assert!((s[0].peak_speed_m_per_s - 1e-3).abs() < 1e-9);
+        assert!((s[1].distance_m + 20e-6).abs() < 1e-15);
+        assert!((s[1].travel_m - 20e-6).abs() < 1e-15);
+        assert!((s[1].peak_speed_m_per_s - 2e-3).abs() < 1e-9);
+        // A long minimum standstill merges everything into one segment.
+        assert_eq!(r.motion_segments(1e-9, 1.0).len(), 1);
+        // A short one splits the first segment at the 5-sample pause.
+        assert_eq!(r.motion_segments(1e-9, 0.001).len(), 3);
     }
 
     #[test]

@@ -1,12 +1,15 @@
 //! One module per subcommand.
 
+mod info;
 mod model;
+mod recording;
 
 use crate::args::{Cli, Command};
 
 /// Dispatch a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Info(a) => info::run(&a),
         Command::Model(a) => model::run(&a),
     }
 }

@@ -287,6 +287,70 @@ mod tests {
     }
 
     #[test]
+    fn coefficients_equal_state_space_conversion() {
+        // Random-ish but physical variations of the default rig, including a
+        // different nut position, all to 1e-9 relative.
+        let mut p = RigParams::default();
+        for case in 0..4 {
+            let tf = closed_loop_state_space(&p).unwrap().to_tf().unwrap();
+            let c = closed_loop_coefficients(&p, D1Variant::Corrected);
+            let scale = c.den[0] / tf.den()[0];
+            assert_eq!(tf.den().len(), 8);
+            for (k, (&got, &want)) in tf.den().iter().zip(c.den.iter()).enumerate() {
+                assert!(
+                    rel(got * scale, want) < 1e-9,
+                    "case {case} D{}: {got} vs {want}",
+                    7 - k
+                );
+            }
+            let num = tf.num();
+            assert_eq!(num.len(), 3, "relative degree 5: {num:?}");
+            for (k, (&got, &want)) in num.iter().zip(c.num.iter()).enumerate() {
+                assert!(
+                    rel(got * scale, want) < 1e-9,
+                    "case {case} N{}: {got} vs {want}",
+                    2 - k
+                );
+            }
+            p.control.kv *= 1.3;
+            p.damping.c2 *= 2.0;
+            p.table.mass *= 0.7;
+            p.geometry.nut_position *= 0.5;
+        }
+    }
+
+    #[test]
+    fn state_space_has_unit_dc_gain_and_notes_poles() {
+        let ss = closed_loop_state_space(&RigParams::default()).unwrap();
+        assert!((ss.dc_gain().unwrap() - 1.0).abs() < 1e-12);
+        let mut f: Vec<f64> = ss
+            .poles()
+            .unwrap()
+            .iter()
+            .filter(|p| p.im >= 0.0)
+            .map(|p| p.norm() / (2.0 * std::f64::consts::PI))
+            .collect();
+        f.sort_by(f64::total_cmp);
+        let want = [60.7, 254.0, 561.0, 579.0, 1430.0];
+        for (g, w) in f.iter().zip(want) {
+            assert!((g - w).abs() / w < 3e-3, "{f:?}");
+        }
+    }
+
+    #[test]
+    fn ramp_response_of_transfer_function_settles_to_v_over_kv_lag() {
+        let p = RigParams::default();
+        let tf = closed_loop_coefficients(&p, D1Variant::Corrected)
+            .transfer_function()
+            .unwrap();
+        let dt = 2e-4;
+        let y = tf.ramp_response(0.05, dt, 1000).unwrap();
+        let t_end = 999.0 * dt;
+        let lag = 0.05 * t_end - y[999];
+        assert!((lag - 0.05 / 700.0).abs() < 1e-9, "{lag}");
+    }
+
+    #[test]
     fn state_space_has_seven_states_and_structure() {
         let ss = closed_loop_state_space(&RigParams::default()).unwrap();
         assert_eq!(ss.order(), 7);

@@ -3,13 +3,17 @@
 //! as a 7-state state-space model, and the nonlinear virtual rig.
 
 mod closed_loop;
+mod nominal;
 mod params;
+mod summary;
 
 pub use closed_loop::{
     closed_loop_coefficients, closed_loop_coefficients_with_stiffness, closed_loop_state_space,
     closed_loop_state_space_with_stiffness, ClosedLoopCoefficients, D1Variant,
 };
+pub use nominal::simulate_nominal;
 pub use params::{
     equivalent_stiffness, screw_inertia, screw_stiffness, total_inertia, Control, Damping,
     Geometry, Inertia, Material, Motor, RigParams, Stiffness, Table,
 };
+pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

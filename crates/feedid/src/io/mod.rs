@@ -1,7 +1,26 @@
-//! Reading recordings from CSV/text and MATLAB v5 files, and writing results.
+//! Reading recordings from CSV/text and MATLAB v5 files ([`read_recording`]
+//! dispatches), the options that pick columns and units ([`ReadOptions`]),
+//! the summary a user checks before identifying ([`recording_info`]), and
+//! writing results without leaving partial files ([`write_atomic`]).
 
+mod csv;
+mod info;
+mod mat;
+mod options;
 mod output;
+mod read;
 
-pub use output::{
+pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
+pub use self::info::{recording_info, ChannelStats, RecordingInfo};
+pub use self::mat::{
+    list_mat_variables, list_mat_variables_from_bytes, read_mat, read_mat_from_bytes,
+    MatVariableInfo,
+};
+pub use self::options::{
+    ChannelRef, ReadOptions, TimeUnit, Unit, DEFAULT_COMMAND_COLUMN, DEFAULT_POSITION_COLUMN,
+    DEFAULT_TIME_COLUMN,
+};
+pub use self::output::{
     cell, write_atomic, write_coefficients_csv, write_predictions_csv, write_string_atomic,
 };
+pub use self::read::{read_recording, read_recording_from_bytes};

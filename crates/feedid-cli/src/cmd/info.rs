@@ -1,0 +1,20 @@
+//! `feedid info`: what a user checks before identifying.
+
+use anyhow::Result;
+use feedid::io::recording_info;
+
+use crate::args::InfoArgs;
+use crate::cmd::recording;
+
+/// Print samples, duration, rate and jitter, channel ranges and motion segments.
+pub fn run(a: &InfoArgs) -> Result<()> {
+    let rec = recording::load(&a.input, &a.recording)?;
+    let info = recording_info(&rec);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+    } else {
+        println!("{}", a.input.display());
+        println!("{info}");
+    }
+    Ok(())
+}

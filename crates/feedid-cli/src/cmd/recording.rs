@@ -1,0 +1,61 @@
+//! Turning the shared recording options into a library read.
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use feedid::io::{read_recording, ChannelRef, ReadOptions};
+use feedid::Recording;
+
+use crate::args::RecordingArgs;
+
+/// Library read options from the command-line options.
+pub fn read_options(a: &RecordingArgs) -> Result<ReadOptions> {
+    let channel = |s: &Option<String>| -> Result<Option<ChannelRef>> {
+        Ok(match s {
+            Some(s) => Some(ChannelRef::parse(s)?),
+            None => None,
+        })
+    };
+    let delimiter = match a.delimiter.as_deref() {
+        None => None,
+        Some("," | "comma") => Some(b','),
+        Some(";" | "semicolon") => Some(b';'),
+        Some("\t" | "tab" | "\\t") => Some(b'\t'),
+        Some(" " | "space" | "whitespace") => Some(b' '),
+        Some(other) => bail!("invalid delimiter `{other}`; expected one of: ',', ';', tab, space"),
+    };
+    let header = if a.no_header {
+        Some(false)
+    } else if a.header {
+        Some(true)
+    } else {
+        None
+    };
+    let opts = ReadOptions {
+        time: channel(&a.time)?,
+        command: channel(&a.command)?,
+        position: channel(&a.position)?,
+        rate_hz: a.rate,
+        delimiter,
+        header,
+        position_unit: a.unit.parse()?,
+        scale: a.scale,
+        time_unit: a.time_unit.parse()?,
+        jitter_tolerance: a.jitter_tol,
+    };
+    opts.validate()?;
+    Ok(opts)
+}
+
+/// Read and check a recording; warn on standard error when the command never moves.
+pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
+    let opts = read_options(a)?;
+    let rec = read_recording(path, &opts)?;
+    if !rec.command_moves() {
+        eprintln!(
+            "warning: {}: the command never moves; there is nothing to identify",
+            path.display()
+        );
+    }
+    Ok(rec)
+}

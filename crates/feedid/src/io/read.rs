@@ -1,0 +1,176 @@
+//! Reading a recording from any supported file: dispatch on content and
+//! extension, unit conversion, and the checks of [`Recording`] with the
+//! place in the file attached to their errors.
+//!
+//! Dispatch: a file whose first bytes are a MAT-file header (`MATLAB …` text
+//! with the `IM`/`MI` endianness indicator at byte 126, or the HDF5 signature
+//! of a v7.3 file at byte 0 or 512) or whose name ends in `.mat` is read by
+//! [`crate::io::read_mat`]; everything else as text by [`crate::io::read_csv`].
+//!
+//! ```no_run
+//! use feedid::io::{read_recording, ChannelRef, ReadOptions};
+//! let opts = ReadOptions {
+//!     time: Some(ChannelRef::Name("t".into())),
+//!     command: Some(ChannelRef::Name("qg".into())),
+//!     position: Some(ChannelRef::Name("qm".into())),
+//!     ..ReadOptions::default()
+//! };
+//! let rec = read_recording("DATA_EMPS.mat".as_ref(), &opts)?;
+//! println!("{} samples at {} Hz", rec.len(), rec.rate_hz());
+//! # Ok::<(), feedid::Error>(())
+//! ```
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::io::csv::read_csv_from_bytes;
+use crate::io::mat::{is_mat_bytes, read_mat_from_bytes};
+use crate::io::options::ReadOptions;
+use crate::recording::Recording;
+
+/// Read a recording from a MAT-file or a text file (see the module doc for the dispatch rule).
+pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Recording> {
+    let bytes = read_file(path)?;
+    read_recording_from_bytes(&bytes, path, opts)
+}
+
+/// Like [`read_recording`] for file contents already in memory; `source` names them in errors.
+pub fn read_recording_from_bytes(
+    bytes: &[u8],
+    source: &Path,
+    opts: &ReadOptions,
+) -> Result<Recording> {
+    let mat_ext = source
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mat"));
+    if mat_ext || is_mat_bytes(bytes) {
+        read_mat_from_bytes(bytes, source, opts)
+    } else {
+        read_csv_from_bytes(bytes, source, opts)
+    }
+}
+
+/// Read a whole file, mapping failures to [`Error::Io`].
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Which of the three signals an error concerns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Role {
+    Time,
+    Command,
+    Position,
+}
+
+/// Convert units and build the checked recording. Errors are those of
+/// [`Recording::with_tolerance`], without file context (see [`failing_sample`]).
+pub(crate) fn build_recording(
+    time: Option<Vec<f64>>,
+    mut command: Vec<f64>,
+    mut position: Vec<f64>,
+    opts: &ReadOptions,
+) -> Result<Recording> {
+    let f = opts.position_factor();
+    if f != 1.0 {
+        command.iter_mut().for_each(|v| *v *= f);
+        position.iter_mut().for_each(|v| *v *= f);
+    }
+    let time = match (time, opts.rate_hz) {
+        (Some(mut t), _) => {
+            let tf = opts.time_unit.factor();
+            if tf != 1.0 {
+                t.iter_mut().for_each(|v| *v *= tf);
+            }
+            t
+        }
+        (None, Some(rate)) => (0..command.len()).map(|k| k as f64 / rate).collect(),
+        (None, None) => {
+            return Err(Error::InvalidParameter {
+                name: "rate",
+                value: f64::NAN,
+                reason: "needed when there is no time column or variable",
+            })
+        }
+    };
+    Recording::with_tolerance(time, command, position, opts.jitter_tolerance)
+}
+
+/// The zero-based sample and the signal a [`Recording`] check error points at.
+pub(crate) fn failing_sample(err: &Error) -> Option<(usize, Option<Role>)> {
+    match err {
+        Error::NonFinite { channel, index, .. } => {
+            let role = match channel.as_str() {
+                "time" => Some(Role::Time),
+                "command" => Some(Role::Command),
+                "position" => Some(Role::Position),
+                _ => None,
+            };
+            Some((*index, role))
+        }
+        Error::NonMonotoneTime { index, .. } => Some((*index, Some(Role::Time))),
+        Error::SamplingJitter { index, .. } => Some((*index, Some(Role::Time))),
+        _ => None,
+    }
+}
+
+/// Wrap `err` into [`Error::InFile`].
+pub(crate) fn in_file(path: &Path, location: String, err: Error) -> Error {
+    Error::InFile {
+        path: path.to_path_buf(),
+        location,
+        source: Box::new(err),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::options::{ChannelRef, TimeUnit, Unit};
+
+    #[test]
+    fn units_are_converted_to_si() {
+        let opts = ReadOptions {
+            position_unit: Unit::Mm,
+            time_unit: TimeUnit::Ms,
+            ..Default::default()
+        };
+        let r = build_recording(
+            Some(vec![0.0, 1.0, 2.0]),
+            vec![0.0, 1.0, 2.0],
+            vec![0.0, 0.5, 1.5],
+            &opts,
+        )
+        .unwrap();
+        assert!((r.rate_hz() - 1000.0).abs() < 1e-9);
+        assert!((r.command()[2] - 2e-3).abs() < 1e-18);
+        assert!((r.position()[1] - 0.5e-3).abs() < 1e-18);
+    }
+
+    #[test]
+    fn rate_synthesises_time_from_zero() {
+        let opts = ReadOptions {
+            rate_hz: Some(500.0),
+            ..Default::default()
+        };
+        let r = build_recording(None, vec![0.0; 4], vec![0.0; 4], &opts).unwrap();
+        assert_eq!(r.time(), &[0.0, 0.002, 0.004, 0.006]);
+    }
+
+    #[test]
+    fn dispatch_reads_text_when_not_a_mat_file() {
+        let text = b"time_s,command_m,position_m\n0,0,0\n0.001,1,1\n0.002,2,2\n";
+        let r = read_recording_from_bytes(text, Path::new("a.csv"), &Default::default()).unwrap();
+        assert_eq!(r.len(), 3);
+        let opts = ReadOptions {
+            command: Some(ChannelRef::Name("qg".into())),
+            ..Default::default()
+        };
+        // A `.mat` name forces the MAT reader, which refuses text.
+        let e = read_recording_from_bytes(text, Path::new("a.mat"), &opts).unwrap_err();
+        assert!(matches!(e, Error::MatFile { .. }), "{e}");
+    }
+}

@@ -1,23 +1,75 @@
 //! One module per subcommand.
 
+mod identify;
 mod info;
 mod model;
 mod recording;
+mod reproduce;
+mod simulate;
+
+use std::path::{Path, PathBuf};
 
 use crate::args::{Cli, Command};
 
 /// Dispatch a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Identify(a) => identify::run(&a),
         Command::Info(a) => info::run(&a),
         Command::Model(a) => model::run(&a),
+        Command::Reproduce(a) => reproduce::run(&a),
+        Command::Simulate(a) => simulate::run(&a),
     }
 }
 
 /// The rig parameters from a TOML file, or the built-in default rig.
-pub fn load_params(path: Option<&std::path::Path>) -> anyhow::Result<feedid::drive::RigParams> {
+pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigParams> {
     Ok(match path {
         Some(p) => feedid::drive::RigParams::load(p)?,
         None => feedid::drive::RigParams::default(),
     })
+}
+
+/// Output files of one command: each is written atomically; if a later one
+/// fails, the ones already written are removed, so a failed command leaves
+/// no output behind.
+#[derive(Default)]
+pub struct Outputs {
+    written: Vec<PathBuf>,
+}
+
+impl Outputs {
+    /// Write one file with `f`; on failure remove what this command wrote so far.
+    pub fn write<F>(&mut self, path: &Path, f: F) -> anyhow::Result<()>
+    where
+        F: FnOnce(&Path) -> feedid::Result<()>,
+    {
+        match f(path) {
+            Ok(()) => {
+                self.written.push(path.to_path_buf());
+                Ok(())
+            }
+            Err(e) => {
+                self.rollback();
+                Err(e.into())
+            }
+        }
+    }
+
+    /// Keep everything written.
+    pub fn commit(mut self) {
+        self.written.clear();
+    }
+
+    fn rollback(&mut self) {
+        for p in self.written.drain(..) {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
+impl Drop for Outputs {
+    fn drop(&mut self) {
+        self.rollback();
+    }
 }

@@ -19,11 +19,11 @@ pub enum Command {
     /// Simulate a scenario on the virtual rig and write a recording.
     Simulate(SimulateArgs),
     /// Identify over sliding windows and predict the next samples.
-    Identify(IdentifyArgs),
+    Identify(Box<IdentifyArgs>),
     /// Run the paper's experiments (ramp and step) end to end on the virtual rig.
     Reproduce(ReproduceArgs),
     /// Summarise a recording: samples, rate and jitter, channel ranges, motion segments.
-    Info(InfoArgs),
+    Info(Box<InfoArgs>),
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),
 }

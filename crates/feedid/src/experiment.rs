@@ -83,6 +83,8 @@ pub struct ExperimentResult {
     pub motion_start: f64,
     /// Zoom length \[s\].
     pub zoom: f64,
+    /// Solver of [`ExperimentResult::identification`].
+    pub solver: Solver,
 }
 
 /// Duration of each experiment \[s\]: the ramp's full 30 mm move and settling, 0.1 s after the step.
@@ -111,7 +113,12 @@ pub fn run_experiment(scenario: Scenario, cfg: &PaperExperimentConfig) -> Result
             ..PaperConfig::default()
         }
         .build()?;
-        runs.push(identify(&recording, &mut est, &cfg.engine, Some(&cfg.params))?);
+        runs.push(identify(
+            &recording,
+            &mut est,
+            &cfg.engine,
+            Some(&cfg.params),
+        )?);
     }
     let errors = |id: &Identification, curve: &dyn Fn(usize) -> Option<f64>| {
         let y = recording.position();
@@ -149,6 +156,7 @@ pub fn run_experiment(scenario: Scenario, cfg: &PaperExperimentConfig) -> Result
         simplex_us,
         motion_start,
         zoom: cfg.zoom,
+        solver: cfg.solver,
     })
 }
 
@@ -165,7 +173,10 @@ impl ExperimentResult {
     pub fn response_chart(&self) -> LineChart {
         let idx = self.zoom_indices();
         let t = self.recording.time();
-        let ms: Vec<f64> = idx.iter().map(|&k| 1e3 * (t[k] - self.motion_start)).collect();
+        let ms: Vec<f64> = idx
+            .iter()
+            .map(|&k| 1e3 * (t[k] - self.motion_start))
+            .collect();
         let um = |f: &dyn Fn(usize) -> Option<f64>| -> Vec<f64> {
             idx.iter()
                 .map(|&k| f(k).map_or(f64::NAN, |v| 1e6 * v))
@@ -208,7 +219,7 @@ impl ExperimentResult {
         );
         c.push(
             Series::new(
-                &format!("identified model (paper LSM, {})", id.sliding.method),
+                &format!("identified model (paper LSM, {})", self.solver.label()),
                 ms,
                 um(&|k| id.sliding.prediction(k)),
             )
@@ -223,7 +234,10 @@ impl ExperimentResult {
         let idx = self.zoom_indices();
         let t = self.recording.time();
         let y = self.recording.position();
-        let ms: Vec<f64> = idx.iter().map(|&k| 1e3 * (t[k] - self.motion_start)).collect();
+        let ms: Vec<f64> = idx
+            .iter()
+            .map(|&k| 1e3 * (t[k] - self.motion_start))
+            .collect();
         let id = &self.identification;
         let err = |f: &dyn Fn(usize) -> Option<f64>| -> Vec<f64> {
             idx.iter()
@@ -262,7 +276,10 @@ impl ExperimentResult {
 /// The error table of the experiments as Markdown, with the paper's values.
 pub fn summary_markdown(results: &[ExperimentResult], cfg: &PaperExperimentConfig) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "# feedid reproduce — the paper's experiments on the virtual rig\n");
+    let _ = writeln!(
+        s,
+        "# feedid reproduce — the paper's experiments on the virtual rig\n"
+    );
     let _ = writeln!(
         s,
         "Virtual rig: default rig of the design notes, every nonlinear effect {} \

@@ -74,7 +74,10 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
     );
     println!(
         "  {} windows ({} failed, {} fallback), {} samples predicted",
-        summary.windows, summary.failed_windows, summary.fallback_windows, summary.samples_predicted
+        summary.windows,
+        summary.failed_windows,
+        summary.fallback_windows,
+        summary.samples_predicted
     );
     println!(
         "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.2} %",

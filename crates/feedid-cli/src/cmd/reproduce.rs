@@ -22,7 +22,10 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
     }
     let mut files = Vec::new();
     for r in &results {
-        files.push((format!("{}_response.svg", r.name), r.response_chart().to_svg()?));
+        files.push((
+            format!("{}_response.svg", r.name),
+            r.response_chart().to_svg()?,
+        ));
         files.push((format!("{}_error.svg", r.name), r.error_chart().to_svg()?));
     }
     let md = summary_markdown(&results, &cfg);

@@ -1,6 +1,5 @@
 //! `feedid simulate`: a scenario on the virtual rig, written as a recording.
 
-
 use anyhow::Result;
 use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
@@ -15,8 +14,8 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let effects = if a.linear {
         RigEffects::linear()
     } else if let Some(p) = &a.effects {
-        let text = std::fs::read_to_string(p)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
+        let text =
+            std::fs::read_to_string(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
         let fx: RigEffects = toml::from_str(&text).map_err(|e| {
             anyhow::anyhow!("{}: {}", p.display(), e.to_string().replace('\n', " "))
         })?;

@@ -397,7 +397,7 @@ mod tests {
             hop: None,
             warm_up: 2,
         };
-        let mut count = vec![0; 50];
+        let mut count = [0; 50];
         for (_, h) in cfg.windows(50, 1) {
             for k in h {
                 count[k] += 1;

@@ -12,9 +12,9 @@ mod paper;
 
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
+pub use identify::{identify, Identification, IdentifySummary};
 pub use model::LinearModel;
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
     PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,
 };
-pub use identify::{identify, Identification, IdentifySummary};

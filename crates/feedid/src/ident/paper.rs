@@ -82,9 +82,16 @@
 //! [`PaperDiagnostics::tf_fallback`]. Building and discretising a model per
 //! window allocates (inside [`crate::lti`]); the polynomial mode does not.
 //!
-//! Positions are used as given: the output model passes through zero at
-//! `τ = 0`, so with [`TimeOrigin::Motion`] the position should be measured from
-//! the rest position at the motion start (as in the paper).
+//! **Rest and reference** (with [`TimeOrigin::Motion`]): the output model
+//! passes through zero at `τ = 0`, so positions are measured from the rest
+//! position at the motion start (the measured position of the last sample at
+//! or before the motion start, fixed by the first window that reaches past
+//! it; predictions add it back). A window whose last sample is at or before the
+//! motion start (or when the motion start is not known yet, `+∞` while
+//! streaming) holds only rest data: there is nothing to identify, so it
+//! predicts the last measured position held, writes zero coefficients and
+//! reports [`Termination::Fallback`]. The command is fitted as given: its
+//! model has a constant term (`Q0 = D7`).
 //!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
 //! Identification of Feed Drive Systems using Nonlinear Least Squares Method",
@@ -357,6 +364,9 @@ struct LastFit {
     inp: [f64; NQ],
     /// Identified `[N2, N1, N0, D7, …, D0]`.
     coef: [f64; NC],
+    /// Rest position and command subtracted before fitting (0 for window-local time).
+    y_ref: f64,
+    u_ref: f64,
 }
 
 /// The paper's identification method as an [`Estimator`] (name `"paper"`).
@@ -379,6 +389,10 @@ pub struct PaperMethod {
     nm_out: NelderMead,
     nm_in: NelderMead,
     last: Option<LastFit>,
+    /// Held position predicted after a rest window (no motion yet).
+    rest: Option<f64>,
+    /// Rest position at the motion start, fixed by the first motion window.
+    reference: Option<f64>,
     diagnostics: Option<PaperDiagnostics>,
     tf_fallbacks: usize,
     du: Vec<f64>,
@@ -402,6 +416,8 @@ impl PaperMethod {
             nm_out: NelderMead::new(NP),
             nm_in: NelderMead::new(NQ),
             last: None,
+            rest: None,
+            reference: None,
             diagnostics: None,
             tf_fallbacks: 0,
             du: Vec::new(),
@@ -428,13 +444,17 @@ impl PaperMethod {
     /// The last window's fitted output polynomial `P(τ)` at time `t` \[s\]
     /// (`None` before the first fit).
     pub fn fitted_position(&self, t: f64) -> Option<f64> {
-        self.last.as_ref().map(|fit| Self::eval_output(fit, t))
+        self.last
+            .as_ref()
+            .map(|fit| fit.y_ref + Self::eval_output(fit, t))
     }
 
     /// The last window's fitted input polynomial `Q(τ)` at time `t` \[s\]
     /// (`None` before the first fit).
     pub fn fitted_command(&self, t: f64) -> Option<f64> {
-        self.last.as_ref().map(|fit| Self::eval_input(fit, t))
+        self.last
+            .as_ref()
+            .map(|fit| fit.u_ref + Self::eval_input(fit, t))
     }
 
     fn ensure_capacity(&mut self, w: usize) {
@@ -573,6 +593,8 @@ impl Estimator for PaperMethod {
 
     fn reset(&mut self) {
         self.last = None;
+        self.rest = None;
+        self.reference = None;
         self.diagnostics = None;
         self.tf_fallbacks = 0;
     }
@@ -606,6 +628,44 @@ impl Estimator for PaperMethod {
         first_non_finite(pos, window.start, "position")?;
         first_non_finite(cmd, window.start, "command")?;
         self.ensure_capacity(w);
+
+        // --- rest windows and the rest reference (motion time origin)
+        let (y_ref, u_ref) = match self.config.time_origin {
+            TimeOrigin::Window => (0.0, 0.0),
+            TimeOrigin::Motion => {
+                // Also catches an unknown (infinite or NaN) motion start.
+                let moving = signals.motion_start < time[w - 1];
+                if !moving {
+                    let hold = pos[w - 1];
+                    let sse: f64 = pos.iter().map(|v| (v - hold) * (v - hold)).sum();
+                    coef.fill(0.0);
+                    self.rest = Some(hold);
+                    return Ok(WindowFit {
+                        residual_rms: (sse / w as f64).sqrt(),
+                        iterations: 0,
+                        termination: Termination::Fallback,
+                    });
+                }
+                // The output model has no constant term, so positions are
+                // measured from the rest position at the motion start. The
+                // input model has one (Q0 = D7), so the command is fitted as
+                // given, as in the paper.
+                // The reference is fixed by the first motion window, which
+                // holds the motion-start sample when windows overlap or touch
+                // (hop ≤ W), in batch and streaming alike. If the recording
+                // starts in motion (no sample at or before the motion start),
+                // positions are taken as given.
+                let y_ref = *self.reference.get_or_insert_with(|| {
+                    signals
+                        .time
+                        .iter()
+                        .rposition(|&t| t <= signals.motion_start)
+                        .map_or(0.0, |k| signals.position[k])
+                });
+                (y_ref, 0.0)
+            }
+        };
+        self.rest = None;
 
         // --- time scaling
         let origin = match self.config.time_origin {
@@ -678,7 +738,9 @@ impl Estimator for PaperMethod {
             Solver::Qr => {
                 let opts = LstsqOptions::default();
                 self.work[..NP * w].copy_from_slice(&self.design_out[..NP * w]);
-                self.rhs[..w].copy_from_slice(pos);
+                for (r, p) in self.rhs[..w].iter_mut().zip(pos) {
+                    *r = p - y_ref;
+                }
                 let io = lstsq_in_place(
                     w,
                     NP,
@@ -689,7 +751,9 @@ impl Estimator for PaperMethod {
                     &opts,
                 )?;
                 self.work[..NQ * w].copy_from_slice(&self.design_in[..NQ * w]);
-                self.rhs[..w].copy_from_slice(cmd);
+                for (r, c) in self.rhs[..w].iter_mut().zip(cmd) {
+                    *r = c - u_ref;
+                }
                 let ii = lstsq_in_place(
                     w,
                     NQ,
@@ -709,7 +773,9 @@ impl Estimator for PaperMethod {
             Solver::Simplex => {
                 let settings = self.config.simplex;
                 let mut steps = [0.0; NQ];
-                self.data[..w].copy_from_slice(pos);
+                for (r, p) in self.data[..w].iter_mut().zip(pos) {
+                    *r = p - y_ref;
+                }
                 let (fo, it_o, term_o) = simplex_fit(
                     &mut self.nm_out,
                     &self.design_out[..NP * w],
@@ -719,7 +785,9 @@ impl Estimator for PaperMethod {
                     &settings,
                     &mut steps[..NP],
                 )?;
-                self.data[..w].copy_from_slice(cmd);
+                for (r, c) in self.data[..w].iter_mut().zip(cmd) {
+                    *r = c - u_ref;
+                }
                 let (fi, it_i, term_i) = simplex_fit(
                     &mut self.nm_in,
                     &self.design_in[..NQ * w],
@@ -781,7 +849,11 @@ impl Estimator for PaperMethod {
         }
         coef.copy_from_slice(&c);
 
-        let in_norm = cmd.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let in_norm = cmd
+            .iter()
+            .map(|v| (v - u_ref) * (v - u_ref))
+            .sum::<f64>()
+            .sqrt();
         self.last = Some(LastFit {
             origin,
             t_scale,
@@ -790,6 +862,8 @@ impl Estimator for PaperMethod {
             out: a_out,
             inp: a_in,
             coef: c,
+            y_ref,
+            u_ref,
         });
         self.diagnostics = Some(PaperDiagnostics {
             output_qr: out_info,
@@ -824,12 +898,16 @@ impl Estimator for PaperMethod {
             });
         }
         check_range(signals, &horizon, "paper horizon")?;
+        if let Some(hold) = self.rest {
+            out.fill(hold);
+            return Ok(());
+        }
         let fit = self.last.ok_or(Error::InvalidModel {
             reason: "paper: predict called before a successful fit",
         })?;
         let time = signals.time(horizon.clone());
         for (o, &t) in out.iter_mut().zip(time) {
-            *o = Self::eval_output(&fit, t);
+            *o = fit.y_ref + Self::eval_output(&fit, t);
         }
         if self.config.prediction == PredictionMode::TransferFunction {
             let h = horizon.len();
@@ -839,7 +917,7 @@ impl Estimator for PaperMethod {
             }
             let cmd = signals.command(horizon.clone());
             for ((d, &u), &t) in self.du.iter_mut().zip(cmd).zip(time) {
-                *d = u - Self::eval_input(&fit, t);
+                *d = u - fit.u_ref - Self::eval_input(&fit, t);
             }
             let ok = tf_response(&fit.coef, signals.dt, &self.du[..h], &mut self.ysim[..h]).is_ok()
                 && out
@@ -1493,6 +1571,60 @@ mod tests {
         assert_eq!("simplex".parse::<Solver>().unwrap(), Solver::Simplex);
         assert_eq!("window".parse::<TimeOrigin>().unwrap(), TimeOrigin::Window);
         assert!("lsq".parse::<Solver>().is_err());
+    }
+
+    #[test]
+    fn rest_windows_hold_the_last_position_and_report_fallback() {
+        let n = 60;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * DT).collect();
+        let y = vec![0.25; n];
+        let u = vec![0.25; n];
+        let d = Data { t, u, y };
+        // motion starts after the data: every window is a rest window
+        let s = d.signals(f64::INFINITY);
+        let mut m = method(Solver::Qr, TimeOrigin::Motion);
+        let (c, f) = fit(&mut m, &s, 0..W);
+        assert_eq!(f.termination, Termination::Fallback);
+        assert!(c.iter().all(|&v| v == 0.0));
+        let mut pred = vec![0.0; H];
+        m.predict(&s, 0..W, W..W + H, &mut pred).unwrap();
+        assert!(pred.iter().all(|&v| v == 0.25));
+    }
+
+    #[test]
+    fn rest_position_offset_does_not_change_the_prediction() {
+        // The same motion measured from 0 and from a rest position of 0.1 m.
+        let span = (W - 1) as f64 * DT;
+        let (p, q) = balanced(span + 0.004);
+        let rest = 10;
+        let n = rest + W + H;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * DT).collect();
+        let t_m = t[rest - 1];
+        let shape = |tt: f64| if tt <= t_m { 0.0 } else { eval_p(&p, tt - t_m) };
+        let y0: Vec<f64> = t.iter().map(|&tt| shape(tt)).collect();
+        let y1: Vec<f64> = y0.iter().map(|v| v + 0.1).collect();
+        let u: Vec<f64> = t
+            .iter()
+            .map(|&tt| eval_q(&q, (tt - t_m).max(0.0)))
+            .collect();
+        let mut preds = Vec::new();
+        for y in [y0, y1] {
+            let d = Data {
+                t: t.clone(),
+                u: u.clone(),
+                y,
+            };
+            let s = d.signals(t_m);
+            let mut m = method(Solver::Qr, TimeOrigin::Motion);
+            let w = rest..rest + W;
+            fit(&mut m, &s, w.clone());
+            let mut pred = vec![0.0; H];
+            m.predict(&s, w, rest + W..n, &mut pred).unwrap();
+            preds.push(pred);
+        }
+        for (a, b) in preds[0].iter().zip(&preds[1]) {
+            assert!((b - a - 0.1).abs() < 1e-12, "{a} {b}");
+        }
     }
 
     #[test]

@@ -1,0 +1,589 @@
+//! End-to-end tests of the `feedid` binary: every subcommand as a user calls
+//! it, its outputs, and its behaviour on bad input (exit code 2, a one-line
+//! reason naming the place, no output file left behind).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn feedid(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_feedid"))
+        .args(args)
+        .output()
+        .expect("run feedid")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data")
+        .join(name)
+}
+
+fn emps() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!("skipped: EMPS data not found at {}", p.display());
+        None
+    }
+}
+
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    (header, rows)
+}
+
+fn column(header: &[String], rows: &[Vec<String>], name: &str) -> Vec<Option<f64>> {
+    let i = header.iter().position(|h| h == name).unwrap();
+    rows.iter().map(|r| r[i].parse().ok()).collect()
+}
+
+/// Assert a failed run: exit code 2, one line on stderr containing `needle`.
+fn assert_fails(o: &Output, needle: &str) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(2), "stderr: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(lines.len(), 1, "one error line expected: {err}");
+    assert!(err.contains(needle), "`{needle}` not in: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn model_prints_stiffness_coefficients_and_poles() {
+    let o = feedid(&["model"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = stdout(&o);
+    assert!(s.contains("3.0000e7 N/m"), "{s}");
+    assert!(s.contains("D7 = 1.680000e-8"), "{s}");
+    assert!(s.contains("561.0"), "{s}");
+    assert!(s.contains("71.4 µm at 50 mm/s"), "{s}");
+}
+
+#[test]
+fn model_json_has_the_documented_fields() {
+    let o = feedid(&["model", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((v["K"].as_f64().unwrap() / 3.0e7 - 1.0).abs() < 1e-9);
+    assert!((v["J"].as_f64().unwrap() / 1.6e-5 - 1.0).abs() < 1e-9);
+    let num = v["num"].as_array().unwrap();
+    let den = v["den"].as_array().unwrap();
+    assert_eq!(num.len(), 3);
+    assert_eq!(den.len(), 8);
+    assert!((den[0].as_f64().unwrap() / 1.68e-8 - 1.0).abs() < 1e-9);
+    let poles = v["poles"].as_array().unwrap();
+    assert_eq!(poles.len(), 7);
+    assert!(poles
+        .iter()
+        .all(|p| p.as_array().unwrap().len() == 2 && p[0].as_f64().unwrap() < 0.0));
+}
+
+#[test]
+fn model_with_printed_d1_shows_the_wrong_following_error() {
+    let o = feedid(&["model", "--d1", "paper", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let e = v["following_error_s"].as_f64().unwrap();
+    let want = 1.0 / 700.0 - 1.0 / 471.2 - 1.0 / 3428.6;
+    assert!((e - want).abs() < 1e-12, "{e}");
+}
+
+#[test]
+fn model_reads_a_parameter_file_and_rejects_bad_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("rig.toml");
+    std::fs::write(&good, "[control]\nkv = 350.0\n").unwrap();
+    let o = feedid(&["model", "--params", good.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((v["following_error_s"].as_f64().unwrap() - 1.0 / 350.0).abs() < 1e-12);
+
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[table]\nmass = -3.0\n").unwrap();
+    assert_fails(
+        &feedid(&["model", "--params", bad.to_str().unwrap()]),
+        "table.mass",
+    );
+    std::fs::write(&bad, "[control]\nkvv = 3.0\n").unwrap();
+    assert_fails(
+        &feedid(&["model", "--params", bad.to_str().unwrap()]),
+        "kvv",
+    );
+    assert_fails(
+        &feedid(&["model", "--params", "/nonexistent/rig.toml"]),
+        "/nonexistent/rig.toml",
+    );
+}
+
+#[test]
+fn model_saves_a_parameter_template_that_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("rig.toml");
+    let o = feedid(&["model", "--save-params", p.to_str().unwrap()]);
+    assert!(o.status.success());
+    let o = feedid(&["model", "--params", p.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((v["K"].as_f64().unwrap() / 3.0e7 - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn simulate_ramp_gives_a_30_mm_move_with_the_notes_following_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ramp.csv");
+    let o = feedid(&[
+        "simulate",
+        "--scenario",
+        "ramp",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (h, rows) = read_csv(&out);
+    assert_eq!(&h[..3], &["time_s", "command_m", "position_m"]);
+    assert_eq!(rows.len(), 4000);
+    let t = column(&h, &rows, "time_s");
+    let c = column(&h, &rows, "command_m");
+    let x = column(&h, &rows, "true_position_m");
+    let y = column(&h, &rows, "position_m");
+    assert!((t[1].unwrap() - 2e-4).abs() < 1e-15);
+    assert!((c.last().unwrap().unwrap() - 0.03).abs() < 1e-12);
+    assert!((y.last().unwrap().unwrap() - 0.03).abs() < 2e-6);
+    // steady following error during the constant-velocity phase: v/Kv = 71.4 µm
+    let errs: Vec<f64> = (0..rows.len())
+        .filter(|&k| (0.3..=0.55).contains(&t[k].unwrap()))
+        .map(|k| c[k].unwrap() - x[k].unwrap())
+        .collect();
+    let mean = errs.iter().sum::<f64>() / errs.len() as f64;
+    assert!((mean - 71.43e-6).abs() < 0.3e-6, "{mean}");
+}
+
+#[test]
+fn simulate_is_reproducible_per_seed_and_covers_every_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    for s in ["ramp", "step", "scurve", "chirp", "prbs", "multisine"] {
+        let a = dir.path().join(format!("{s}_a.csv"));
+        let b = dir.path().join(format!("{s}_b.csv"));
+        for p in [&a, &b] {
+            let o = feedid(&[
+                "simulate",
+                "--scenario",
+                s,
+                "--seed",
+                "7",
+                "--duration",
+                "0.3",
+                "-o",
+                p.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{s}: {}", stderr(&o));
+        }
+        assert_eq!(
+            std::fs::read(&a).unwrap(),
+            std::fs::read(&b).unwrap(),
+            "{s}"
+        );
+    }
+    assert_fails(
+        &feedid(&["simulate", "--scenario", "zigzag", "-o", "/tmp/never.csv"]),
+        "zigzag",
+    );
+    assert!(!Path::new("/tmp/never.csv").exists());
+}
+
+fn simulated(dir: &Path, scenario: &str) -> PathBuf {
+    let p = dir.join(format!("{scenario}.csv"));
+    let o = feedid(&[
+        "simulate",
+        "--scenario",
+        scenario,
+        "-o",
+        p.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    p
+}
+
+#[test]
+fn identify_writes_predictions_coefficients_and_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let pred = dir.path().join("pred.csv");
+    let coef = dir.path().join("coef.csv");
+    let summ = dir.path().join("summary.json");
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--method",
+        "paper",
+        "-o",
+        pred.to_str().unwrap(),
+        "--coefficients",
+        coef.to_str().unwrap(),
+        "--summary",
+        summ.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("prediction error"));
+
+    let (h, rows) = read_csv(&pred);
+    assert_eq!(
+        h,
+        [
+            "time_s",
+            "command_m",
+            "measured_m",
+            "predicted_m",
+            "simulated_m"
+        ]
+    );
+    assert_eq!(rows.len(), 4000);
+    let p = column(&h, &rows, "predicted_m");
+    assert!(
+        p[..20].iter().all(Option::is_none),
+        "first window not predicted"
+    );
+    assert!(p[20..].iter().all(Option::is_some));
+    assert!(column(&h, &rows, "simulated_m").iter().all(Option::is_some));
+
+    let (ch, crows) = read_csv(&coef);
+    assert_eq!(
+        ch[6..],
+        ["N2", "N1", "N0", "D7", "D6", "D5", "D4", "D3", "D2", "D1", "D0"]
+    );
+    assert_eq!(crows.len(), 398);
+
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summ).unwrap()).unwrap();
+    for key in [
+        "method",
+        "samples",
+        "windows",
+        "samples_predicted",
+        "rms_error_m",
+        "max_abs_error_m",
+        "fit_percent",
+        "sim_rms_error_m",
+        "sim_max_abs_error_m",
+        "identification_seconds",
+        "per_window_us",
+    ] {
+        assert!(!v[key].is_null(), "missing {key}");
+    }
+    assert_eq!(v["method"], "paper");
+    assert_eq!(v["samples"], 4000);
+    assert_eq!(v["windows"], 398);
+    assert_eq!(v["samples_predicted"], 3980);
+    // the rms over predicted samples recomputed from the CSV
+    let y = column(&h, &rows, "measured_m");
+    let se: f64 = (20..4000)
+        .map(|k| (y[k].unwrap() - p[k].unwrap()).powi(2))
+        .sum();
+    let rms = (se / 3980.0).sqrt();
+    assert!((rms / v["rms_error_m"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn identify_simplex_agrees_with_qr_on_the_ramp() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let mut preds = Vec::new();
+    for solver in ["qr", "simplex"] {
+        let out = dir.path().join(format!("{solver}.csv"));
+        let o = feedid(&[
+            "identify",
+            input.to_str().unwrap(),
+            "--solver",
+            solver,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (h, rows) = read_csv(&out);
+        preds.push(column(&h, &rows, "predicted_m"));
+    }
+    let worst = preds[0]
+        .iter()
+        .zip(&preds[1])
+        .filter_map(|(a, b)| Some((a.as_ref()? - b.as_ref()?).abs()))
+        .fold(0.0, f64::max);
+    // same least-squares problems; the simplex stops within its tolerances
+    assert!(worst < 1e-6 * 0.03, "{worst}");
+}
+
+#[test]
+fn identify_options_window_horizon_hop_time_origin_and_tf_prediction() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let summ = dir.path().join("s.json");
+    let out = dir.path().join("p.csv");
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--window",
+        "40",
+        "--horizon",
+        "5",
+        "--hop",
+        "3",
+        "--time-origin",
+        "window",
+        "--prediction",
+        "tf",
+        "-o",
+        out.to_str().unwrap(),
+        "--summary",
+        summ.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summ).unwrap()).unwrap();
+    assert_eq!(v["window"], 40);
+    assert_eq!(v["horizon"], 5);
+    assert_eq!(v["hop"], 3);
+    assert_eq!(v["windows"], (4000 - 40 + 2) / 3);
+}
+
+#[test]
+fn identify_picks_columns_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("renamed.csv");
+    let mut text = String::from("t,x_set,x_meas\n");
+    for k in 0..200 {
+        let t = k as f64 * 2e-4;
+        text.push_str(&format!("{t},{},{}\n", 0.05 * t, 0.05 * t));
+    }
+    std::fs::write(&input, text).unwrap();
+    let out = dir.path().join("p.csv");
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--time",
+        "t",
+        "--command",
+        "x_set",
+        "--position",
+        "x_meas",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+}
+
+#[test]
+fn reproduce_writes_the_four_figures_and_the_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = feedid(&["reproduce", "--out", dir.path().to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in [
+        "ramp_response.svg",
+        "ramp_error.svg",
+        "step_response.svg",
+        "step_error.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.path().join(f)).unwrap();
+        assert!(
+            svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{f}"
+        );
+        assert!(svg.contains("[µm]") && svg.contains("[ms]"), "{f}");
+        assert!(!svg.contains("NaN"), "{f}");
+    }
+    let md = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+    assert!(md.contains("| ramp | paper LSM, QR |"));
+    assert!(md.contains("| step | simulation model |"));
+    assert!(stdout(&o).contains("| ramp | paper LSM, simplex |"));
+}
+
+#[test]
+fn info_summarises_a_recording() {
+    let o = feedid(&["info", data("comma_header.csv").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = stdout(&o);
+    assert!(s.contains("samples"), "{s}");
+    assert!(s.contains("motion segments"), "{s}");
+    let o = feedid(&["info", data("comma_header.csv").to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["samples"].as_u64().unwrap() > 0);
+}
+
+#[test]
+fn bad_inputs_end_with_exit_2_a_one_line_reason_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pred.csv");
+    let o = out.to_str().unwrap();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec![data("empty.csv").display().to_string()], "empty.csv"),
+        (
+            vec![data("header_only.csv").display().to_string()],
+            "header_only.csv",
+        ),
+        (vec![data("text_cell.csv").display().to_string()], "line"),
+        (vec![data("nan.csv").display().to_string()], "NaN"),
+        (
+            vec![data("decreasing_time.csv").display().to_string()],
+            "not strictly increasing",
+        ),
+        (
+            vec![data("decimal_comma.csv").display().to_string()],
+            "decimal comma",
+        ),
+        (
+            vec![
+                data("truncated.mat").display().to_string(),
+                "--time".into(),
+                "t".into(),
+                "--command".into(),
+                "u".into(),
+                "--position".into(),
+                "y".into(),
+            ],
+            "truncated.mat",
+        ),
+        (
+            vec!["/nonexistent/file.csv".into()],
+            "/nonexistent/file.csv",
+        ),
+        (
+            vec![
+                data("comma_header.csv").display().to_string(),
+                "--position".into(),
+                "nope".into(),
+            ],
+            "nope",
+        ),
+        (
+            vec![
+                data("comma_header.csv").display().to_string(),
+                "--window".into(),
+                "100000".into(),
+            ],
+            "too few samples",
+        ),
+        (
+            vec![
+                data("comma_header.csv").display().to_string(),
+                "--method".into(),
+                "magic".into(),
+            ],
+            "magic",
+        ),
+    ];
+    for (args, needle) in cases {
+        let mut full = vec!["identify".to_string()];
+        full.extend(args.iter().cloned());
+        full.extend(["-o".to_string(), o.to_string()]);
+        let refs: Vec<&str> = full.iter().map(String::as_str).collect();
+        let r = feedid(&refs);
+        assert_fails(&r, needle);
+        assert!(!out.exists(), "output left behind for {args:?}");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "{args:?}"
+        );
+    }
+}
+
+#[test]
+fn unwritable_output_path_is_reported_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = data("comma_header.csv");
+    let r = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--window",
+        "8",
+        "--horizon",
+        "2",
+        "-o",
+        "/nonexistent-dir/pred.csv",
+    ]);
+    assert_fails(&r, "/nonexistent-dir/pred.csv");
+    // a failing second output removes the first
+    let pred = dir.path().join("pred.csv");
+    let r = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--window",
+        "8",
+        "--horizon",
+        "2",
+        "-o",
+        pred.to_str().unwrap(),
+        "--summary",
+        "/nonexistent-dir/s.json",
+    ]);
+    assert_fails(&r, "/nonexistent-dir/s.json");
+    assert!(!pred.exists());
+}
+
+#[test]
+fn emps_info_and_identify_work_as_a_new_user_calls_them() {
+    let Some(path) = emps() else { return };
+    let p = path.to_str().unwrap();
+    let o = feedid(&[
+        "info",
+        p,
+        "--time",
+        "t",
+        "--command",
+        "qg",
+        "--position",
+        "qm",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("24841"));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.csv");
+    let summ = dir.path().join("s.json");
+    let o = feedid(&[
+        "identify",
+        p,
+        "--time",
+        "t",
+        "--command",
+        "qg",
+        "--position",
+        "qm",
+        "--method",
+        "paper",
+        "-o",
+        out.to_str().unwrap(),
+        "--summary",
+        summ.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summ).unwrap()).unwrap();
+    assert_eq!(v["samples"], 24841);
+    let rms = v["rms_error_m"].as_f64().unwrap();
+    assert!(rms.is_finite() && rms > 0.0 && rms < 0.01, "{rms}");
+    assert_fails(
+        &feedid(&[
+            "identify",
+            p,
+            "--time",
+            "t",
+            "--command",
+            "qg",
+            "--position",
+            "qx",
+            "-o",
+            out.to_str().unwrap(),
+        ]),
+        "qx",
+    );
+}

@@ -4,11 +4,13 @@
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
 //! shifts by a hop.
 
+mod arx;
 pub mod engine;
 mod estimator;
 mod model;
 mod paper;
 
+pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
 pub use model::LinearModel;

@@ -87,7 +87,7 @@
 //!     y[k] = 0.6 * y[k - 1] + 0.4 * u[k - 1];
 //! }
 //! let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
-//! let mut arx = ArxConfig { orders: ArxOrders::new(1, 1, 1), ..ArxConfig::default() }
+//! let mut arx = ArxConfig { orders: ArxOrders::new(1, 1, 1), ridge: 0.0, ..ArxConfig::default() }
 //!     .build()
 //!     .unwrap();
 //! let cfg = EngineConfig { window: 50, horizon: 10, hop: Some(1), warm_up: 0 };

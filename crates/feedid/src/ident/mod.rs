@@ -9,6 +9,7 @@ pub mod engine;
 mod estimator;
 mod model;
 mod paper;
+mod residuals;
 mod rls;
 
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
@@ -19,4 +20,5 @@ pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
     PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,
 };
+pub use residuals::{ResidualAnalysis, Z_99};
 pub use rls::{RlsConfig, RlsEstimator};

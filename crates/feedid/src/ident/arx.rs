@@ -1048,7 +1048,7 @@ pub fn fit_arx(
     orders: ArxOrders,
     cfg: &ArxConfig,
 ) -> Result<ArxFit> {
-    fit_arx_rows(u, y, dt, orders, cfg, orders.lag(), y.len())
+    fit_arx_rows(u, y, dt, orders, cfg, orders.lag(), y.len(), true)
 }
 
 /// Batch ARX fit over the rows `first_row .. end` (`first_row ≥ lag`).
@@ -1060,6 +1060,7 @@ pub(crate) fn fit_arx_rows(
     cfg: &ArxConfig,
     first_row: usize,
     end: usize,
+    with_std_errors: bool,
 ) -> Result<ArxFit> {
     orders.validate()?;
     if u.len() != y.len() {
@@ -1139,7 +1140,11 @@ pub(crate) fn fit_arx_rows(
     }
     let sse: f64 = residuals.iter().map(|e| e * e).sum();
     let loss = sse / m as f64;
-    let std_errors = standard_errors(&a_copy, m, np, &scale, sse / (m - np) as f64);
+    let std_errors = if with_std_errors {
+        standard_errors(&a_copy, m, np, &scale, sse / (m - np) as f64)
+    } else {
+        vec![f64::NAN; np]
+    };
     let model = orders.model(&theta[..orders.n_params()], dt)?;
     Ok(ArxFit {
         orders,

@@ -8,6 +8,7 @@ mod arx;
 pub mod engine;
 mod estimator;
 mod model;
+mod order;
 mod paper;
 mod residuals;
 mod rls;
@@ -16,6 +17,10 @@ pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrder
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
 pub use model::LinearModel;
+pub use order::{
+    frols, order_table, select_order, Criterion, FrolsConfig, FrolsResult, FrolsTerm, OrderRow,
+    OrderSearch, OrderSelection, OrderTable, TermKind,
+};
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
     PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,

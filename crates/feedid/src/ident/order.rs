@@ -55,11 +55,13 @@
 //!
 //! ```
 //! use feedid::ident::{select_order, OrderSearch};
+//! use rand::{Rng, SeedableRng};
+//! let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
 //! let n = 2000;
-//! let u: Vec<f64> = (0..n).map(|k| ((k * 7919 % 1009) as f64 / 1009.0) - 0.5).collect();
+//! let u: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
 //! let mut y = vec![0.0; n];
 //! for k in 2..n {
-//!     let e = 1e-3 * (((k * 104729) % 997) as f64 / 997.0 - 0.5);
+//!     let e = 1e-2 * rng.random_range(-1.0..1.0);
 //!     y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] + 0.5 * u[k - 1] + e;
 //! }
 //! let sel = select_order(&u, &y, 1e-3, &OrderSearch::default()).unwrap();

@@ -205,6 +205,11 @@ impl ArxOrders {
 }
 
 /// Configuration of the windowed ARX estimator (defaults tuned on the virtual rig).
+///
+/// With these defaults and engine windows of W = 200 samples (40 ms at
+/// 5 kHz), H = 10, hop = H, the 2 ms-ahead rms error on the virtual rig is
+/// 0.23 … 0.48 µm on the ramp, S-curve, chirp, PRBS and multisine, and about
+/// 4 µm on the saturating paper step (`tests/arx_rls_targets.rs`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArxConfig {
     /// Model orders; default `na = 8, nb = 8, nk = 1`.

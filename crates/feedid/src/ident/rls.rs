@@ -81,7 +81,12 @@ use crate::ident::arx::{check_window, predict_k_step, regressor};
 use crate::ident::{ArxOrders, Estimator, Signals, WindowFit};
 use crate::solve::Termination;
 
-/// Configuration of the RLS estimator (defaults tuned on the virtual rig).
+/// Configuration of the RLS estimator (defaults tuned on the virtual rig and EMPS).
+///
+/// With these defaults the 2 ms-ahead rms error is 0.61 µm on EMPS (1 kHz,
+/// H = 10) and 0.35 … 0.80 µm on the rig's ramp, S-curve, chirp, PRBS and
+/// multisine; λ between 0.99 and 0.9995 changes it by a few percent
+/// (`tests/arx_rls_targets.rs`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RlsConfig {
     /// Model orders; default `na = 8, nb = 8, nk = 1`.

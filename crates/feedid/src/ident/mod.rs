@@ -4,17 +4,28 @@
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
 //! shifts by a hop.
 
+mod arx;
 pub mod engine;
 mod estimator;
 mod identify;
 mod model;
+mod order;
 mod paper;
+mod residuals;
+mod rls;
 
+pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
 pub use identify::{identify, Identification, IdentifySummary};
 pub use model::LinearModel;
+pub use order::{
+    frols, order_table, select_order, Criterion, FrolsConfig, FrolsResult, FrolsTerm, OrderRow,
+    OrderSearch, OrderSelection, OrderTable, TermKind,
+};
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
     PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,
 };
+pub use residuals::{ResidualAnalysis, Z_99};
+pub use rls::{RlsConfig, RlsEstimator};

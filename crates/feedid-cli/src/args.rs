@@ -137,7 +137,7 @@ pub struct SimulateArgs {
 /// Method options shared by identify and stream.
 #[derive(Debug, Clone, Args)]
 pub struct MethodArgs {
-    /// Identification method.
+    /// Identification method: paper, arx, rls.
     #[arg(long, default_value = "paper", value_name = "NAME")]
     pub method: String,
     /// Solver of the paper method: qr (exact least squares) or simplex (Nelder–Mead, as in the paper).
@@ -149,14 +149,20 @@ pub struct MethodArgs {
     /// Prediction of the paper method: polynomial (fitted output continued) or tf (identified Tf on the next command).
     #[arg(long, default_value = "polynomial", value_name = "NAME")]
     pub prediction: String,
+    /// ARX/RLS orders `na,nb,nk` (poles, input terms, input delay in samples) [default: 8,8,1].
+    #[arg(long, value_name = "NA,NB,NK")]
+    pub order: Option<String>,
+    /// RLS forgetting factor λ (memory ≈ 1/(1−λ) samples) [default: 0.999].
+    #[arg(long, value_name = "LAMBDA")]
+    pub lambda: Option<f64>,
 }
 
 /// Sliding-window options.
 #[derive(Debug, Clone, Args)]
 pub struct WindowArgs {
-    /// Window length W [samples].
-    #[arg(long, default_value_t = 20)]
-    pub window: usize,
+    /// Window length W [samples]; default: paper 20, arx 200, rls 100.
+    #[arg(long)]
+    pub window: Option<usize>,
     /// Prediction horizon H [samples].
     #[arg(long, default_value_t = 10)]
     pub horizon: usize,

@@ -1,32 +1,53 @@
 //! `feedid identify`: sliding-window identification and prediction of a recording.
 
 use anyhow::Result;
-use feedid::ident::{identify, EngineConfig, Estimator, PaperConfig};
+use feedid::ident::{identify, ArxOrders, EngineConfig, MethodSpec, PaperConfig};
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
 
 use crate::args::{IdentifyArgs, MethodArgs, WindowArgs};
 use crate::cmd::{load_params, recording, Outputs};
 
-/// The estimator named on the command line.
-pub fn build_estimator(m: &MethodArgs) -> Result<Box<dyn Estimator>> {
-    match m.method.as_str() {
-        "paper" => Ok(Box::new(
-            PaperConfig {
-                solver: m.solver.parse()?,
-                time_origin: m.time_origin.parse()?,
-                prediction: m.prediction.parse()?,
-                ..PaperConfig::default()
-            }
-            .build()?,
-        )),
-        other => anyhow::bail!("invalid method `{other}`; expected one of: paper"),
+/// The method named on the command line with its options.
+pub fn method_spec(m: &MethodArgs) -> Result<MethodSpec> {
+    let mut spec = MethodSpec::new(m.method.parse()?);
+    spec.paper = PaperConfig {
+        solver: m.solver.parse()?,
+        time_origin: m.time_origin.parse()?,
+        prediction: m.prediction.parse()?,
+        ..spec.paper
+    };
+    if let Some(o) = &m.order {
+        let orders = parse_orders(o)?;
+        spec.arx.orders = orders;
+        spec.rls.orders = orders;
     }
+    if let Some(l) = m.lambda {
+        spec.rls.lambda = l;
+    }
+    Ok(spec)
 }
 
-/// Engine settings from the command line.
-pub fn engine_config(w: &WindowArgs) -> EngineConfig {
+/// `na,nb,nk` → orders.
+fn parse_orders(s: &str) -> Result<ArxOrders> {
+    let v: Vec<&str> = s.split(',').map(str::trim).collect();
+    let parse = |x: &str| -> Result<usize> {
+        x.parse()
+            .map_err(|_| anyhow::anyhow!("invalid order `{s}`: expected na,nb,nk (e.g. 8,8,1)"))
+    };
+    if v.len() != 3 {
+        anyhow::bail!("invalid order `{s}`: expected na,nb,nk (e.g. 8,8,1)");
+    }
+    Ok(ArxOrders {
+        na: parse(v[0])?,
+        nb: parse(v[1])?,
+        nk: parse(v[2])?,
+    })
+}
+
+/// Engine settings from the command line (window defaulting to the method's).
+pub fn engine_config(w: &WindowArgs, spec: &MethodSpec) -> EngineConfig {
     EngineConfig {
-        window: w.window,
+        window: w.window.unwrap_or_else(|| spec.default_window()),
         horizon: w.horizon,
         hop: w.hop,
         warm_up: 0,
@@ -35,8 +56,9 @@ pub fn engine_config(w: &WindowArgs) -> EngineConfig {
 
 /// Identify, write the outputs, print a short summary.
 pub fn run(a: &IdentifyArgs) -> Result<()> {
-    let mut est = build_estimator(&a.method)?;
-    let cfg = engine_config(&a.windows);
+    let spec = method_spec(&a.method)?;
+    let mut est = spec.build()?;
+    let cfg = engine_config(&a.windows, &spec);
     let params = load_params(a.params.as_deref())?;
     let rec = recording::load(&a.input, &a.recording)?;
     let run = identify(&rec, est.as_mut(), &cfg, Some(&params))?;
@@ -80,7 +102,7 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
         summary.samples_predicted
     );
     println!(
-        "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.2} %",
+        "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %",
         1e6 * summary.rms_error_m,
         1e6 * summary.max_abs_error_m,
         summary.fit_percent

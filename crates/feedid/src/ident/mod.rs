@@ -8,6 +8,7 @@ mod arx;
 pub mod engine;
 mod estimator;
 mod identify;
+mod method;
 mod model;
 mod order;
 mod paper;
@@ -18,6 +19,7 @@ pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrder
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
 pub use identify::{identify, Identification, IdentifySummary};
+pub use method::{MethodKind, MethodSpec, METHOD_NAMES};
 pub use model::LinearModel;
 pub use order::{
     frols, order_table, select_order, Criterion, FrolsConfig, FrolsResult, FrolsTerm, OrderRow,

@@ -20,6 +20,8 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// Identify over sliding windows and predict the next samples.
     Identify(Box<IdentifyArgs>),
+    /// Select ARX orders: FPE, AIC, AICc, BIC over a grid, and FROLS term selection.
+    Order(Box<OrderArgs>),
     /// Run the paper's experiments (ramp and step) end to end on the virtual rig.
     Reproduce(ReproduceArgs),
     /// Summarise a recording: samples, rate and jitter, channel ranges, motion segments.
@@ -214,4 +216,32 @@ pub struct ReproduceArgs {
     /// Solver of the paper method: qr or simplex.
     #[arg(long, default_value = "simplex", value_name = "NAME")]
     pub solver: String,
+}
+
+/// `feedid order`.
+#[derive(Debug, Args)]
+pub struct OrderArgs {
+    /// Recording: CSV/text or MATLAB v5 .mat file.
+    pub input: PathBuf,
+    /// How to read it.
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// Range of na (poles), `lo..hi` or `n`.
+    #[arg(long, default_value = "1..8", value_name = "LO..HI")]
+    pub na: String,
+    /// Range of nb (input terms).
+    #[arg(long, default_value = "1..8", value_name = "LO..HI")]
+    pub nb: String,
+    /// Range of nk (input delay in samples).
+    #[arg(long, default_value = "0..2", value_name = "LO..HI")]
+    pub nk: String,
+    /// Criterion of the choice: fpe, aic, aicc, bic.
+    #[arg(long, default_value = "bic", value_name = "NAME")]
+    pub criterion: String,
+    /// Fraction of the samples at the end held out for validation.
+    #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
+    pub validation: f64,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -3,6 +3,7 @@
 mod identify;
 mod info;
 mod model;
+mod order;
 mod recording;
 mod reproduce;
 mod simulate;
@@ -17,6 +18,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Identify(a) => identify::run(&a),
         Command::Info(a) => info::run(&a),
         Command::Model(a) => model::run(&a),
+        Command::Order(a) => order::run(&a),
         Command::Reproduce(a) => reproduce::run(&a),
         Command::Simulate(a) => simulate::run(&a),
     }

@@ -952,44 +952,62 @@ impl Estimator for ArxEstimator {
                 context: "arx prediction (no model)",
             });
         }
-        if horizon.start != window.end || out.len() != horizon.len() || window.is_empty() {
-            return Err(Error::LengthMismatch {
-                what: "ARX horizon",
-                expected: horizon.len(),
-                actual: out.len(),
-            });
-        }
-        let lag = orders.lag();
-        check_window(signals, &(window.end..horizon.end), lag.max(1))?;
-        let base = window.end - lag.max(1);
-        let y = signals.position(base..window.end);
-        let u = signals.command(base..horizon.end);
-        let need = orders.na + out.len();
-        if self.past.len() < need {
-            self.past.resize(need, 0.0);
-        }
-        let e = window.end - base;
-        let reference = y[e - 1];
-        predict_k_step(
+        let offset = self.theta[orders.n_params()];
+        predict_horizon(
             &orders,
             &self.theta,
-            y,
-            u,
-            e,
-            reference,
-            self.theta[orders.n_params()],
+            offset,
+            signals,
+            window,
+            horizon,
             &mut self.past,
             out,
-        );
-        if out.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err(Error::NonFinite {
-                channel: "arx prediction".to_string(),
-                index: horizon.start,
-                value: f64::NAN,
-            })
-        }
+            "ARX",
+        )
+    }
+}
+
+/// k-step-ahead prediction of an ARX model over `horizon` (which starts at
+/// `window.end`): the past from the measurements, the future command known,
+/// predicted outputs fed back. Shared by [`ArxEstimator`] and the RLS estimator.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn predict_horizon(
+    orders: &ArxOrders,
+    theta: &[f64],
+    offset: f64,
+    signals: &Signals<'_>,
+    window: Range<usize>,
+    horizon: Range<usize>,
+    past: &mut Vec<f64>,
+    out: &mut [f64],
+    what: &'static str,
+) -> Result<()> {
+    if horizon.start != window.end || out.len() != horizon.len() || window.is_empty() {
+        return Err(Error::LengthMismatch {
+            what: "ARX/RLS horizon",
+            expected: horizon.len(),
+            actual: out.len(),
+        });
+    }
+    let lag = orders.lag().max(1);
+    check_window(signals, &(window.end..horizon.end), lag)?;
+    let base = window.end - lag;
+    let y = signals.position(base..window.end);
+    let u = signals.command(base..horizon.end);
+    let need = orders.na + out.len();
+    if past.len() < need {
+        past.resize(need, 0.0);
+    }
+    let e = window.end - base;
+    let reference = y[e - 1];
+    predict_k_step(orders, theta, y, u, e, reference, offset, past, out);
+    match out.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::NonFinite {
+            channel: format!("{what} prediction"),
+            index: horizon.start + i,
+            value: out[i],
+        }),
     }
 }
 

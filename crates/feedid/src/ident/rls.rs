@@ -77,7 +77,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::arx::{check_window, predict_k_step, regressor};
+use crate::ident::arx::{check_window, predict_horizon, regressor};
 use crate::ident::{ArxOrders, Estimator, Signals, WindowFit};
 use crate::solve::Termination;
 
@@ -486,44 +486,17 @@ impl Estimator for RlsEstimator {
                 context: "rls prediction (no model)",
             });
         }
-        if horizon.start != window.end || out.len() != horizon.len() {
-            return Err(Error::LengthMismatch {
-                what: "RLS horizon",
-                expected: horizon.len(),
-                actual: out.len(),
-            });
-        }
-        let lag = orders.lag().max(1);
-        check_window(signals, &(window.end..horizon.end), lag)?;
-        let base = window.end - lag;
-        let y = signals.position(base..window.end);
-        let u = signals.command(base..horizon.end);
-        let need = orders.na + out.len();
-        if self.past.len() < need {
-            self.past.resize(need, 0.0);
-        }
-        let e = window.end - base;
-        let reference = y[e - 1];
-        predict_k_step(
+        predict_horizon(
             &orders,
             &self.theta,
-            y,
-            u,
-            e,
-            reference,
             0.0,
+            signals,
+            window,
+            horizon,
             &mut self.past,
             out,
-        );
-        if out.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err(Error::NonFinite {
-                channel: "rls prediction".to_string(),
-                index: horizon.start,
-                value: f64::NAN,
-            })
-        }
+            "RLS",
+        )
     }
 }
 

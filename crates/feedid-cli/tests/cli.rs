@@ -2,39 +2,11 @@
 //! it, its outputs, and its behaviour on bad input (exit code 2, a one-line
 //! reason naming the place, no output file left behind).
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn feedid(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_feedid"))
-        .args(args)
-        .output()
-        .expect("run feedid")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data")
-        .join(name)
-}
-
-fn emps() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("skipped: EMPS data not found at {}", p.display());
-        None
-    }
-}
+use common::{data, emps, feedid, stderr, stdout};
 
 fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let text = std::fs::read_to_string(path).unwrap();
@@ -51,14 +23,8 @@ fn column(header: &[String], rows: &[Vec<String>], name: &str) -> Vec<Option<f64
     rows.iter().map(|r| r[i].parse().ok()).collect()
 }
 
-/// Assert a failed run: exit code 2, one line on stderr containing `needle`.
-fn assert_fails(o: &Output, needle: &str) {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(2), "stderr: {err}");
-    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
-    assert_eq!(lines.len(), 1, "one error line expected: {err}");
-    assert!(err.contains(needle), "`{needle}` not in: {err}");
-    assert!(!err.contains("panicked"), "{err}");
+fn assert_fails(o: &std::process::Output, needle: &str) {
+    common::assert_fails(o, &[needle]);
 }
 
 #[test]

@@ -3,26 +3,12 @@
 //! `tests/data/make_fixtures.py`), and real data: the EMPS benchmark with
 //! every method.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn feedid(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_feedid"))
-        .args(args)
-        .output()
-        .expect("run feedid")
-}
+use common::{assert_fails, emps, feedid, stderr};
 
 fn data(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../tests/data")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+    common::data(name).display().to_string()
 }
 
 /// `feedid info --json` on a fixture with extra arguments.
@@ -61,15 +47,6 @@ fn assert_reference(v: &serde_json::Value, what: &str) {
         (channel_max(v, "position") - 0.0028).abs() < 1e-9,
         "{what}: {v}"
     );
-}
-
-fn assert_fails(o: &Output, needles: &[&str]) {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert_eq!(err.lines().count(), 1, "one line expected: {err}");
-    for n in needles {
-        assert!(err.contains(n), "`{n}` not in: {err}");
-    }
 }
 
 #[test]
@@ -259,12 +236,7 @@ fn every_reader_error_names_the_place_and_exits_2() {
 
 #[test]
 fn emps_identifies_with_every_method() {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
-    if !p.exists() {
-        eprintln!("skipped: EMPS data not found at {}", p.display());
-        return;
-    }
-    let file: PathBuf = p;
+    let Some(file) = emps() else { return };
     let dir = tempfile::tempdir().unwrap();
     for method in ["paper", "arx", "rls"] {
         let out = dir.path().join(format!("{method}.csv"));

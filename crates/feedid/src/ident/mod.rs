@@ -6,12 +6,16 @@
 
 pub mod engine;
 mod estimator;
+mod companion;
 mod model;
+mod oe;
 mod paper;
+mod srivc;
 
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
 pub use model::LinearModel;
+pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit};
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
     PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,

@@ -919,12 +919,271 @@ mod tests {
     }
 
     #[test]
-    fn scratch() {
-        let tf = three_pole_one_zero();
-        let u = binary_input(4000, 25, 50, 1e-4, 7);
+    fn second_order_system_is_recovered_to_1e_8_from_noise_free_data() {
+        let tf = second_order();
+        let u = binary_input(3000, 30, 50, 1e-4, 1);
         let y = simulate(&tf, &u, DT);
-        let fit = fit_oe(&u, &y, DT, &OeConfig { poles: 3, zeros: 1, ..OeConfig::default() }).unwrap();
-        eprintln!("{:?}\n{:?}\n{:?}", fit.num, fit.den, fit.report);
-        eprintln!("{:?} {:?}", tf.num(), tf.den());
+        let cfg = OeConfig {
+            poles: 2,
+            zeros: 0,
+            ..OeConfig::default()
+        };
+        let fit = fit_oe(&u, &y, DT, &cfg).unwrap();
+        assert!(max_rel(&fit.den, tf.den()) < 1e-8, "{:?}", fit.den);
+        assert!(max_rel(&fit.num, tf.num()) < 1e-8, "{:?}", fit.num);
+        assert!(fit.fit_percent > 99.9999);
+        assert_eq!(fit.report.termination, Termination::Converged);
+        assert!(fit.srivc_iterations > 0);
+        // the time scale is the natural frequency (α₀ = 1)
+        assert!((fit.time_scale / (2.0 * PI * 50.0) - 1.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn three_pole_one_zero_system_is_recovered_to_1e_8_from_multisine() {
+        let tf = three_pole_one_zero();
+        let u = Scenario::Multisine.command(5000.0, 0.6, 0).unwrap();
+        let y = simulate(&tf, &u, DT);
+        let fit = fit_oe(&u, &y, DT, &OeConfig::default()).unwrap();
+        assert!(max_rel(&fit.den, tf.den()) < 1e-8, "{:?}", fit.den);
+        assert!(max_rel(&fit.num, tf.num()) < 1e-8, "{:?}", fit.num);
+        // and the model simulates the data
+        let sim = fit.simulate(&u, DT).unwrap();
+        let scale = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        assert!(sim.iter().zip(&y).all(|(a, b)| (a - b).abs() < 1e-9 * scale));
+    }
+
+    #[test]
+    fn noisy_estimates_lie_within_four_standard_errors() {
+        let tf = three_pole_one_zero();
+        let u = binary_input(5000, 25, 50, 1e-4, 11);
+        let y0 = simulate(&tf, &u, DT);
+        let noise = Normal::new(0.0, 2e-7).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let y: Vec<f64> = y0.iter().map(|v| v + noise.sample(&mut rng)).collect();
+        let fit = fit_oe(&u, &y, DT, &OeConfig::default()).unwrap();
+        for (k, (est, truth)) in fit.den.iter().zip(tf.den()).enumerate().skip(1) {
+            let se = fit.den_std[k];
+            assert!(se > 0.0 && se < 0.05 * truth.abs(), "den {k}: se {se}");
+            assert!((est - truth).abs() < 4.0 * se, "den {k}: {est} vs {truth} ± {se}");
+        }
+        for (k, (est, truth)) in fit.num.iter().zip(tf.num()).enumerate() {
+            let se = fit.num_std[k];
+            assert!((est - truth).abs() < 4.0 * se, "num {k}: {est} vs {truth} ± {se}");
+        }
+        // residual rms is the noise level
+        assert!((fit.residual_rms / 2e-7 - 1.0).abs() < 0.05, "{}", fit.residual_rms);
+    }
+
+    #[test]
+    fn nominal_feed_drive_model_is_recovered_from_a_perturbed_start() {
+        let params = RigParams::default();
+        let c = closed_loop_coefficients(&params, D1Variant::Corrected);
+        let truth = c.transfer_function().unwrap().normalized();
+        let u = binary_input(5000, 8, 50, 3e-5, 3);
+        let y = simulate_nominal(&params, &u, DT).unwrap();
+        // perturb every pole magnitude and the gain by a few per cent
+        let poles = truth.poles().unwrap();
+        let perturbed: Vec<Complex<f64>> = poles
+            .iter()
+            .enumerate()
+            .map(|(k, p)| p * (1.0 + 0.03 * if k % 2 == 0 { 1.0 } else { -1.0 }))
+            .collect();
+        let den0 = crate::lti::poly_from_roots(&perturbed);
+        let num0: Vec<f64> = truth.num().iter().map(|v| v * 0.97).collect();
+        let cfg = OeConfig {
+            poles: 7,
+            zeros: 2,
+            initial: Some(TransferFunction::new(num0, den0).unwrap()),
+            ..OeConfig::default()
+        };
+        let fit = fit_oe(&u, &y, DT, &cfg).unwrap();
+        let mut got = fit.poles().unwrap();
+        let mut want = poles.clone();
+        let key = |p: &Complex<f64>| (p.norm(), p.im);
+        got.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+        want.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+        let worst = got
+            .iter()
+            .zip(&want)
+            .map(|(a, b)| (a - b).norm() / b.norm())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "7/2: worst pole error {worst:e}, N {:e}, D {:e}, {:?}",
+            max_rel(&fit.num, truth.num()),
+            max_rel(&fit.den, truth.den()),
+            fit.report
+        );
+        assert!(worst < 1e-6, "{worst:e}");
+        assert!(max_rel(&fit.num, truth.num()) < 1e-5);
+        assert!(max_rel(&fit.den, truth.den()) < 1e-5);
+    }
+
+    #[test]
+    fn unstable_initial_model_is_reflected_and_the_fit_is_stable() {
+        let tf = second_order();
+        let u = binary_input(2000, 30, 50, 1e-4, 2);
+        let y = simulate(&tf, &u, DT);
+        let wn = 2.0 * PI * 40.0;
+        let cfg = OeConfig {
+            poles: 2,
+            zeros: 0,
+            initial: Some(TransferFunction::new(vec![wn * wn], vec![1.0, -0.5 * wn, wn * wn]).unwrap()),
+            ..OeConfig::default()
+        };
+        let fit = fit_oe(&u, &y, DT, &cfg).unwrap();
+        assert!(fit.model.is_stable().unwrap());
+        assert!(max_rel(&fit.den, tf.den()) < 1e-8, "{:?}", fit.den);
+    }
+
+    #[test]
+    fn sliding_windows_on_exact_data_predict_exactly_and_report_the_model() {
+        let tf = three_pole_one_zero();
+        let u = binary_input(1500, 25, 0, 1e-4, 9);
+        let y = simulate(&tf, &u, DT);
+        let t: Vec<f64> = (0..u.len()).map(|k| k as f64 * DT).collect();
+        let mut oe = OeConfig::default().build().unwrap();
+        assert_eq!(oe.coefficient_names(), ["N1", "N0", "D3", "D2", "D1", "D0"]);
+        let ecfg = EngineConfig {
+            window: 150,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        };
+        let res = run(&mut oe, &Signals::new(&t, &u, &y, DT, 0.0), &ecfg).unwrap();
+        assert_eq!(res.failed_windows(), 0);
+        let scale = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        assert!(res.stats.max_abs < 1e-8 * scale, "{:e}", res.stats.max_abs);
+        let last = res.window_coefficients(res.windows.len() - 1);
+        assert!(max_rel(&last[..2], tf.num()) < 1e-6, "{last:?}");
+        assert!(max_rel(&last[2..], tf.den()) < 1e-6, "{last:?}");
+    }
+
+    #[test]
+    fn sliding_oe_on_the_virtual_rig_gives_finite_accurate_predictions() {
+        let rate = 5000.0;
+        let cmd = Scenario::Scurve.command(rate, 0.25, 0).unwrap();
+        let out = crate::drive::VirtualRig::new(RigParams::default())
+            .with_seed(1)
+            .simulate(&cmd, rate)
+            .unwrap();
+        let s = Signals::new(&out.time, &out.command, &out.position, 1.0 / rate, 0.0);
+        let mut oe = OeConfig::default().build().unwrap();
+        let ecfg = EngineConfig {
+            window: 200,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        };
+        let res = run(&mut oe, &s, &ecfg).unwrap();
+        assert_eq!(res.failed_windows(), 0);
+        assert!(res.predicted.iter().all(|v| v.is_finite()));
+        assert!(res.coefficients.iter().all(|v| v.is_finite()));
+        // the measurement noise is 0.2 µm: predictions are within a few µm
+        assert!(res.stats.rms < 2e-6, "{}", res.stats.rms);
+        assert!(oe.model().unwrap().is_stable().unwrap());
+    }
+
+    #[test]
+    fn buffers_are_not_regrown_for_windows_of_the_same_size() {
+        let tf = second_order();
+        let u = binary_input(600, 20, 0, 1e-4, 4);
+        let y = simulate(&tf, &u, DT);
+        let t: Vec<f64> = (0..u.len()).map(|k| k as f64 * DT).collect();
+        let s = Signals::new(&t, &u, &y, DT, 0.0);
+        let mut oe = OeConfig {
+            poles: 2,
+            zeros: 0,
+            ..OeConfig::default()
+        }
+        .build()
+        .unwrap();
+        let mut c = [0.0; 4];
+        oe.fit(&s, 0..100, &mut c).unwrap();
+        let ptrs = (oe.work.obs.as_ptr(), oe.work.forced.as_ptr(), oe.resid.as_ptr());
+        for start in (10..400).step_by(37) {
+            oe.fit(&s, start..start + 100, &mut c).unwrap();
+            let mut out = [0.0; 10];
+            oe.predict(&s, start..start + 100, start + 100..start + 110, &mut out)
+                .unwrap();
+            assert_eq!(
+                ptrs,
+                (oe.work.obs.as_ptr(), oe.work.forced.as_ptr(), oe.resid.as_ptr())
+            );
+        }
+    }
+
+    #[test]
+    fn constant_command_keeps_the_model_and_reports_fallback() {
+        let tf = second_order();
+        let mut u = binary_input(400, 20, 0, 1e-4, 4);
+        for v in u[250..].iter_mut() {
+            *v = 2e-4;
+        }
+        let y = simulate(&tf, &u, DT);
+        let t: Vec<f64> = (0..u.len()).map(|k| k as f64 * DT).collect();
+        let s = Signals::new(&t, &u, &y, DT, 0.0);
+        let mut oe = OeConfig {
+            poles: 2,
+            zeros: 0,
+            ..OeConfig::default()
+        }
+        .build()
+        .unwrap();
+        let mut c0 = [0.0; 4];
+        oe.fit(&s, 100..250, &mut c0).unwrap();
+        let mut c1 = [0.0; 4];
+        let f = oe.fit(&s, 250..400, &mut c1).unwrap();
+        assert_eq!(f.termination, Termination::Fallback);
+        assert_eq!(c0, c1);
+    }
+
+    #[test]
+    fn invalid_settings_and_data_are_rejected() {
+        let bad = [
+            OeConfig {
+                poles: 0,
+                ..OeConfig::default()
+            },
+            OeConfig {
+                poles: 2,
+                zeros: 2,
+                ..OeConfig::default()
+            },
+            OeConfig {
+                time_scale: Some(-1.0),
+                ..OeConfig::default()
+            },
+            OeConfig {
+                window_iterations: 0,
+                ..OeConfig::default()
+            },
+            OeConfig {
+                initial: Some(second_order()),
+                ..OeConfig::default()
+            },
+        ];
+        for cfg in bad {
+            assert!(cfg.clone().build().is_err(), "{cfg:?}");
+        }
+        let u = vec![0.0; 5];
+        assert!(matches!(
+            fit_oe(&u, &u, DT, &OeConfig::default()),
+            Err(Error::TooFewSamples { .. })
+        ));
+        let mut y = vec![0.0; 100];
+        y[7] = f64::NAN;
+        assert!(matches!(
+            fit_oe(&[0.0; 100], &y, DT, &OeConfig::default()),
+            Err(Error::NonFinite { index: 7, .. })
+        ));
+        // no excitation at all: no model
+        assert!(fit_oe(&[1.0; 100], &[1.0; 100], DT, &OeConfig::default()).is_err());
+        // predict without fit
+        let mut oe = OeConfig::default().build().unwrap();
+        let t = vec![0.0; 100];
+        let mut out = [0.0; 10];
+        assert!(oe
+            .predict(&Signals::new(&t, &t, &t, DT, 0.0), 0..50, 50..60, &mut out)
+            .is_err());
     }
 }

@@ -35,7 +35,15 @@ fn main() -> feedid::Result<()> {
         let rate = 5000.0;
         let cmd = sc.command(rate, sc.default_duration(), 1)?;
         let out = rig.simulate(&cmd, rate)?;
-        report(sc.name(), &out.time, &out.command, &out.position, 1.0 / rate, &cfg, window)?;
+        report(
+            sc.name(),
+            &out.time,
+            &out.command,
+            &out.position,
+            1.0 / rate,
+            &cfg,
+            window,
+        )?;
     }
     if Path::new(&emps).exists() {
         let opts = ReadOptions {
@@ -73,7 +81,11 @@ fn report(
                 "{name}: poles {:?} iters {} {:?}",
                 f.poles()?
                     .iter()
-                    .map(|p| format!("{:.1}{:+.1}i Hz", p.re / 6.2832, p.im / 6.2832))
+                    .map(|p| format!(
+                        "{:.1}{:+.1}i Hz",
+                        p.re / std::f64::consts::TAU,
+                        p.im / std::f64::consts::TAU
+                    ))
                     .collect::<Vec<_>>(),
                 f.report.iterations,
                 f.report.termination

@@ -151,7 +151,13 @@ impl Companion {
             self.g0[i] = self.e[(i, n)];
             self.g1[i] = self.e[(i, n + 1)] / h;
         }
-        if self.ad.iter().chain(&self.g0).chain(&self.g1).any(|v| !v.is_finite()) {
+        if self
+            .ad
+            .iter()
+            .chain(&self.g0)
+            .chain(&self.g1)
+            .any(|v| !v.is_finite())
+        {
             return Err(Error::InvalidModel {
                 reason: "non-finite companion discretisation",
             });
@@ -177,8 +183,8 @@ impl Companion {
     fn step(&mut self, x: &mut [f64], v: f64, dv: f64) {
         let n = self.n;
         let s = &mut self.scratch[..n];
-        for i in 0..n {
-            s[i] = self.g0[i] * v + self.g1[i] * dv;
+        for ((si, g0), g1) in s.iter_mut().zip(&self.g0).zip(&self.g1) {
+            *si = g0 * v + g1 * dv;
         }
         for (j, &xj) in x.iter().enumerate().take(n) {
             if xj != 0.0 {

@@ -4,9 +4,9 @@
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
 //! shifts by a hop.
 
+mod companion;
 pub mod engine;
 mod estimator;
-mod companion;
 mod model;
 mod oe;
 mod paper;

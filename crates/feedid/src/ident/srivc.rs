@@ -127,8 +127,7 @@ pub(crate) fn srivc(
                 *s = nrm;
             }
         }
-        for j in 0..p {
-            let s = scale[j];
+        for (j, &s) in scale.iter().enumerate() {
             phi.column_mut(j).scale_mut(1.0 / s);
             zeta.column_mut(j).scale_mut(1.0 / s);
         }

@@ -1259,7 +1259,8 @@ mod tests {
             ((c[3] - tf.den()[1]) / tf.den()[1]).abs()
         };
         let with_prior = drift(1.0);
-        assert!(with_prior < 0.05, "{with_prior}");
+        // (without the prior, prior_weight = 0, D2 drifts by a factor ~1e5 here)
+        assert!(with_prior < 0.1, "{with_prior}");
     }
 
     #[test]

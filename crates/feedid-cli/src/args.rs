@@ -139,7 +139,7 @@ pub struct SimulateArgs {
 /// Method options shared by identify and stream.
 #[derive(Debug, Clone, Args)]
 pub struct MethodArgs {
-    /// Identification method: paper, arx, rls.
+    /// Identification method: paper, arx, rls, oe.
     #[arg(long, default_value = "paper", value_name = "NAME")]
     pub method: String,
     /// Solver of the paper method: qr (exact least squares) or simplex (Nelder–Mead, as in the paper).

@@ -7,6 +7,7 @@
 //! | `paper` | the paper's polynomial method ([`PaperConfig`]) | 20 |
 //! | `arx` | windowed ARX with exact sliding update ([`ArxConfig`]) | 200 |
 //! | `rls` | recursive least squares with forgetting ([`RlsConfig`]) | 100 |
+//! | `oe` | continuous-time output error over sliding windows ([`OeConfig`]) | 200 |
 //!
 //! ```
 //! use feedid::ident::{MethodKind, MethodSpec};
@@ -20,7 +21,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
-use crate::ident::{ArxConfig, Estimator, PaperConfig, RlsConfig};
+use crate::ident::{ArxConfig, Estimator, OeConfig, PaperConfig, RlsConfig};
 
 /// The identification methods by name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,10 +32,12 @@ pub enum MethodKind {
     Arx,
     /// Recursive least squares.
     Rls,
+    /// Continuous-time output error.
+    Oe,
 }
 
 /// Accepted method names, for messages.
-pub const METHOD_NAMES: &str = "paper, arx, rls";
+pub const METHOD_NAMES: &str = "paper, arx, rls, oe";
 
 impl MethodKind {
     /// Lowercase name.
@@ -43,6 +46,7 @@ impl MethodKind {
             MethodKind::Paper => "paper",
             MethodKind::Arx => "arx",
             MethodKind::Rls => "rls",
+            MethodKind::Oe => "oe",
         }
     }
 }
@@ -60,6 +64,7 @@ impl FromStr for MethodKind {
             "paper" | "lsm" => Ok(MethodKind::Paper),
             "arx" => Ok(MethodKind::Arx),
             "rls" => Ok(MethodKind::Rls),
+            "oe" => Ok(MethodKind::Oe),
             _ => Err(Error::InvalidChoice {
                 what: "method",
                 value: s.to_string(),
@@ -70,7 +75,7 @@ impl FromStr for MethodKind {
 }
 
 /// A method and the settings of every method (only the chosen one is used).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MethodSpec {
     /// Which method.
     pub kind: MethodKind,
@@ -80,6 +85,8 @@ pub struct MethodSpec {
     pub arx: ArxConfig,
     /// Settings of `rls`.
     pub rls: RlsConfig,
+    /// Settings of `oe`.
+    pub oe: OeConfig,
 }
 
 impl MethodSpec {
@@ -90,6 +97,7 @@ impl MethodSpec {
             paper: PaperConfig::default(),
             arx: ArxConfig::default(),
             rls: RlsConfig::default(),
+            oe: OeConfig::default(),
         }
     }
 
@@ -101,6 +109,7 @@ impl MethodSpec {
             MethodKind::Paper => 20,
             MethodKind::Arx => 200,
             MethodKind::Rls => 100,
+            MethodKind::Oe => 200,
         }
     }
 
@@ -110,6 +119,7 @@ impl MethodSpec {
             MethodKind::Paper => Box::new(self.paper.build()?),
             MethodKind::Arx => Box::new(self.arx.build()?),
             MethodKind::Rls => Box::new(self.rls.build()?),
+            MethodKind::Oe => Box::new(self.oe.clone().build()?),
         })
     }
 }
@@ -120,7 +130,7 @@ mod tests {
 
     #[test]
     fn every_name_builds_its_estimator() {
-        for name in ["paper", "arx", "rls"] {
+        for name in ["paper", "arx", "rls", "oe"] {
             let kind: MethodKind = name.parse().unwrap();
             assert_eq!(kind.name(), name);
             assert_eq!(MethodSpec::new(kind).build().unwrap().name(), name);
@@ -130,6 +140,6 @@ mod tests {
     #[test]
     fn unknown_name_lists_the_choices() {
         let e = "magic".parse::<MethodKind>().unwrap_err();
-        assert!(e.to_string().contains("paper, arx, rls"), "{e}");
+        assert!(e.to_string().contains("paper, arx, rls, oe"), "{e}");
     }
 }

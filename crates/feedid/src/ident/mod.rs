@@ -5,15 +5,18 @@
 //! shifts by a hop.
 
 mod arx;
+mod companion;
 pub mod engine;
 mod estimator;
 mod identify;
 mod method;
 mod model;
+mod oe;
 mod order;
 mod paper;
 mod residuals;
 mod rls;
+mod srivc;
 
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
@@ -21,6 +24,7 @@ pub use estimator::{Estimator, Signals, WindowFit};
 pub use identify::{identify, Identification, IdentifySummary};
 pub use method::{MethodKind, MethodSpec, METHOD_NAMES};
 pub use model::LinearModel;
+pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit};
 pub use order::{
     frols, order_table, select_order, Criterion, FrolsConfig, FrolsResult, FrolsTerm, OrderRow,
     OrderSearch, OrderSelection, OrderTable, TermKind,

@@ -60,6 +60,15 @@
 //! `Tf` to the fitted input polynomial is `N(s)/s⁸`, exactly that polynomial.
 //! `TransferFunction` drives the identified `Tf` with the actual next command.
 //!
+//! **Rest windows.** With [`TimeOrigin::Motion`], a window whose last sample
+//! is at or before the motion start (`t_last ≤ motion_start`, including
+//! `motion_start = ∞` while the command has not moved yet, as in the streaming
+//! path) contains no motion: it is not fitted. The coefficients are 0, the
+//! fit reports [`Termination::Fallback`] and the prediction holds the last
+//! measured position. The rule only reads the window, so batch and streaming
+//! decide it identically at the window end (the motion start is the time of
+//! the last rest sample, known as soon as the command first moves).
+//!
 //! Positions are used as given: the output model passes through zero at
 //! `τ = 0`, so with [`TimeOrigin::Motion`] the position should be measured from
 //! the rest position at the motion start (as in the paper).
@@ -345,6 +354,8 @@ struct LastFit {
 #[derive(Debug, Clone)]
 pub struct PaperMethod {
     config: PaperConfig,
+    /// Held position of the last window if it was a rest window.
+    rest_hold: Option<f64>,
     legendre: [[f64; NQ]; NQ],
     cap: usize,
     tau: Vec<f64>,
@@ -365,6 +376,7 @@ impl PaperMethod {
     fn new(config: PaperConfig) -> Self {
         Self {
             config,
+            rest_hold: None,
             legendre: legendre_monomials(),
             cap: 0,
             tau: Vec::new(),
@@ -393,7 +405,7 @@ impl PaperMethod {
     }
 
     /// The last window's fitted output polynomial `P(τ)` at time `t` \[s\]
-    /// (`None` before the first fit).
+    /// (`None` before the first fit and after a rest window).
     pub fn fitted_position(&self, t: f64) -> Option<f64> {
         self.last.as_ref().map(|fit| Self::eval_output(fit, t))
     }
@@ -402,6 +414,21 @@ impl PaperMethod {
     /// (`None` before the first fit).
     pub fn fitted_command(&self, t: f64) -> Option<f64> {
         self.last.as_ref().map(|fit| Self::eval_input(fit, t))
+    }
+
+    /// A window entirely at rest (see the module doc): coefficients 0, hold the last position.
+    fn rest_window(&mut self, pos: &[f64], coef: &mut [f64]) -> WindowFit {
+        let hold = pos.last().copied().unwrap_or(0.0);
+        coef.fill(0.0);
+        self.rest_hold = Some(hold);
+        self.last = None;
+        self.diagnostics = None;
+        let sse: f64 = pos.iter().map(|y| (y - hold) * (y - hold)).sum();
+        WindowFit {
+            residual_rms: (sse / pos.len().max(1) as f64).sqrt(),
+            iterations: 0,
+            termination: Termination::Fallback,
+        }
     }
 
     fn ensure_capacity(&mut self, w: usize) {
@@ -534,11 +561,16 @@ impl Estimator for PaperMethod {
         "paper"
     }
 
+    fn uses_future_command(&self) -> bool {
+        self.config.prediction != PredictionMode::Polynomial
+    }
+
     fn coefficient_names(&self) -> Vec<String> {
         NAMES.iter().map(|s| s.to_string()).collect()
     }
 
     fn reset(&mut self) {
+        self.rest_hold = None;
         self.last = None;
         self.diagnostics = None;
     }
@@ -571,6 +603,10 @@ impl Estimator for PaperMethod {
         first_non_finite(time, window.start, "time")?;
         first_non_finite(pos, window.start, "position")?;
         first_non_finite(cmd, window.start, "command")?;
+        if self.config.time_origin == TimeOrigin::Motion && time[w - 1] <= signals.motion_start {
+            return Ok(self.rest_window(pos, coef));
+        }
+        self.rest_hold = None;
         self.ensure_capacity(w);
 
         // --- time scaling
@@ -788,6 +824,10 @@ impl Estimator for PaperMethod {
             });
         }
         check_range(signals, &horizon, "paper horizon")?;
+        if let Some(hold) = self.rest_hold {
+            out.fill(hold);
+            return Ok(());
+        }
         let fit = self.last.as_ref().ok_or(Error::InvalidModel {
             reason: "paper: predict called before a successful fit",
         })?;
@@ -1328,6 +1368,53 @@ mod tests {
             assert!(c.iter().all(|v| *v == 0.0), "{c:?}");
             assert_eq!(f.residual_rms, 0.0);
         }
+    }
+
+    #[test]
+    fn windows_ending_at_or_before_the_motion_start_are_rest_windows() {
+        let (p, q) = balanced(0.004);
+        let mut d = model_data(&p, &q, 0.0, 0.0, W + H);
+        d.y.iter_mut().for_each(|y| *y += 1e-3);
+        let last = d.y[W - 1];
+        for (ms, rest) in [
+            (f64::INFINITY, true),
+            (d.t[W - 1], true),
+            (d.t[W - 1] + 1e-9, true),
+            (d.t[W - 2], false),
+        ] {
+            for solver in [Solver::Qr, Solver::Simplex] {
+                let mut m = method(solver, TimeOrigin::Motion);
+                let mut c = [1.0; 11];
+                let s = d.signals(ms);
+                let f = m.fit(&s, 0..W, &mut c).unwrap();
+                let mut pred = [0.0; H];
+                m.predict(&s, 0..W, W..W + H, &mut pred).unwrap();
+                if rest {
+                    assert_eq!(f.termination, Termination::Fallback);
+                    assert_eq!(c, [0.0; 11]);
+                    assert!(pred.iter().all(|&v| v == last), "{pred:?}");
+                    assert!(m.fitted_position(d.t[0]).is_none());
+                } else {
+                    assert_ne!(f.termination, Termination::Fallback);
+                    assert!(c.iter().any(|&v| v != 0.0));
+                    assert!(pred.iter().all(|&v| v != last));
+                }
+            }
+        }
+        // the window-local origin ignores the motion start
+        let mut m = method(Solver::Qr, TimeOrigin::Window);
+        let f = m
+            .fit(&d.signals(f64::INFINITY), 0..W, &mut [0.0; 11])
+            .unwrap();
+        assert_eq!(f.termination, Termination::Exact);
+    }
+
+    #[test]
+    fn only_the_polynomial_prediction_does_without_the_future_command() {
+        assert!(!method(Solver::Qr, TimeOrigin::Motion).uses_future_command());
+        let mut m = method(Solver::Qr, TimeOrigin::Motion);
+        m.config.prediction = PredictionMode::TransferFunction;
+        assert!(m.uses_future_command());
     }
 
     #[test]

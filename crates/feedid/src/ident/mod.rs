@@ -4,14 +4,17 @@
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
 //! shifts by a hop. The [`stream`] module does the same one sample at a time.
 
+pub mod batch;
 pub mod engine;
 mod estimator;
+mod method;
 mod model;
 mod paper;
 pub mod stream;
 
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
+pub use method::{build_estimator, MethodOptions, METHOD_NAMES};
 pub use model::LinearModel;
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,

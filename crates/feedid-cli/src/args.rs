@@ -20,6 +20,8 @@ pub enum Command {
     Info(InfoArgs),
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),
+    /// Identify and predict online: CSV samples on stdin, predictions on stdout as they are due.
+    Stream(StreamArgs),
 }
 
 /// Which D1 coefficient to use.
@@ -97,4 +99,27 @@ pub struct InfoArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `feedid stream`.
+#[derive(Debug, Args)]
+pub struct StreamArgs {
+    /// Identification method.
+    #[arg(long, value_name = "M", default_value = "paper")]
+    pub method: String,
+    /// Least-squares solver of the paper method: qr, simplex.
+    #[arg(long, value_name = "S", default_value = "qr")]
+    pub solver: String,
+    /// Window length W [samples].
+    #[arg(long, value_name = "W", default_value_t = 20)]
+    pub window: usize,
+    /// Prediction horizon H [samples].
+    #[arg(long, value_name = "H", default_value_t = 10)]
+    pub horizon: usize,
+    /// Shift between windows [samples; default: the horizon].
+    #[arg(long, value_name = "K")]
+    pub hop: Option<usize>,
+    /// Sampling rate [Hz]: input lines are `command,position` without a time column.
+    #[arg(long, value_name = "HZ")]
+    pub rate: Option<f64>,
 }

@@ -3,6 +3,7 @@
 mod info;
 mod model;
 mod recording;
+mod stream;
 
 use crate::args::{Cli, Command};
 
@@ -11,6 +12,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(a) => info::run(&a),
         Command::Model(a) => model::run(&a),
+        Command::Stream(a) => stream::run(&a),
     }
 }
 

@@ -92,6 +92,9 @@ const NP: usize = 3;
 const NQ: usize = 8;
 /// Number of identified coefficients (`N2, N1, N0, D7 … D0`).
 const NC: usize = NP + NQ;
+/// Legendre recurrence factors `(2k+1)/(k+1)` and `k/(k+1)`, `k = 0 … 6`.
+const LEGENDRE_A: [f64; NQ - 1] = [1.0, 1.5, 5.0 / 3.0, 1.75, 1.8, 11.0 / 6.0, 13.0 / 7.0];
+const LEGENDRE_B: [f64; NQ - 1] = [0.0, 0.5, 2.0 / 3.0, 0.75, 0.8, 5.0 / 6.0, 6.0 / 7.0];
 /// `i!` for `i = 0 … 7`.
 const FACT: [f64; 8] = [1.0, 1.0, 2.0, 6.0, 24.0, 120.0, 720.0, 5040.0];
 const NAMES: [&str; NC] = [
@@ -644,16 +647,18 @@ impl Estimator for PaperMethod {
         {
             let g_out = &mut self.design_out[..NP * w];
             let g_in = &mut self.design_in[..NQ * w];
+            // multiplications by reciprocals: no division in the per-sample loop
+            let (inv_half, inv_t) = (1.0 / half, 1.0 / t_scale);
             for i in 0..w {
-                let s = (tau[i] - centre) / half;
-                let wt = (tau[i] / t_scale).powi(5);
-                // Legendre recurrence (k+1) L_{k+1} = (2k+1) s L_k − k L_{k−1}
+                let s = (tau[i] - centre) * inv_half;
+                let wt = (tau[i] * inv_t).powi(5);
+                // Legendre recurrence L_{k+1} = ((2k+1) s L_k − k L_{k−1})/(k+1)
                 let mut lm1 = 1.0;
                 let mut l = s;
                 g_in[i] = 1.0;
                 g_in[i + w] = s;
                 for k in 1..NQ - 1 {
-                    let next = ((2 * k + 1) as f64 * s * l - k as f64 * lm1) / (k + 1) as f64;
+                    let next = LEGENDRE_A[k] * s * l - LEGENDRE_B[k] * lm1;
                     lm1 = l;
                     l = next;
                     g_in[i + (k + 1) * w] = l;
@@ -917,8 +922,9 @@ fn affine_to_monomial(m: &[f64], c: f64, h: f64, out: &mut [f64]) {
 fn normalise(v: &mut [f64]) -> f64 {
     let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     if n > 0.0 && n.is_finite() {
+        let inv = 1.0 / n;
         for x in v.iter_mut() {
-            *x /= n;
+            *x *= inv;
         }
         n
     } else {

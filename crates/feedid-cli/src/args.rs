@@ -28,6 +28,8 @@ pub enum Command {
     Info(Box<InfoArgs>),
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),
+    /// Identify and predict online: CSV samples on stdin, predictions on stdout as they are due.
+    Stream(StreamArgs),
 }
 
 /// Which D1 coefficient to use.
@@ -244,4 +246,18 @@ pub struct OrderArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `feedid stream`.
+#[derive(Debug, Args)]
+pub struct StreamArgs {
+    /// Method.
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// Windows.
+    #[command(flatten)]
+    pub windows: WindowArgs,
+    /// Sampling rate [Hz] when lines are `command,position` without a time.
+    #[arg(long, value_name = "HZ")]
+    pub rate: Option<f64>,
 }

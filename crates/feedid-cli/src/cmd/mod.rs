@@ -8,6 +8,8 @@ mod recording;
 mod reproduce;
 mod simulate;
 
+mod stream;
+
 use std::path::{Path, PathBuf};
 
 use crate::args::{Cli, Command};
@@ -21,6 +23,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Order(a) => order::run(&a),
         Command::Reproduce(a) => reproduce::run(&a),
         Command::Simulate(a) => simulate::run(&a),
+        Command::Stream(a) => stream::run(&a),
     }
 }
 

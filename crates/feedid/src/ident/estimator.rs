@@ -99,6 +99,17 @@ pub trait Estimator {
         0
     }
 
+    /// Whether `predict` reads the command over the horizon (default `true`).
+    ///
+    /// The command is the set-point, known ahead in a CNC; the streaming path
+    /// ([`crate::ident::stream::Streamer`]) emits a prediction of such an
+    /// estimator only once the command over its horizon has arrived. Methods
+    /// that predict from the window alone return `false` and are emitted at
+    /// the window end.
+    fn uses_future_command(&self) -> bool {
+        true
+    }
+
     /// Forget all state (start of a new recording).
     fn reset(&mut self) {}
 
@@ -120,4 +131,41 @@ pub trait Estimator {
         horizon: Range<usize>,
         out: &mut [f64],
     ) -> Result<()>;
+}
+
+/// A boxed estimator is an estimator (so `Streamer<Box<dyn Estimator>>` and
+/// [`crate::ident::engine::run`] work with methods chosen at run time).
+impl<E: Estimator + ?Sized> Estimator for Box<E> {
+    fn name(&self) -> &'static str {
+        (**self).name()
+    }
+    fn coefficient_names(&self) -> Vec<String> {
+        (**self).coefficient_names()
+    }
+    fn warm_up(&self) -> usize {
+        (**self).warm_up()
+    }
+    fn uses_future_command(&self) -> bool {
+        (**self).uses_future_command()
+    }
+    fn reset(&mut self) {
+        (**self).reset()
+    }
+    fn fit(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        coef: &mut [f64],
+    ) -> Result<WindowFit> {
+        (**self).fit(signals, window, coef)
+    }
+    fn predict(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        horizon: Range<usize>,
+        out: &mut [f64],
+    ) -> Result<()> {
+        (**self).predict(signals, window, horizon, out)
+    }
 }

@@ -2,9 +2,10 @@
 //!
 //! Every method implements [`Estimator`]; the [`engine`] slides a window of
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
-//! shifts by a hop.
+//! shifts by a hop. The [`stream`] module does the same one sample at a time.
 
 mod arx;
+pub mod batch;
 mod companion;
 pub mod engine;
 mod estimator;
@@ -17,6 +18,7 @@ mod paper;
 mod residuals;
 mod rls;
 mod srivc;
+pub mod stream;
 
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
@@ -35,3 +37,4 @@ pub use paper::{
 };
 pub use residuals::{ResidualAnalysis, Z_99};
 pub use rls::{RlsConfig, RlsEstimator};
+pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};

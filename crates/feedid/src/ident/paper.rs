@@ -113,6 +113,9 @@ const NP: usize = 3;
 const NQ: usize = 8;
 /// Number of identified coefficients (`N2, N1, N0, D7 … D0`).
 const NC: usize = NP + NQ;
+/// Legendre recurrence factors `(2k+1)/(k+1)` and `k/(k+1)`, `k = 0 … 6`.
+const LEGENDRE_A: [f64; NQ - 1] = [1.0, 1.5, 5.0 / 3.0, 1.75, 1.8, 11.0 / 6.0, 13.0 / 7.0];
+const LEGENDRE_B: [f64; NQ - 1] = [0.0, 0.5, 2.0 / 3.0, 0.75, 0.8, 5.0 / 6.0, 6.0 / 7.0];
 /// `i!` for `i = 0 … 7`.
 const FACT: [f64; 8] = [1.0, 1.0, 2.0, 6.0, 24.0, 120.0, 720.0, 5040.0];
 const NAMES: [&str; NC] = [
@@ -376,6 +379,8 @@ struct LastFit {
 #[derive(Debug, Clone)]
 pub struct PaperMethod {
     config: PaperConfig,
+    /// Held position of the last window if it was a rest window.
+    rest_hold: Option<f64>,
     legendre: [[f64; NQ]; NQ],
     cap: usize,
     tau: Vec<f64>,
@@ -389,8 +394,6 @@ pub struct PaperMethod {
     nm_out: NelderMead,
     nm_in: NelderMead,
     last: Option<LastFit>,
-    /// Held position predicted after a rest window (no motion yet).
-    rest: Option<f64>,
     /// Rest position at the motion start, fixed by the first motion window.
     reference: Option<f64>,
     diagnostics: Option<PaperDiagnostics>,
@@ -403,6 +406,7 @@ impl PaperMethod {
     fn new(config: PaperConfig) -> Self {
         Self {
             config,
+            rest_hold: None,
             legendre: legendre_monomials(),
             cap: 0,
             tau: Vec::new(),
@@ -416,7 +420,6 @@ impl PaperMethod {
             nm_out: NelderMead::new(NP),
             nm_in: NelderMead::new(NQ),
             last: None,
-            rest: None,
             reference: None,
             diagnostics: None,
             tf_fallbacks: 0,
@@ -442,7 +445,7 @@ impl PaperMethod {
     }
 
     /// The last window's fitted output polynomial `P(τ)` at time `t` \[s\]
-    /// (`None` before the first fit).
+    /// (`None` before the first fit and after a rest window).
     pub fn fitted_position(&self, t: f64) -> Option<f64> {
         self.last
             .as_ref()
@@ -455,6 +458,21 @@ impl PaperMethod {
         self.last
             .as_ref()
             .map(|fit| fit.u_ref + Self::eval_input(fit, t))
+    }
+
+    /// A window entirely at rest (see the module doc): coefficients 0, hold the last position.
+    fn rest_window(&mut self, pos: &[f64], coef: &mut [f64]) -> WindowFit {
+        let hold = pos.last().copied().unwrap_or(0.0);
+        coef.fill(0.0);
+        self.rest_hold = Some(hold);
+        self.last = None;
+        self.diagnostics = None;
+        let sse: f64 = pos.iter().map(|y| (y - hold) * (y - hold)).sum();
+        WindowFit {
+            residual_rms: (sse / pos.len().max(1) as f64).sqrt(),
+            iterations: 0,
+            termination: Termination::Fallback,
+        }
     }
 
     fn ensure_capacity(&mut self, w: usize) {
@@ -587,13 +605,17 @@ impl Estimator for PaperMethod {
         "paper"
     }
 
+    fn uses_future_command(&self) -> bool {
+        self.config.prediction != PredictionMode::Polynomial
+    }
+
     fn coefficient_names(&self) -> Vec<String> {
         NAMES.iter().map(|s| s.to_string()).collect()
     }
 
     fn reset(&mut self) {
+        self.rest_hold = None;
         self.last = None;
-        self.rest = None;
         self.reference = None;
         self.diagnostics = None;
         self.tf_fallbacks = 0;
@@ -627,25 +649,16 @@ impl Estimator for PaperMethod {
         first_non_finite(time, window.start, "time")?;
         first_non_finite(pos, window.start, "position")?;
         first_non_finite(cmd, window.start, "command")?;
+        if self.config.time_origin == TimeOrigin::Motion && time[w - 1] <= signals.motion_start {
+            return Ok(self.rest_window(pos, coef));
+        }
+        self.rest_hold = None;
         self.ensure_capacity(w);
 
         // --- rest windows and the rest reference (motion time origin)
         let (y_ref, u_ref) = match self.config.time_origin {
             TimeOrigin::Window => (0.0, 0.0),
             TimeOrigin::Motion => {
-                // Also catches an unknown (infinite or NaN) motion start.
-                let moving = signals.motion_start < time[w - 1];
-                if !moving {
-                    let hold = pos[w - 1];
-                    let sse: f64 = pos.iter().map(|v| (v - hold) * (v - hold)).sum();
-                    coef.fill(0.0);
-                    self.rest = Some(hold);
-                    return Ok(WindowFit {
-                        residual_rms: (sse / w as f64).sqrt(),
-                        iterations: 0,
-                        termination: Termination::Fallback,
-                    });
-                }
                 // The output model has no constant term, so positions are
                 // measured from the rest position at the motion start. The
                 // input model has one (Q0 = D7), so the command is fitted as
@@ -665,7 +678,6 @@ impl Estimator for PaperMethod {
                 (y_ref, 0.0)
             }
         };
-        self.rest = None;
 
         // --- time scaling
         let origin = match self.config.time_origin {
@@ -702,16 +714,18 @@ impl Estimator for PaperMethod {
         {
             let g_out = &mut self.design_out[..NP * w];
             let g_in = &mut self.design_in[..NQ * w];
+            // multiplications by reciprocals: no division in the per-sample loop
+            let (inv_half, inv_t) = (1.0 / half, 1.0 / t_scale);
             for i in 0..w {
-                let s = (tau[i] - centre) / half;
-                let wt = (tau[i] / t_scale).powi(5);
-                // Legendre recurrence (k+1) L_{k+1} = (2k+1) s L_k − k L_{k−1}
+                let s = (tau[i] - centre) * inv_half;
+                let wt = (tau[i] * inv_t).powi(5);
+                // Legendre recurrence L_{k+1} = ((2k+1) s L_k − k L_{k−1})/(k+1)
                 let mut lm1 = 1.0;
                 let mut l = s;
                 g_in[i] = 1.0;
                 g_in[i + w] = s;
                 for k in 1..NQ - 1 {
-                    let next = ((2 * k + 1) as f64 * s * l - k as f64 * lm1) / (k + 1) as f64;
+                    let next = LEGENDRE_A[k] * s * l - LEGENDRE_B[k] * lm1;
                     lm1 = l;
                     l = next;
                     g_in[i + (k + 1) * w] = l;
@@ -898,7 +912,7 @@ impl Estimator for PaperMethod {
             });
         }
         check_range(signals, &horizon, "paper horizon")?;
-        if let Some(hold) = self.rest {
+        if let Some(hold) = self.rest_hold {
             out.fill(hold);
             return Ok(());
         }
@@ -1029,8 +1043,9 @@ fn affine_to_monomial(m: &[f64], c: f64, h: f64, out: &mut [f64]) {
 fn normalise(v: &mut [f64]) -> f64 {
     let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     if n > 0.0 && n.is_finite() {
+        let inv = 1.0 / n;
         for x in v.iter_mut() {
-            *x /= n;
+            *x *= inv;
         }
         n
     } else {
@@ -1480,6 +1495,53 @@ mod tests {
             assert!(c.iter().all(|v| *v == 0.0), "{c:?}");
             assert_eq!(f.residual_rms, 0.0);
         }
+    }
+
+    #[test]
+    fn windows_ending_at_or_before_the_motion_start_are_rest_windows() {
+        let (p, q) = balanced(0.004);
+        let mut d = model_data(&p, &q, 0.0, 0.0, W + H);
+        d.y.iter_mut().for_each(|y| *y += 1e-3);
+        let last = d.y[W - 1];
+        for (ms, rest) in [
+            (f64::INFINITY, true),
+            (d.t[W - 1], true),
+            (d.t[W - 1] + 1e-9, true),
+            (d.t[W - 2], false),
+        ] {
+            for solver in [Solver::Qr, Solver::Simplex] {
+                let mut m = method(solver, TimeOrigin::Motion);
+                let mut c = [1.0; 11];
+                let s = d.signals(ms);
+                let f = m.fit(&s, 0..W, &mut c).unwrap();
+                let mut pred = [0.0; H];
+                m.predict(&s, 0..W, W..W + H, &mut pred).unwrap();
+                if rest {
+                    assert_eq!(f.termination, Termination::Fallback);
+                    assert_eq!(c, [0.0; 11]);
+                    assert!(pred.iter().all(|&v| v == last), "{pred:?}");
+                    assert!(m.fitted_position(d.t[0]).is_none());
+                } else {
+                    assert_ne!(f.termination, Termination::Fallback);
+                    assert!(c.iter().any(|&v| v != 0.0));
+                    assert!(pred.iter().all(|&v| v != last));
+                }
+            }
+        }
+        // the window-local origin ignores the motion start
+        let mut m = method(Solver::Qr, TimeOrigin::Window);
+        let f = m
+            .fit(&d.signals(f64::INFINITY), 0..W, &mut [0.0; 11])
+            .unwrap();
+        assert_eq!(f.termination, Termination::Exact);
+    }
+
+    #[test]
+    fn only_the_polynomial_prediction_does_without_the_future_command() {
+        assert!(!method(Solver::Qr, TimeOrigin::Motion).uses_future_command());
+        let mut m = method(Solver::Qr, TimeOrigin::Motion);
+        m.config.prediction = PredictionMode::TransferFunction;
+        assert!(m.uses_future_command());
     }
 
     #[test]

@@ -94,6 +94,9 @@ pub struct QrWorkspace {
     z: Vec<f64>,
     small: Vec<f64>,
     small_rhs: Vec<f64>,
+    /// Squared partial column norms (current estimate, last exact value).
+    vn1: Vec<f64>,
+    vn2: Vec<f64>,
 }
 
 impl QrWorkspace {
@@ -106,6 +109,8 @@ impl QrWorkspace {
             z: vec![0.0; n],
             small: vec![0.0; 2 * n * n],
             small_rhs: vec![0.0; 2 * n],
+            vn1: vec![0.0; n],
+            vn2: vec![0.0; n],
         }
     }
 
@@ -202,37 +207,45 @@ pub fn lstsq_in_place(
     let scale = &mut ws.scale[..n];
     let perm = &mut ws.perm[..n];
     // 1. column scaling
+    let vn1 = &mut ws.vn1[..n];
+    let vn2 = &mut ws.vn2[..n];
     for j in 0..n {
         let col = &mut a[j * m..(j + 1) * m];
         let d = norm2(col);
         let d = if d > 0.0 && d.is_finite() { d } else { 1.0 };
+        let inv = 1.0 / d;
         for v in col.iter_mut() {
-            *v /= d;
+            *v *= inv;
         }
         scale[j] = d;
         perm[j] = j;
+        vn1[j] = sum_sq(col);
+        vn2[j] = vn1[j];
     }
 
-    // 2. Householder QR with column pivoting
+    // 2. Householder QR with column pivoting. The squared norms of the
+    // remaining columns are downdated after each step, `‖a_j‖² −= r_kj²`, and
+    // recomputed when cancellation has lost half the digits (LAPACK xGEQP3).
     let kmax = m.min(n);
+    let tol3z = f64::EPSILON.sqrt();
     for k in 0..kmax {
         // pivot: remaining column (rows k..m) of largest norm
         let mut best = k;
         let mut best_norm = -1.0;
-        for j in k..n {
-            let nj = norm2(&a[j * m + k..(j + 1) * m]);
+        for (j, &nj) in vn1.iter().enumerate().skip(k) {
             if nj > best_norm {
                 best_norm = nj;
                 best = j;
             }
         }
         if best != k {
-            for i in 0..m {
-                a.swap(i + k * m, i + best * m);
-            }
+            let (left, right) = a.split_at_mut(best * m);
+            left[k * m..(k + 1) * m].swap_with_slice(&mut right[..m]);
             perm.swap(k, best);
+            vn1.swap(k, best);
+            vn2.swap(k, best);
         }
-        let alpha_norm = best_norm.max(0.0);
+        let alpha_norm = norm2(&a[k * m + k..(k + 1) * m]);
         if alpha_norm == 0.0 {
             // the rest of the matrix is exactly zero
             continue;
@@ -266,6 +279,17 @@ pub fn lstsq_in_place(
         a[k + k * m] = alpha;
         for i in (k + 1)..m {
             a[i + k * m] = 0.0;
+        }
+        // downdate the remaining column norms by the new row of R
+        for j in (k + 1)..n {
+            let r = a[k + j * m];
+            let rest = vn1[j] - r * r;
+            if rest <= tol3z * vn2[j] {
+                vn1[j] = sum_sq(&a[j * m + k + 1..(j + 1) * m]);
+                vn2[j] = vn1[j];
+            } else {
+                vn1[j] = rest;
+            }
         }
     }
 
@@ -445,12 +469,38 @@ fn split_cols(a: &mut [f64], m: usize, k: usize, j: usize) -> (&[f64], &mut [f64
     (&left[k * m..(k + 1) * m], &mut right[..m])
 }
 
+/// Dot product with four partial sums (independent dependency chains).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    let mut acc = [0.0; 4];
+    for (x, y) in ca.zip(cb) {
+        acc[0] += x[0] * y[0];
+        acc[1] += x[1] * y[1];
+        acc[2] += x[2] * y[2];
+        acc[3] += x[3] * y[3];
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
 }
 
-/// 2-norm without overflow/underflow for extreme magnitudes.
+/// Sum of squares (no protection against over/underflow).
+fn sum_sq(v: &[f64]) -> f64 {
+    dot(v, v)
+}
+
+/// 2-norm without overflow/underflow for extreme magnitudes (one pass when
+/// the sum of squares is safely representable).
 fn norm2(v: &[f64]) -> f64 {
+    let s = sum_sq(v);
+    if s.is_finite() && s >= 1e-200 {
+        return s.sqrt();
+    }
     let amax = v.iter().fold(0.0f64, |acc, x| acc.max(x.abs()));
     if amax == 0.0 || !amax.is_finite() {
         return amax;

@@ -17,7 +17,8 @@ What it does, in one run (so the ratio holds on a noisy machine):
    the window; `numpy.linalg.lstsq` on (tau/T)^5..(tau/T)^7 for the position
    and (tau/T)^0..(tau/T)^7 for the command; the prediction continues the
    position polynomial over the next H samples. Windows that end at or
-   before the motion start hold the last position (as feedid does). The
+   before the motion start hold the last position and positions are taken
+   from the rest position at the motion start (as feedid does). The
    paper's simplex: `scipy.optimize.fmin` on the same two sums of squares
    (data normalised to unit norm, start at 0, tolerances like feedid's).
 4. feedid: `feedid identify --method paper --solver qr|simplex --window 20
@@ -101,6 +102,12 @@ def motion_start(np, t, u):
     return t[0] if len(moving) == 0 else t[max(moving[0] - 1, 0)]
 
 
+def rest_position(np, t, y, ms):
+    """Measured position at the motion start (the output model has no constant term)."""
+    k = np.nonzero(t <= ms)[0]
+    return 0.0 if len(k) == 0 else y[k[-1]]
+
+
 def windows(n):
     s = 0
     while s + W < n:
@@ -111,6 +118,7 @@ def windows(n):
 def python_lstsq(np, t, u, y):
     """The paper method with numpy.linalg.lstsq; (predictions, seconds, windows)."""
     ms = motion_start(np, t, u)
+    y0 = rest_position(np, t, y, ms)
     pred = np.full(len(t), np.nan)
     count = 0
     t0 = time.perf_counter()
@@ -123,17 +131,18 @@ def python_lstsq(np, t, u, y):
         scale = np.max(np.abs(tau))
         x = tau / scale
         a_out = np.column_stack([x ** 5, x ** 6, x ** 7])
-        p, *_ = np.linalg.lstsq(a_out, y[s:we], rcond=None)
+        p, *_ = np.linalg.lstsq(a_out, y[s:we] - y0, rcond=None)
         a_in = np.vander(x, 8, increasing=True)
         q, *_ = np.linalg.lstsq(a_in, u[s:we], rcond=None)
         xh = (t[we:he] - ms) / scale
-        pred[we:he] = np.column_stack([xh ** 5, xh ** 6, xh ** 7]) @ p
+        pred[we:he] = y0 + np.column_stack([xh ** 5, xh ** 6, xh ** 7]) @ p
     return pred, time.perf_counter() - t0, count
 
 
 def python_fmin(np, fmin, t, u, y, max_windows):
     """The paper's simplex with scipy.optimize.fmin on the first `max_windows` moving windows."""
     ms = motion_start(np, t, u)
+    y0 = rest_position(np, t, y, ms)
     pred = np.full(len(t), np.nan)
     count = 0
     elapsed = 0.0
@@ -160,10 +169,10 @@ def python_fmin(np, fmin, t, u, y, max_windows):
         scale = np.max(np.abs(tau))
         x = tau / scale
         a_out = np.column_stack([x ** 5, x ** 6, x ** 7])
-        p = fit(a_out, y[s:we])
+        p = fit(a_out, y[s:we] - y0)
         fit(np.vander(x, 8, increasing=True), u[s:we])
         xh = (t[we:he] - ms) / scale
-        pred[we:he] = np.column_stack([xh ** 5, xh ** 6, xh ** 7]) @ p
+        pred[we:he] = y0 + np.column_stack([xh ** 5, xh ** 6, xh ** 7]) @ p
         elapsed += time.perf_counter() - t0
     return pred, elapsed, count
 

@@ -178,8 +178,9 @@ pub struct WindowArgs {
 /// `feedid identify`.
 #[derive(Debug, Args)]
 pub struct IdentifyArgs {
-    /// Recording: CSV/text or MATLAB v5 .mat file.
-    pub input: PathBuf,
+    /// Recording(s): CSV/text or MATLAB v5 .mat files; several need --out-dir.
+    #[arg(required = true, num_args = 1..)]
+    pub inputs: Vec<PathBuf>,
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
@@ -193,8 +194,17 @@ pub struct IdentifyArgs {
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
     /// Predictions CSV: time_s,command_m,measured_m,predicted_m,simulated_m.
-    #[arg(short, long, value_name = "predictions.csv")]
-    pub output: PathBuf,
+    #[arg(
+        short,
+        long,
+        value_name = "predictions.csv",
+        required_unless_present = "out_dir"
+    )]
+    pub output: Option<PathBuf>,
+    /// Batch mode: identify every input in parallel (all cores) and write
+    /// NAME.predictions.csv, NAME.coefficients.csv and NAME.summary.json here.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["output", "coefficients", "summary"])]
+    pub out_dir: Option<PathBuf>,
     /// Per-window coefficients CSV.
     #[arg(long, value_name = "coef.csv")]
     pub coefficients: Option<PathBuf>,

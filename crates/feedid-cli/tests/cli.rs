@@ -553,3 +553,65 @@ fn emps_info_and_identify_work_as_a_new_user_calls_them() {
         "qx",
     );
 }
+
+#[test]
+fn identify_batch_writes_one_set_of_outputs_per_input_and_reports_failures() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = simulated(dir.path(), "ramp");
+    let b = simulated(dir.path(), "scurve");
+    let out = dir.path().join("out");
+    let o = feedid(&[
+        "identify",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--method",
+        "arx",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for stem in ["ramp", "scurve"] {
+        for ext in ["predictions.csv", "coefficients.csv", "summary.json"] {
+            assert!(out.join(format!("{stem}.{ext}")).exists(), "{stem}.{ext}");
+        }
+        // the same as identifying the file alone
+        let single = dir.path().join(format!("{stem}_single.csv"));
+        let input = dir.path().join(format!("{stem}.csv"));
+        let o = feedid(&[
+            "identify",
+            input.to_str().unwrap(),
+            "--method",
+            "arx",
+            "-o",
+            single.to_str().unwrap(),
+        ]);
+        assert!(o.status.success());
+        assert_eq!(
+            std::fs::read(&single).unwrap(),
+            std::fs::read(out.join(format!("{stem}.predictions.csv"))).unwrap()
+        );
+    }
+    // one bad file: the others are written, exit code 2, the bad one named
+    let bad = data("nan.csv");
+    let out2 = dir.path().join("out2");
+    let o = feedid(&[
+        "identify",
+        a.to_str().unwrap(),
+        bad.to_str().unwrap(),
+        "--out-dir",
+        out2.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("nan.csv: line 16"), "{}", stderr(&o));
+    assert!(out2.join("ramp.predictions.csv").exists());
+    assert!(!out2.join("nan.predictions.csv").exists());
+    // several inputs without --out-dir
+    let o = feedid(&[
+        "identify",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "-o",
+        "x.csv",
+    ]);
+    assert_fails(&o, "--out-dir");
+}

@@ -229,3 +229,64 @@ fn malformed_lines_are_reported_with_their_number_and_skipped() {
         .unwrap();
     assert_eq!(st.code(), Some(2));
 }
+
+#[test]
+fn stream_equals_identify_on_the_same_file_for_every_method() {
+    let rec = rig_recording(0.15);
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("ramp.csv");
+    let text = csv(&rec, true);
+    std::fs::write(&input, &text).unwrap();
+    let n = rec.len();
+    let dt = rec.dt();
+    for (method, extra) in [
+        ("paper", vec![]),
+        ("paper", vec!["--prediction", "tf"]),
+        ("arx", vec!["--window", "100", "--order", "4,4,1"]),
+        ("rls", vec![]),
+        ("oe", vec!["--window", "100"]),
+    ] {
+        let pred = dir.path().join("pred.csv");
+        let mut args = vec![
+            "identify",
+            input.to_str().unwrap(),
+            "--method",
+            method,
+            "-o",
+            pred.to_str().unwrap(),
+        ];
+        args.extend(extra.iter().copied());
+        let o = Command::new(BIN).args(&args).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let batch: Vec<Option<f64>> = std::fs::read_to_string(&pred)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(3).and_then(|c| c.parse().ok()))
+            .collect();
+        let mut sargs = vec!["--method", method];
+        sargs.extend(extra.iter().copied());
+        let (out, _) = stream(&sargs, &text);
+        let mut streamed = vec![None; n + 20];
+        for (t, y) in rows(&out) {
+            streamed[(t / dt).round() as usize] = Some(y);
+        }
+        let scale = rec.position().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let mut compared = 0;
+        for k in 0..n {
+            match (streamed[k], batch[k]) {
+                (Some(a), Some(b)) => {
+                    // identify writes shortest round-trip decimals: exact
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale,
+                        "{method} {extra:?}: sample {k}: {a} vs {b}"
+                    );
+                    compared += 1;
+                }
+                (None, None) => {}
+                (a, b) => panic!("{method} {extra:?}: sample {k}: stream {a:?} vs identify {b:?}"),
+            }
+        }
+        assert!(compared > n / 3, "{method}: {compared}");
+    }
+}

@@ -1,8 +1,13 @@
 //! `feedid identify`: sliding-window identification and prediction of a recording.
 
-use anyhow::Result;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use feedid::drive::RigParams;
 use feedid::ident::{identify, ArxOrders, EngineConfig, MethodSpec, PaperConfig};
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
+use rayon::prelude::*;
 
 use crate::args::{IdentifyArgs, MethodArgs, WindowArgs};
 use crate::cmd::{load_params, recording, Outputs};
@@ -54,18 +59,90 @@ pub fn engine_config(w: &WindowArgs, spec: &MethodSpec) -> EngineConfig {
     }
 }
 
-/// Identify, write the outputs, print a short summary.
+/// Output paths of one recording.
+struct OutputPaths {
+    predictions: PathBuf,
+    coefficients: Option<PathBuf>,
+    summary: Option<PathBuf>,
+}
+
+/// Identify, write the outputs, print a short summary (one file, or a batch with --out-dir).
 pub fn run(a: &IdentifyArgs) -> Result<()> {
     let spec = method_spec(&a.method)?;
-    let mut est = spec.build()?;
     let cfg = engine_config(&a.windows, &spec);
     let params = load_params(a.params.as_deref())?;
-    let rec = recording::load(&a.input, &a.recording)?;
-    let run = identify(&rec, est.as_mut(), &cfg, Some(&params))?;
+    match (&a.out_dir, a.inputs.as_slice()) {
+        (None, [input]) => {
+            let paths = OutputPaths {
+                predictions: a
+                    .output
+                    .clone()
+                    .ok_or_else(|| anyhow::anyhow!("missing -o predictions.csv"))?,
+                coefficients: a.coefficients.clone(),
+                summary: a.summary.clone(),
+            };
+            let text = identify_file(input, a, &spec, &cfg, &params, &paths)?;
+            print!("{text}");
+            Ok(())
+        }
+        (None, _) => bail!("several inputs need --out-dir DIR (one set of outputs per input)"),
+        (Some(dir), inputs) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+            let results: Vec<(PathBuf, Result<String>)> = inputs
+                .par_iter()
+                .map(|input| {
+                    let stem = input
+                        .file_stem()
+                        .map(|s| s.to_string_lossy().into_owned())
+                        .unwrap_or_else(|| "recording".to_string());
+                    let paths = OutputPaths {
+                        predictions: dir.join(format!("{stem}.predictions.csv")),
+                        coefficients: Some(dir.join(format!("{stem}.coefficients.csv"))),
+                        summary: Some(dir.join(format!("{stem}.summary.json"))),
+                    };
+                    let r = identify_file(input, a, &spec, &cfg, &params, &paths);
+                    (input.clone(), r)
+                })
+                .collect();
+            let mut failed = 0;
+            for (input, r) in &results {
+                match r {
+                    Ok(text) => print!("{text}"),
+                    Err(e) => {
+                        failed += 1;
+                        eprintln!(
+                            "error: {}: {}",
+                            input.display(),
+                            e.to_string().replace('\n', " ")
+                        );
+                    }
+                }
+            }
+            if failed > 0 {
+                bail!("{failed} of {} recordings failed", results.len());
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Read, identify and write one recording; returns the human-readable summary.
+fn identify_file(
+    input: &Path,
+    a: &IdentifyArgs,
+    spec: &MethodSpec,
+    cfg: &EngineConfig,
+    params: &RigParams,
+    paths: &OutputPaths,
+) -> Result<String> {
+    let mut est = spec.build()?;
+    let rec = recording::load(input, &a.recording)?;
+    let run = identify(&rec, est.as_mut(), cfg, Some(params))?;
     let summary = run.summary();
 
     let mut outputs = Outputs::default();
-    outputs.write(&a.output, |p| {
+    outputs.write(&paths.predictions, |p| {
         write_predictions_csv(
             p,
             rec.time(),
@@ -75,18 +152,20 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             run.simulated.as_deref(),
         )
     })?;
-    if let Some(p) = &a.coefficients {
+    if let Some(p) = &paths.coefficients {
         outputs.write(p, |p| write_coefficients_csv(p, rec.time(), &run.sliding))?;
     }
-    if let Some(p) = &a.summary {
+    if let Some(p) = &paths.summary {
         let json = serde_json::to_string_pretty(&summary)?;
         outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
     }
     outputs.commit();
 
-    println!(
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
         "{}: {} samples at {:.2} Hz, method {}, window {}, horizon {}, hop {}",
-        a.input.display(),
+        input.display(),
         summary.samples,
         summary.rate_hz,
         summary.method,
@@ -94,30 +173,34 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
         summary.horizon,
         summary.hop
     );
-    println!(
+    let _ = writeln!(
+        t,
         "  {} windows ({} failed, {} fallback), {} samples predicted",
         summary.windows,
         summary.failed_windows,
         summary.fallback_windows,
         summary.samples_predicted
     );
-    println!(
+    let _ = writeln!(
+        t,
         "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %",
         1e6 * summary.rms_error_m,
         1e6 * summary.max_abs_error_m,
         summary.fit_percent
     );
     if let (Some(r), Some(m)) = (summary.sim_rms_error_m, summary.sim_max_abs_error_m) {
-        println!(
+        let _ = writeln!(
+            t,
             "  simulation model:  rms {:.3} µm, max {:.3} µm",
             1e6 * r,
             1e6 * m
         );
     }
-    println!(
+    let _ = writeln!(
+        t,
         "  time: {:.3} ms identification and prediction, {:.2} µs per window",
         1e3 * summary.identification_seconds,
         summary.per_window_us
     );
-    Ok(())
+    Ok(t)
 }

@@ -195,6 +195,8 @@ pub struct RlsEstimator {
     start: Option<usize>,
     updates: usize,
     max_trace: f64,
+    /// Whether the CPU has AVX2 (selects the vectorised update).
+    avx: bool,
 }
 
 impl RlsEstimator {
@@ -214,6 +216,10 @@ impl RlsEstimator {
             start: None,
             updates: 0,
             max_trace: config.max_trace.unwrap_or(n as f64 * config.p0),
+            #[cfg(target_arch = "x86_64")]
+            avx: std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(not(target_arch = "x86_64"))]
+            avx: false,
         };
         s.reset();
         s
@@ -287,59 +293,26 @@ impl RlsEstimator {
     /// same pass (as [`Self::bound_trace`] would after it). `P` stays exactly
     /// symmetric: the downdate is `P ← (P − h·hᵀ)/λ` with `h = g/√(λ + ψᵀg)`.
     fn add(&mut self, target: f64, lambda: f64, bound: bool) -> f64 {
-        let n = self.n;
-        sym_mul(&self.p, &self.psi, &mut self.g);
-        let mut den = lambda;
-        let mut pred = 0.0;
-        for ((&s, &gi), &t) in self.psi.iter().zip(&self.g).zip(&self.theta) {
-            den += s * gi;
-            pred += s * t;
-        }
-        let e = target - pred;
-        if !(den > 0.0) || !den.is_finite() {
-            if bound {
-                self.bound_trace();
-            }
-            return e;
-        }
-        let inv = 1.0 / den;
-        for (t, &gi) in self.theta.iter_mut().zip(&self.g) {
-            *t += gi * inv * e;
-        }
-        let root = inv.sqrt();
-        for gi in &mut self.g {
-            *gi *= root;
-        }
-        let il = 1.0 / lambda;
-        let h = &self.g;
-        let mut f = 1.0;
-        if bound {
-            // trace of the updated P, from its diagonal computed as below
-            let tr: f64 = self
-                .p
-                .iter()
-                .step_by(n + 1)
-                .zip(h)
-                .map(|(&d, &hi)| (d - hi * hi) * il)
-                .sum();
-            if tr > self.max_trace {
-                f = self.max_trace / tr;
-            }
-        }
-        if f == 1.0 {
-            for (row, &hi) in self.p.chunks_exact_mut(n).zip(h) {
-                for (v, &hj) in row.iter_mut().zip(h) {
-                    *v = (*v - hi * hj) * il;
-                }
-            }
+        let max = if bound { self.max_trace } else { f64::INFINITY };
+        let (p, psi, theta, g) = (&mut self.p, &self.psi, &mut self.theta, &mut self.g);
+        #[cfg(target_arch = "x86_64")]
+        let r = if self.avx {
+            // SAFETY: `avx` is set only when the CPU reports AVX2 (`new`).
+            unsafe { add_avx2(self.n, p, psi, theta, g, target, lambda, max) }
         } else {
-            for (row, &hi) in self.p.chunks_exact_mut(n).zip(h) {
-                for (v, &hj) in row.iter_mut().zip(h) {
-                    *v = (*v - hi * hj) * il * f;
+            add_sized(self.n, p, psi, theta, g, target, lambda, max)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let r = add_sized(self.n, p, psi, theta, g, target, lambda, max);
+        match r {
+            Ok(e) => e,
+            Err(e) => {
+                if bound {
+                    self.bound_trace();
                 }
+                e
             }
         }
-        e
     }
 
     /// Exact removal of a sample; false if it would lose definiteness.
@@ -392,9 +365,121 @@ impl RlsEstimator {
     }
 }
 
+/// [`add_kernel`] with the common sizes as constants (unrolled, vectorised).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn add_sized(
+    n: usize,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    add_kernel(n, p, psi, theta, g, target, lambda, max)
+}
+
+/// [`add_sized`] compiled for AVX2 (4-wide vectors). No FMA contraction
+/// happens in Rust, so the results are bit-identical to the portable path.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+fn add_avx2(
+    n: usize,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    add_sized(n, p, psi, theta, g, target, lambda, max)
+}
+
+/// The update of [`RlsEstimator::add`] on `n` parameters with the trace
+/// bound `max` (∞ = none); `Err(e)` if `λ + ψᵀg` is not positive (nothing
+/// updated, the trace bound not applied).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn add_kernel(
+    n: usize,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    let (p, psi, theta, g) = (&mut p[..n * n], &psi[..n], &mut theta[..n], &mut g[..n]);
+    sym_mul(p, psi, g);
+    let mut den = lambda;
+    let mut pred = 0.0;
+    for ((&s, &gi), &t) in psi.iter().zip(g.iter()).zip(theta.iter()) {
+        den += s * gi;
+        pred += s * t;
+    }
+    let e = target - pred;
+    if !(den > 0.0) || !den.is_finite() {
+        return Err(e);
+    }
+    let inv = 1.0 / den;
+    for (t, &gi) in theta.iter_mut().zip(g.iter()) {
+        *t += gi * inv * e;
+    }
+    let root = inv.sqrt();
+    for gi in g.iter_mut() {
+        *gi *= root;
+    }
+    let il = 1.0 / lambda;
+    let h = &*g;
+    let mut f = 1.0;
+    if max < f64::INFINITY {
+        // trace of the updated P, from its diagonal computed as below
+        let tr: f64 = p
+            .iter()
+            .step_by(n + 1)
+            .zip(h)
+            .map(|(&d, &hi)| (d - hi * hi) * il)
+            .sum();
+        if tr > max {
+            f = max / tr;
+        }
+    }
+    if f == 1.0 {
+        for (row, &hi) in p.chunks_exact_mut(n).zip(h) {
+            for (v, &hj) in row.iter_mut().zip(h) {
+                *v = (*v - hi * hj) * il;
+            }
+        }
+    } else {
+        for (row, &hi) in p.chunks_exact_mut(n).zip(h) {
+            for (v, &hj) in row.iter_mut().zip(h) {
+                *v = (*v - hi * hj) * il * f;
+            }
+        }
+    }
+    Ok(e)
+}
+
 /// `g = P·ψ` for an exactly symmetric row-major `P`, accumulated as the
 /// ψ-weighted sum of its rows (contiguous, vectorisable).
+#[inline(always)]
 fn sym_mul(p: &[f64], psi: &[f64], g: &mut [f64]) {
+    if let Ok(g) = <&mut [f64; 16]>::try_from(&mut *g) {
+        // accumulate in registers for the default orders
+        let mut acc = [0.0; 16];
+        for (row, &s) in p.chunks_exact(16).zip(psi) {
+            for (a, &v) in acc.iter_mut().zip(row) {
+                *a += v * s;
+            }
+        }
+        *g = acc;
+        return;
+    }
     let n = psi.len();
     g.fill(0.0);
     for (row, &s) in p.chunks_exact(n).zip(psi) {

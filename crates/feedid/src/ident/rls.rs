@@ -12,7 +12,9 @@
 //! g = P·ψ,   K = g/(λ + ψᵀg),   θ ← θ + K·(ỹ − ψᵀθ),   P ← (P − K·gᵀ)/λ
 //! ```
 //!
-//! `P` is symmetrised after every update (`P ← (P + Pᵀ)/2`). Memory
+//! `P` is kept exactly symmetric by writing the downdate as
+//! `P ← (P − h·hᵀ)/λ`, `h = g/√(λ + ψᵀg)` (so `Pψ` can be accumulated from
+//! contiguous rows). Memory
 //! `≈ 1/(1 − λ)` samples. Two safeguards against covariance wind-up:
 //! * **Excitation gate:** a sample updates `θ` and `P` (and is forgotten) only
 //!   when the command moved over the regressor span, i.e. the range of
@@ -77,7 +79,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::arx::{check_window, predict_horizon, regressor};
+use crate::ident::arx::{check_window, predict_horizon};
 use crate::ident::{ArxOrders, Estimator, Signals, WindowFit};
 use crate::solve::Termination;
 
@@ -193,6 +195,8 @@ pub struct RlsEstimator {
     start: Option<usize>,
     updates: usize,
     max_trace: f64,
+    /// Whether the CPU has AVX2 (selects the vectorised update).
+    avx: bool,
 }
 
 impl RlsEstimator {
@@ -212,6 +216,10 @@ impl RlsEstimator {
             start: None,
             updates: 0,
             max_trace: config.max_trace.unwrap_or(n as f64 * config.p0),
+            #[cfg(target_arch = "x86_64")]
+            avx: std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(not(target_arch = "x86_64"))]
+            avx: false,
         };
         s.reset();
         s
@@ -260,72 +268,75 @@ impl RlsEstimator {
     }
 
     /// Load the scaled regressor of sample `k` (local) into `psi`; returns the target.
+    ///
+    /// Same values as `arx::regressor` followed by the scaling, without bounds
+    /// checks per element.
     fn load(&mut self, y: &[f64], u: &[f64], k: usize) -> f64 {
-        let t = regressor(&self.config.orders, y, u, k, self.r0, &mut self.psi);
+        let o = &self.config.orders;
+        let (na, nb, nk) = (o.na, o.nb, o.nk);
+        let r = self.r0;
         let s = 1.0 / self.config.scale;
-        for v in &mut self.psi {
-            *v *= s;
+        let (pa, pb) = self.psi.split_at_mut(na);
+        for (p, &v) in pa.iter_mut().zip(y[k - na..k].iter().rev()) {
+            *p = -(v - r) * s;
         }
-        t * s
+        let hi = k + 1 - nk;
+        for (p, &v) in pb.iter_mut().zip(u[hi - nb..hi].iter().rev()) {
+            *p = (v - r) * s;
+        }
+        (y[k] - r) * s
     }
 
     /// RLS update with forgetting `lambda`; returns the a-priori error (scaled).
-    fn add(&mut self, target: f64, lambda: f64) -> f64 {
-        let n = self.n;
-        let mut den = lambda;
-        let mut pred = 0.0;
-        for i in 0..n {
-            let row = &self.p[i * n..(i + 1) * n];
-            let gi: f64 = row.iter().zip(&self.psi).map(|(a, b)| a * b).sum();
-            self.g[i] = gi;
-            den += self.psi[i] * gi;
-            pred += self.psi[i] * self.theta[i];
-        }
-        let e = target - pred;
-        if !(den > 0.0) || !den.is_finite() {
-            return e;
-        }
-        let inv = 1.0 / den;
-        for i in 0..n {
-            self.theta[i] += self.g[i] * inv * e;
-        }
-        let il = 1.0 / lambda;
-        for i in 0..n {
-            let gi = self.g[i] * inv;
-            for j in i..n {
-                let v = (self.p[i * n + j] - gi * self.g[j]) * il;
-                self.p[i * n + j] = v;
-                self.p[j * n + i] = v;
+    ///
+    /// With `bound`, the trace bound is applied to the updated `P` in the
+    /// same pass (as [`Self::bound_trace`] would after it). `P` stays exactly
+    /// symmetric: the downdate is `P ← (P − h·hᵀ)/λ` with `h = g/√(λ + ψᵀg)`.
+    fn add(&mut self, target: f64, lambda: f64, bound: bool) -> f64 {
+        let max = if bound { self.max_trace } else { f64::INFINITY };
+        let (p, psi, theta, g) = (&mut self.p, &self.psi, &mut self.theta, &mut self.g);
+        #[cfg(target_arch = "x86_64")]
+        let r = if self.avx {
+            // SAFETY: `avx` is set only when the CPU reports AVX2 (`new`).
+            unsafe { add_avx2(self.n, p, psi, theta, g, target, lambda, max) }
+        } else {
+            add_sized(self.n, p, psi, theta, g, target, lambda, max)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let r = add_sized(self.n, p, psi, theta, g, target, lambda, max);
+        match r {
+            Ok(e) => e,
+            Err(e) => {
+                if bound {
+                    self.bound_trace();
+                }
+                e
             }
         }
-        e
     }
 
     /// Exact removal of a sample; false if it would lose definiteness.
     fn remove(&mut self, target: f64) -> bool {
         let n = self.n;
+        sym_mul(&self.p, &self.psi, &mut self.g);
         let mut q = 0.0;
         let mut pred = 0.0;
-        for i in 0..n {
-            let row = &self.p[i * n..(i + 1) * n];
-            let gi: f64 = row.iter().zip(&self.psi).map(|(a, b)| a * b).sum();
-            self.g[i] = gi;
-            q += self.psi[i] * gi;
-            pred += self.psi[i] * self.theta[i];
+        for ((&s, &gi), &t) in self.psi.iter().zip(&self.g).zip(&self.theta) {
+            q += s * gi;
+            pred += s * t;
         }
         let d = 1.0 - q;
         if !(d > 1e-12) {
             return false;
         }
         let e = target - pred;
-        for i in 0..n {
-            self.theta[i] -= self.g[i] * e / d;
+        for (t, &gi) in self.theta.iter_mut().zip(&self.g) {
+            *t -= gi * e / d;
         }
-        for i in 0..n {
-            for j in i..n {
-                let v = self.p[i * n + j] + self.g[i] * self.g[j] / d;
-                self.p[i * n + j] = v;
-                self.p[j * n + i] = v;
+        let g = &self.g;
+        for (row, &gi) in self.p.chunks_exact_mut(n).zip(g) {
+            for (v, &gj) in row.iter_mut().zip(g) {
+                *v += gi * gj / d;
             }
         }
         true
@@ -333,7 +344,7 @@ impl RlsEstimator {
 
     fn bound_trace(&mut self) {
         let n = self.n;
-        let tr: f64 = (0..n).map(|i| self.p[i * n + i]).sum();
+        let tr: f64 = self.p.iter().step_by(n + 1).sum();
         if tr > self.max_trace {
             let f = self.max_trace / tr;
             for v in &mut self.p {
@@ -348,8 +359,132 @@ impl RlsEstimator {
         for j in k.saturating_sub(w).max(first)..k {
             if self.exciting(u, j) {
                 let t = self.load(y, u, j);
-                self.add(t, 1.0);
+                self.add(t, 1.0, false);
             }
+        }
+    }
+}
+
+/// [`add_kernel`] with the common sizes as constants (unrolled, vectorised).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn add_sized(
+    n: usize,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    add_kernel(n, p, psi, theta, g, target, lambda, max)
+}
+
+/// [`add_sized`] compiled for AVX2 (4-wide vectors). No FMA contraction
+/// happens in Rust, so the results are bit-identical to the portable path.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+fn add_avx2(
+    n: usize,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    add_sized(n, p, psi, theta, g, target, lambda, max)
+}
+
+/// The update of [`RlsEstimator::add`] on `n` parameters with the trace
+/// bound `max` (∞ = none); `Err(e)` if `λ + ψᵀg` is not positive (nothing
+/// updated, the trace bound not applied).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn add_kernel(
+    n: usize,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    let (p, psi, theta, g) = (&mut p[..n * n], &psi[..n], &mut theta[..n], &mut g[..n]);
+    sym_mul(p, psi, g);
+    let mut den = lambda;
+    let mut pred = 0.0;
+    for ((&s, &gi), &t) in psi.iter().zip(g.iter()).zip(theta.iter()) {
+        den += s * gi;
+        pred += s * t;
+    }
+    let e = target - pred;
+    if !(den > 0.0) || !den.is_finite() {
+        return Err(e);
+    }
+    let inv = 1.0 / den;
+    for (t, &gi) in theta.iter_mut().zip(g.iter()) {
+        *t += gi * inv * e;
+    }
+    let root = inv.sqrt();
+    for gi in g.iter_mut() {
+        *gi *= root;
+    }
+    let il = 1.0 / lambda;
+    let h = &*g;
+    let mut f = 1.0;
+    if max < f64::INFINITY {
+        // trace of the updated P, from its diagonal computed as below
+        let tr: f64 = p
+            .iter()
+            .step_by(n + 1)
+            .zip(h)
+            .map(|(&d, &hi)| (d - hi * hi) * il)
+            .sum();
+        if tr > max {
+            f = max / tr;
+        }
+    }
+    if f == 1.0 {
+        for (row, &hi) in p.chunks_exact_mut(n).zip(h) {
+            for (v, &hj) in row.iter_mut().zip(h) {
+                *v = (*v - hi * hj) * il;
+            }
+        }
+    } else {
+        for (row, &hi) in p.chunks_exact_mut(n).zip(h) {
+            for (v, &hj) in row.iter_mut().zip(h) {
+                *v = (*v - hi * hj) * il * f;
+            }
+        }
+    }
+    Ok(e)
+}
+
+/// `g = P·ψ` for an exactly symmetric row-major `P`, accumulated as the
+/// ψ-weighted sum of its rows (contiguous, vectorisable).
+#[inline(always)]
+fn sym_mul(p: &[f64], psi: &[f64], g: &mut [f64]) {
+    if let Ok(g) = <&mut [f64; 16]>::try_from(&mut *g) {
+        // accumulate in registers for the default orders
+        let mut acc = [0.0; 16];
+        for (row, &s) in p.chunks_exact(16).zip(psi) {
+            for (a, &v) in acc.iter_mut().zip(row) {
+                *a += v * s;
+            }
+        }
+        *g = acc;
+        return;
+    }
+    let n = psi.len();
+    g.fill(0.0);
+    for (row, &s) in p.chunks_exact(n).zip(psi) {
+        for (gi, &a) in g.iter_mut().zip(row) {
+            *gi += a * s;
         }
     }
 }
@@ -422,12 +557,11 @@ impl Estimator for RlsEstimator {
             let t = self.load(y, u, k);
             match self.config.window {
                 None => {
-                    let e = self.add(t, self.config.lambda);
-                    self.bound_trace();
+                    let e = self.add(t, self.config.lambda, true);
                     sse += e * e;
                 }
                 Some(w) => {
-                    let e = self.add(t, 1.0);
+                    let e = self.add(t, 1.0, false);
                     sse += e * e;
                     if k >= w + local_first && self.exciting(u, k - w) {
                         let t_old = self.load(y, u, k - w);
@@ -503,6 +637,7 @@ impl Estimator for RlsEstimator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ident::arx::regressor;
     use nalgebra::{DMatrix, DVector};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;

@@ -141,8 +141,8 @@ pub struct SimulateArgs {
 /// Method options shared by identify and stream.
 #[derive(Debug, Clone, Args)]
 pub struct MethodArgs {
-    /// Identification method: paper, arx, rls, oe.
-    #[arg(long, default_value = "paper", value_name = "NAME")]
+    /// Identification method: auto (validated choice of model, order and memory), paper, arx, rls, oe.
+    #[arg(long, default_value = "auto", value_name = "NAME")]
     pub method: String,
     /// Solver of the paper method: qr (exact least squares) or simplex (Nelder–Mead, as in the paper).
     #[arg(long, default_value = "qr", value_name = "NAME")]
@@ -159,12 +159,16 @@ pub struct MethodArgs {
     /// RLS forgetting factor λ (memory ≈ 1/(1−λ) samples) [default: 0.999].
     #[arg(long, value_name = "LAMBDA")]
     pub lambda: Option<f64>,
+    /// auto: emit a prediction only when the chosen model's recent rms error
+    /// is within this tolerance [µm] [default: 5].
+    #[arg(long, value_name = "UM")]
+    pub tolerance: Option<f64>,
 }
 
 /// Sliding-window options.
 #[derive(Debug, Clone, Args)]
 pub struct WindowArgs {
-    /// Window length W [samples]; default: paper 20, arx 200, rls 100.
+    /// Window length W [samples]; default: auto 50, paper 20, arx 200, rls 100, oe 200.
     #[arg(long)]
     pub window: Option<usize>,
     /// Prediction horizon H [samples].

@@ -297,6 +297,8 @@ fn identify_options_window_horizon_hop_time_origin_and_tf_prediction() {
     let o = feedid(&[
         "identify",
         input.to_str().unwrap(),
+        "--method",
+        "paper",
         "--window",
         "40",
         "--horizon",
@@ -614,4 +616,63 @@ fn identify_batch_writes_one_set_of_outputs_per_input_and_reports_failures() {
         "x.csv",
     ]);
     assert_fails(&o, "--out-dir");
+}
+
+#[test]
+fn identify_defaults_to_auto_and_reports_coverage_and_residuals() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let pred = dir.path().join("pred.csv");
+    let summ = dir.path().join("summary.json");
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "-o",
+        pred.to_str().unwrap(),
+        "--summary",
+        summ.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("method auto"), "{}", stdout(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summ).unwrap()).unwrap();
+    assert_eq!(v["method"], "auto");
+    assert_eq!(v["window"], 50);
+    let cov = v["coverage_percent"].as_f64().unwrap();
+    let n = v["samples"].as_f64().unwrap();
+    let np = v["samples_predicted"].as_f64().unwrap();
+    assert!((cov - 100.0 * np / n).abs() < 1e-9);
+    assert!(cov > 90.0, "{cov}");
+    assert!(v["withheld_windows"].as_u64().is_some());
+    // the 2 ms-ahead error of auto on the default ramp: below 0.5 µm rms
+    assert!(v["rms_error_m"].as_f64().unwrap() < 0.5e-6, "{v}");
+    let r = &v["residuals"];
+    assert_eq!(r["r_ee"].as_array().unwrap().len(), 26);
+    assert_eq!(r["r_ue"].as_array().unwrap().len(), 51);
+    assert!((r["r_ee"][0].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    let bound = r["bound"].as_f64().unwrap();
+    assert!((bound - 2.58 / np.sqrt()).abs() < 1e-12);
+}
+
+#[test]
+fn order_auto_chooses_the_orders_from_the_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let pred = dir.path().join("pred.csv");
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--method",
+        "arx",
+        "--order",
+        "auto",
+        "-o",
+        pred.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("order auto (bic): na "),
+        "{}",
+        stdout(&o)
+    );
 }

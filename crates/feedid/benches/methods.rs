@@ -28,7 +28,12 @@ fn methods(c: &mut Criterion) {
     let rec = recording();
     let signals = rec.signals();
     let mut group = c.benchmark_group("methods");
-    for kind in [MethodKind::Arx, MethodKind::Oe, MethodKind::Rls] {
+    for kind in [
+        MethodKind::Arx,
+        MethodKind::Oe,
+        MethodKind::Rls,
+        MethodKind::Auto,
+    ] {
         let spec = MethodSpec::new(kind);
         let cfg = EngineConfig {
             window: spec.default_window(),
@@ -36,8 +41,8 @@ fn methods(c: &mut Criterion) {
         };
         let windows = cfg.windows(rec.len(), 0).count() as u64;
         let mut est = spec.build().unwrap_or_else(|e| panic!("{e}"));
-        // per window for arx/oe, per sample for rls
-        let (label, n) = if kind == MethodKind::Rls {
+        // per window for arx/oe, per sample for rls and auto (sample-driven)
+        let (label, n) = if matches!(kind, MethodKind::Rls | MethodKind::Auto) {
             ("per_sample", rec.len() as u64)
         } else {
             ("per_window", windows)

@@ -191,6 +191,13 @@ pub enum Error {
         iterations: usize,
     },
 
+    /// A method declined to predict (its model is not validated for this horizon).
+    #[error("prediction withheld: {reason}")]
+    PredictionWithheld {
+        /// Why.
+        reason: &'static str,
+    },
+
     // --- plot
     /// A figure could not be rendered.
     #[error("cannot render figure: {reason}")]

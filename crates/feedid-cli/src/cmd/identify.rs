@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use feedid::drive::RigParams;
-use feedid::ident::{identify, ArxOrders, EngineConfig, MethodSpec, PaperConfig};
+use feedid::ident::{
+    identify, select_order, ArxOrders, EngineConfig, MethodSpec, OrderSearch, PaperConfig,
+};
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
 use rayon::prelude::*;
 
@@ -21,13 +23,20 @@ pub fn method_spec(m: &MethodArgs) -> Result<MethodSpec> {
         prediction: m.prediction.parse()?,
         ..spec.paper
     };
-    if let Some(o) = &m.order {
+    if let Some(o) = m
+        .order
+        .as_deref()
+        .filter(|o| !o.eq_ignore_ascii_case("auto"))
+    {
         let orders = parse_orders(o)?;
         spec.arx.orders = orders;
         spec.rls.orders = orders;
     }
     if let Some(l) = m.lambda {
         spec.rls.lambda = l;
+    }
+    if let Some(t) = m.tolerance {
+        spec.auto.tolerance = t * 1e-6;
     }
     Ok(spec)
 }
@@ -136,8 +145,27 @@ fn identify_file(
     params: &RigParams,
     paths: &OutputPaths,
 ) -> Result<String> {
-    let mut est = spec.build()?;
     let rec = recording::load(input, &a.recording)?;
+    let mut spec = spec.clone();
+    let mut chosen_order = None;
+    if a.method
+        .order
+        .as_deref()
+        .is_some_and(|o| o.eq_ignore_ascii_case("auto"))
+    {
+        let sel = select_order(
+            rec.command(),
+            rec.position(),
+            rec.dt(),
+            &OrderSearch::default(),
+        )
+        .with_context(|| format!("{}: order selection", input.display()))?;
+        spec.arx.orders = sel.chosen;
+        spec.rls.orders = sel.chosen;
+        spec.auto.long.orders = sel.chosen;
+        chosen_order = Some((sel.chosen, sel.criterion));
+    }
+    let mut est = spec.build()?;
     let run = identify(&rec, est.as_mut(), cfg, Some(params))?;
     let summary = run.summary();
 
@@ -173,13 +201,25 @@ fn identify_file(
         summary.horizon,
         summary.hop
     );
+    if let Some((o, c)) = chosen_order {
+        let _ = writeln!(
+            t,
+            "  order auto ({}): na {}, nb {}, nk {}",
+            c.label(),
+            o.na,
+            o.nb,
+            o.nk
+        );
+    }
     let _ = writeln!(
         t,
-        "  {} windows ({} failed, {} fallback), {} samples predicted",
+        "  {} windows ({} failed, {} fallback, {} withheld), {} samples predicted ({:.1} %)",
         summary.windows,
         summary.failed_windows,
         summary.fallback_windows,
-        summary.samples_predicted
+        summary.withheld_windows,
+        summary.samples_predicted,
+        summary.coverage_percent
     );
     let _ = writeln!(
         t,

@@ -190,6 +190,14 @@ impl SlidingResult {
             .count()
     }
 
+    /// Number of windows whose prediction the method withheld (`auto`).
+    pub fn withheld_windows(&self) -> usize {
+        self.windows
+            .iter()
+            .filter(|w| w.fit.termination == Termination::Withheld)
+            .count()
+    }
+
     /// Mean wall time per window \[µs\].
     pub fn per_window_us(&self) -> f64 {
         if self.windows.is_empty() {
@@ -238,6 +246,10 @@ pub fn run<E: Estimator + ?Sized>(
                     has_prediction[horizon.clone()].fill(true);
                     fit
                 }
+                Err(Error::PredictionWithheld { .. }) => WindowFit {
+                    termination: Termination::Withheld,
+                    ..fit
+                },
                 _ => failed(fit.residual_rms),
             },
             Err(_) => failed(f64::NAN),
@@ -271,7 +283,8 @@ pub fn run<E: Estimator + ?Sized>(
     })
 }
 
-fn failed(residual_rms: f64) -> WindowFit {
+/// The record of a window whose fit or prediction failed.
+pub(crate) fn failed(residual_rms: f64) -> WindowFit {
     WindowFit {
         residual_rms: if residual_rms.is_finite() {
             residual_rms

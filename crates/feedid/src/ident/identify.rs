@@ -20,7 +20,7 @@ use serde::Serialize;
 use crate::drive::{simulate_nominal, RigParams};
 use crate::error::Result;
 use crate::ident::engine::{run as run_engine, EngineConfig, SlidingResult};
-use crate::ident::Estimator;
+use crate::ident::{Estimator, ResidualAnalysis};
 use crate::recording::Recording;
 use crate::solve::Termination;
 use crate::stats::ErrorStats;
@@ -41,6 +41,8 @@ pub struct Identification {
     pub samples: usize,
     /// Sampling rate \[Hz\].
     pub rate_hz: f64,
+    /// Residual analysis of the prediction errors (see [`IdentifySummary::residuals`]).
+    pub residuals: Option<ResidualAnalysis>,
 }
 
 /// Slide `estimator` over `recording` and compare with the nominal model of `params`.
@@ -66,12 +68,18 @@ pub fn identify<E: Estimator + ?Sized>(
         )
     });
     Ok(Identification {
-        sliding,
         simulated,
         simulation_stats,
         config: *config,
         samples: recording.len(),
         rate_hz: recording.rate_hz(),
+        residuals: prediction_residuals(
+            &sliding,
+            recording.command(),
+            recording.position(),
+            RESIDUAL_LAGS,
+        ),
+        sliding,
     })
 }
 
@@ -96,8 +104,12 @@ pub struct IdentifySummary {
     pub failed_windows: usize,
     /// Windows that kept the previous model (not informative).
     pub fallback_windows: usize,
+    /// Windows whose prediction the method withheld (not validated; `auto`).
+    pub withheld_windows: usize,
     /// Samples with a prediction.
     pub samples_predicted: usize,
+    /// Share of the recording's samples with a prediction \[%\].
+    pub coverage_percent: f64,
     /// RMS prediction error \[m\].
     pub rms_error_m: f64,
     /// Largest absolute prediction error \[m\].
@@ -114,6 +126,44 @@ pub struct IdentifySummary {
     pub identification_seconds: f64,
     /// Mean wall time per window \[µs\].
     pub per_window_us: f64,
+    /// Residual analysis of the prediction errors `y − ŷ` over the predicted
+    /// samples (at most the last 200 000) against the command, lags 0 … 25
+    /// (`None` when fewer than 52 samples were predicted). The k-step errors of one horizon share the
+    /// state they were predicted from, so `r_ee` is expected to be
+    /// positive for lags below the horizon.
+    pub residuals: Option<ResidualAnalysis>,
+}
+
+/// Largest lag of the residual analysis in the summary.
+pub const RESIDUAL_LAGS: usize = 25;
+
+/// Most recent predicted samples used by the residual analysis.
+const RESIDUAL_SAMPLES: usize = 200_000;
+
+/// Residual analysis of `y − ŷ` over the predicted samples (at most the last
+/// [`RESIDUAL_SAMPLES`]) against the command; `None` if too few were predicted.
+fn prediction_residuals(
+    s: &SlidingResult,
+    command: &[f64],
+    position: &[f64],
+    max_lag: usize,
+) -> Option<ResidualAnalysis> {
+    let (mut u, mut e) = (Vec::new(), Vec::new());
+    for k in (0..s.predicted.len()).rev() {
+        if e.len() >= RESIDUAL_SAMPLES {
+            break;
+        }
+        if s.has_prediction[k] {
+            u.push(command.get(k).copied().unwrap_or(0.0));
+            e.push(position.get(k).copied().unwrap_or(0.0) - s.predicted[k]);
+        }
+    }
+    if e.len() <= 2 * max_lag + 1 {
+        return None;
+    }
+    u.reverse();
+    e.reverse();
+    ResidualAnalysis::new(&u, &e, max_lag).ok()
 }
 
 impl Identification {
@@ -135,7 +185,13 @@ impl Identification {
             windows: s.windows.len(),
             failed_windows: s.failed_windows(),
             fallback_windows: fallback,
+            withheld_windows: s.withheld_windows(),
             samples_predicted: s.stats.samples,
+            coverage_percent: if self.samples > 0 {
+                100.0 * s.stats.samples as f64 / self.samples as f64
+            } else {
+                0.0
+            },
             rms_error_m: s.stats.rms,
             max_abs_error_m: s.stats.max_abs,
             fit_percent: s.stats.fit_percent,
@@ -144,6 +200,7 @@ impl Identification {
             nominal_fit_percent: self.simulation_stats.map(|x| x.fit_percent),
             identification_seconds: s.elapsed.as_secs_f64(),
             per_window_us: s.per_window_us(),
+            residuals: self.residuals.clone(),
         }
     }
 }

@@ -8,6 +8,7 @@
 //! | `arx` | windowed ARX with exact sliding update ([`ArxConfig`]) | 200 |
 //! | `rls` | recursive least squares with forgetting ([`RlsConfig`]) | 100 |
 //! | `oe` | continuous-time output error over sliding windows ([`OeConfig`]) | 200 |
+//! | `auto` | validated choice among RLS models and hold ([`AutoConfig`]); the default | 50 |
 //!
 //! ```
 //! use feedid::ident::{MethodKind, MethodSpec};
@@ -21,7 +22,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
-use crate::ident::{ArxConfig, Estimator, OeConfig, PaperConfig, RlsConfig};
+use crate::ident::{ArxConfig, AutoConfig, Estimator, OeConfig, PaperConfig, RlsConfig};
 
 /// The identification methods by name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,10 +35,12 @@ pub enum MethodKind {
     Rls,
     /// Continuous-time output error.
     Oe,
+    /// Validated choice of model, order and memory from the data (the default).
+    Auto,
 }
 
 /// Accepted method names, for messages.
-pub const METHOD_NAMES: &str = "paper, arx, rls, oe";
+pub const METHOD_NAMES: &str = "auto, paper, arx, rls, oe";
 
 impl MethodKind {
     /// Lowercase name.
@@ -47,6 +50,7 @@ impl MethodKind {
             MethodKind::Arx => "arx",
             MethodKind::Rls => "rls",
             MethodKind::Oe => "oe",
+            MethodKind::Auto => "auto",
         }
     }
 }
@@ -65,6 +69,7 @@ impl FromStr for MethodKind {
             "arx" => Ok(MethodKind::Arx),
             "rls" => Ok(MethodKind::Rls),
             "oe" => Ok(MethodKind::Oe),
+            "auto" => Ok(MethodKind::Auto),
             _ => Err(Error::InvalidChoice {
                 what: "method",
                 value: s.to_string(),
@@ -87,6 +92,8 @@ pub struct MethodSpec {
     pub rls: RlsConfig,
     /// Settings of `oe`.
     pub oe: OeConfig,
+    /// Settings of `auto`.
+    pub auto: AutoConfig,
 }
 
 impl MethodSpec {
@@ -98,11 +105,12 @@ impl MethodSpec {
             arx: ArxConfig::default(),
             rls: RlsConfig::default(),
             oe: OeConfig::default(),
+            auto: AutoConfig::default(),
         }
     }
 
     /// The window a method works best with at kHz rates \[samples\]:
-    /// paper 20 (4 ms at 5 kHz, the paper's), arx 200, rls 100 (it decides only
+    /// paper 20 (4 ms at 5 kHz, the paper's), arx 200, oe 200, auto 50, rls 100 (it decides only
     /// when the first prediction is made; rls remembers ≈ 1/(1 − λ) samples).
     pub fn default_window(&self) -> usize {
         match self.kind {
@@ -110,6 +118,7 @@ impl MethodSpec {
             MethodKind::Arx => 200,
             MethodKind::Rls => 100,
             MethodKind::Oe => 200,
+            MethodKind::Auto => 50,
         }
     }
 
@@ -120,6 +129,7 @@ impl MethodSpec {
             MethodKind::Arx => Box::new(self.arx.build()?),
             MethodKind::Rls => Box::new(self.rls.build()?),
             MethodKind::Oe => Box::new(self.oe.clone().build()?),
+            MethodKind::Auto => Box::new(self.auto.build()?),
         })
     }
 }
@@ -130,7 +140,7 @@ mod tests {
 
     #[test]
     fn every_name_builds_its_estimator() {
-        for name in ["paper", "arx", "rls", "oe"] {
+        for name in ["paper", "arx", "rls", "oe", "auto"] {
             let kind: MethodKind = name.parse().unwrap();
             assert_eq!(kind.name(), name);
             assert_eq!(MethodSpec::new(kind).build().unwrap().name(), name);
@@ -140,6 +150,6 @@ mod tests {
     #[test]
     fn unknown_name_lists_the_choices() {
         let e = "magic".parse::<MethodKind>().unwrap_err();
-        assert!(e.to_string().contains("paper, arx, rls, oe"), "{e}");
+        assert!(e.to_string().contains("auto, paper, arx, rls, oe"), "{e}");
     }
 }

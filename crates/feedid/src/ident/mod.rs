@@ -5,6 +5,7 @@
 //! shifts by a hop. The [`stream`] module does the same one sample at a time.
 
 mod arx;
+mod auto;
 pub mod batch;
 mod companion;
 pub mod engine;
@@ -21,9 +22,10 @@ mod srivc;
 pub mod stream;
 
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
+pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
-pub use identify::{identify, Identification, IdentifySummary};
+pub use identify::{identify, Identification, IdentifySummary, RESIDUAL_LAGS};
 pub use method::{MethodKind, MethodSpec, METHOD_NAMES};
 pub use model::LinearModel;
 pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit};

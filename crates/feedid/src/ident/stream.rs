@@ -142,7 +142,7 @@ pub struct Prediction<'a> {
 impl Prediction<'_> {
     /// Whether the window produced a prediction.
     pub fn is_ok(&self) -> bool {
-        self.fit.termination != Termination::Failed
+        self.fit.termination.predicted()
     }
 }
 
@@ -157,6 +157,8 @@ pub struct StreamStats {
     pub windows: usize,
     /// Windows whose fit or prediction failed.
     pub failed_windows: usize,
+    /// Windows whose prediction the method withheld (not validated; `auto`).
+    pub withheld_windows: usize,
     /// Error of the latest prediction of each measured sample that no later window can predict.
     pub scored: ErrorStats,
 }
@@ -200,6 +202,7 @@ pub struct Streamer<E: Estimator = Box<dyn Estimator>> {
     pred: Vec<f64>,
     windows: usize,
     failed: usize,
+    withheld: usize,
     acc: ErrorAccumulator,
 }
 
@@ -287,6 +290,7 @@ impl<E: Estimator> Streamer<E> {
             pred: vec![0.0; config.horizon],
             windows: 0,
             failed: 0,
+            withheld: 0,
             acc: ErrorAccumulator::default(),
         };
         s.reset();
@@ -307,6 +311,7 @@ impl<E: Estimator> Streamer<E> {
         self.finished = false;
         self.windows = 0;
         self.failed = 0;
+        self.withheld = 0;
         self.acc = ErrorAccumulator::default();
     }
 
@@ -338,6 +343,7 @@ impl<E: Estimator> Streamer<E> {
             commands: self.nc,
             windows: self.windows,
             failed_windows: self.failed,
+            withheld_windows: self.withheld,
             scored: self.acc.finish(),
         }
     }
@@ -453,6 +459,10 @@ impl<E: Estimator> Streamer<E> {
                     has[we - off..he - off].fill(true);
                     fit
                 }
+                Err(Error::PredictionWithheld { .. }) => WindowFit {
+                    termination: Termination::Withheld,
+                    ..fit
+                },
                 _ => failed(fit.residual_rms),
             },
             Err(_) => failed(f64::NAN),
@@ -460,10 +470,12 @@ impl<E: Estimator> Streamer<E> {
         if !coef.iter().all(|c| c.is_finite()) {
             coef.fill(0.0);
         }
-        let ok = fit.termination != Termination::Failed;
+        let ok = fit.termination.predicted();
         self.windows += 1;
         if ok {
             self.top = self.top.max(he);
+        } else if fit.termination == Termination::Withheld {
+            self.withheld += 1;
         } else {
             self.failed += 1;
         }
@@ -767,6 +779,7 @@ mod tests {
                 commands: 0,
                 windows: 0,
                 failed_windows: 0,
+                withheld_windows: 0,
                 scored: ErrorStats::from_pairs([]),
             },
         };

@@ -16,9 +16,17 @@ pub enum Termination {
     Fallback,
     /// No model could be identified and none was available to fall back on.
     Failed,
+    /// A model was identified but not validated for this horizon; no
+    /// prediction was emitted (the `auto` method).
+    Withheld,
 }
 
 impl Termination {
+    /// Whether the window produced a prediction (neither failed nor withheld).
+    pub fn predicted(self) -> bool {
+        !matches!(self, Termination::Failed | Termination::Withheld)
+    }
+
     /// Short lowercase label for tables and CSV files.
     pub fn label(self) -> &'static str {
         match self {
@@ -27,6 +35,7 @@ impl Termination {
             Termination::MaxIterations => "max_iterations",
             Termination::Fallback => "fallback",
             Termination::Failed => "failed",
+            Termination::Withheld => "withheld",
         }
     }
 }

@@ -465,7 +465,8 @@ impl Estimator for AutoEstimator {
                 reason: "not yet validated",
             });
         }
-        if !(self.pending_excursion <= self.config.headroom * self.seen_excursion + tol) {
+        let within = self.pending_excursion <= self.config.headroom * self.seen_excursion + tol;
+        if !within {
             return Err(Error::PredictionWithheld {
                 reason: "the command leaves the validated range",
             });
@@ -532,9 +533,9 @@ mod tests {
                 let mut e = c.build().unwrap();
                 let rc = run(&mut e, &s, &cfg).unwrap();
                 let (mut se, mut m) = (0.0, 0);
-                for k in 0..y.len() {
+                for (k, yk) in y.iter().enumerate() {
                     if let (Some(_), Some(p)) = (r.prediction(k), rc.prediction(k)) {
-                        se += (p - y[k]) * (p - y[k]);
+                        se += (p - yk) * (p - yk);
                         m += 1;
                     }
                 }

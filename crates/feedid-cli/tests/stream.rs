@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::engine::run;
-use feedid::ident::{EngineConfig, PaperConfig, Solver};
+use feedid::ident::{EngineConfig, MethodKind, MethodSpec, PaperConfig, Solver};
 use feedid::signal::Scenario;
 use feedid::Recording;
 
@@ -40,10 +40,17 @@ fn csv(rec: &Recording, with_time: bool) -> String {
     s
 }
 
-/// Run `feedid stream ARGS` on `input`; (stdout, stderr).
+/// Run `feedid stream ARGS` on `input` (the paper method unless ARGS name
+/// one); (stdout, stderr).
 fn stream(args: &[&str], input: &str) -> (String, String) {
+    let method: &[&str] = if args.contains(&"--method") {
+        &[]
+    } else {
+        &["--method", "paper"]
+    };
     let mut child = Command::new(BIN)
         .arg("stream")
+        .args(method)
         .args(args)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
@@ -129,6 +136,29 @@ fn stream_output_equals_the_batch_engine_predictions() {
             "{err}"
         );
     }
+    // the default method, auto: the same predictions as the batch engine
+    let spec = MethodSpec::new(MethodKind::Auto);
+    let cfg = EngineConfig {
+        window: spec.default_window(),
+        ..EngineConfig::default()
+    };
+    let mut auto = spec.build().unwrap();
+    let batch = run(&mut auto, &rec.signals(), &cfg).unwrap();
+    let (out, err) = stream(&["--method", "auto"], &csv(&rec, true));
+    let mut predicted = vec![None; n + 10];
+    for (t, y) in rows(&out) {
+        predicted[(t / dt).round() as usize] = Some(y);
+    }
+    let scale = rec.position().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for (k, &streamed) in predicted.iter().enumerate().take(n) {
+        match (streamed, batch.prediction(k)) {
+            (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-12 * scale, "auto: sample {k}"),
+            (None, None) => {}
+            (a, b) => panic!("auto: sample {k}: {a:?} vs {b:?}"),
+        }
+    }
+    assert!(batch.stats.samples > n / 2, "{}", batch.stats.samples);
+    assert!(err.contains("withheld"), "{err}");
     // without a time column, at a given rate: the same rows
     let (with_time, _) = stream(&[], &csv(&rec, true));
     let (with_rate, _) = stream(&["--rate", "5000"], &csv(&rec, false));
@@ -145,7 +175,7 @@ fn stream_works_in_a_pipe_behind_a_slow_writer() {
     let text = csv(&rec, true);
     let lines: Vec<String> = text.lines().map(|l| format!("{l}\n")).collect();
     let mut child = Command::new(BIN)
-        .arg("stream")
+        .args(["stream", "--method", "paper"])
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

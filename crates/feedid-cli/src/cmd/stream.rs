@@ -128,12 +128,13 @@ fn run_on<R: BufRead, W: Write, E: Write>(
     let s = streamer.stats();
     let _ = writeln!(
         err,
-        "samples {}, predictions {} ({} windows, {} failed, {} rows), skipped lines {}, \
+        "samples {}, predictions {} ({} windows, {} failed, {} withheld, {} rows), skipped lines {}, \
          rms error {:.6e} m over {} scored samples (max {:.6e} m)",
         s.samples,
-        s.windows - s.failed_windows,
+        s.windows - s.failed_windows - s.withheld_windows,
         s.windows,
         s.failed_windows,
+        s.withheld_windows,
         counts.rows,
         counts.skipped,
         s.scored.rms,

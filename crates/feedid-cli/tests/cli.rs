@@ -676,3 +676,34 @@ fn order_auto_chooses_the_orders_from_the_recording() {
         stdout(&o)
     );
 }
+
+#[test]
+fn summary_has_the_free_run_fit_of_the_global_model_except_for_paper() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "chirp");
+    for (method, expect) in [("arx", true), ("auto", true), ("paper", false)] {
+        let summ = dir.path().join(format!("{method}.json"));
+        let pred = dir.path().join(format!("{method}.csv"));
+        let o = feedid(&[
+            "identify",
+            input.to_str().unwrap(),
+            "--method",
+            method,
+            "-o",
+            pred.to_str().unwrap(),
+            "--summary",
+            summ.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&summ).unwrap()).unwrap();
+        if expect {
+            let f = v["sim_fit_percent"].as_f64().unwrap();
+            assert!(f > 90.0 && f <= 100.0, "{method}: {f}");
+            assert_eq!(v["global_model"], "arx na=8 nb=8 nk=1");
+            assert!(stdout(&o).contains("free-run fit"));
+        } else {
+            assert!(v["sim_fit_percent"].is_null());
+        }
+    }
+}

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use feedid::drive::RigParams;
 use feedid::ident::{
-    identify, select_order, ArxOrders, EngineConfig, MethodSpec, OrderSearch, PaperConfig,
+    fit_global_model, identify, select_order, ArxOrders, EngineConfig, MethodSpec, OrderSearch,
+    PaperConfig,
 };
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
 use rayon::prelude::*;
@@ -166,7 +167,12 @@ fn identify_file(
         chosen_order = Some((sel.chosen, sel.criterion));
     }
     let mut est = spec.build()?;
-    let run = identify(&rec, est.as_mut(), cfg, Some(params))?;
+    let mut run = identify(&rec, est.as_mut(), cfg, Some(params))?;
+    let mut global_note = None;
+    match fit_global_model(&rec, &spec) {
+        Ok(g) => run.global = g,
+        Err(e) => global_note = Some(format!("  global model: not fitted ({e})")),
+    }
     let summary = run.summary();
 
     let mut outputs = Outputs::default();
@@ -228,6 +234,18 @@ fn identify_file(
         1e6 * summary.max_abs_error_m,
         summary.fit_percent
     );
+    if let Some(g) = &run.global {
+        let _ = writeln!(
+            t,
+            "  global model ({}): free-run fit {:.3} %{}",
+            g.structure,
+            g.sim_fit_percent,
+            if g.stable { "" } else { " (unstable)" }
+        );
+    }
+    if let Some(n) = global_note {
+        let _ = writeln!(t, "{n}");
+    }
     if let (Some(r), Some(m)) = (summary.sim_rms_error_m, summary.sim_max_abs_error_m) {
         let _ = writeln!(
             t,

@@ -20,7 +20,7 @@ use serde::Serialize;
 use crate::drive::{simulate_nominal, RigParams};
 use crate::error::Result;
 use crate::ident::engine::{run as run_engine, EngineConfig, SlidingResult};
-use crate::ident::{Estimator, ResidualAnalysis};
+use crate::ident::{Estimator, GlobalModel, ResidualAnalysis};
 use crate::recording::Recording;
 use crate::solve::Termination;
 use crate::stats::ErrorStats;
@@ -43,6 +43,9 @@ pub struct Identification {
     pub rate_hz: f64,
     /// Residual analysis of the prediction errors (see [`IdentifySummary::residuals`]).
     pub residuals: Option<ResidualAnalysis>,
+    /// The method's global model, if one was fitted (set it with
+    /// [`crate::ident::fit_global_model`]; `identify` leaves it `None`).
+    pub global: Option<GlobalModel>,
 }
 
 /// Slide `estimator` over `recording` and compare with the nominal model of `params`.
@@ -80,6 +83,7 @@ pub fn identify<E: Estimator + ?Sized>(
             RESIDUAL_LAGS,
         ),
         sliding,
+        global: None,
     })
 }
 
@@ -116,6 +120,12 @@ pub struct IdentifySummary {
     pub max_abs_error_m: f64,
     /// NRMSE fit of the k-step (k = horizon) predictions \[%\].
     pub fit_percent: f64,
+    /// NRMSE fit of the free-run simulation of the method's global model
+    /// over the whole recording \[%\] (`None` without one, e.g. `paper`;
+    /// `null` in JSON also when the model is unstable).
+    pub sim_fit_percent: Option<f64>,
+    /// Structure of the global model (e.g. `"arx na=8 nb=8 nk=1"`).
+    pub global_model: Option<String>,
     /// RMS error of the nominal simulation model over the predicted samples \[m\].
     pub sim_rms_error_m: Option<f64>,
     /// Largest absolute error of the nominal simulation model \[m\].
@@ -195,6 +205,12 @@ impl Identification {
             rms_error_m: s.stats.rms,
             max_abs_error_m: s.stats.max_abs,
             fit_percent: s.stats.fit_percent,
+            sim_fit_percent: self
+                .global
+                .as_ref()
+                .map(|g| g.sim_fit_percent)
+                .filter(|f| f.is_finite()),
+            global_model: self.global.as_ref().map(|g| g.structure.clone()),
             sim_rms_error_m: self.simulation_stats.map(|x| x.rms),
             sim_max_abs_error_m: self.simulation_stats.map(|x| x.max_abs),
             nominal_fit_percent: self.simulation_stats.map(|x| x.fit_percent),

@@ -10,6 +10,7 @@ pub mod batch;
 mod companion;
 pub mod engine;
 mod estimator;
+mod global;
 mod identify;
 mod method;
 mod model;
@@ -25,6 +26,7 @@ pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrder
 pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
+pub use global::{fit_global_model, GlobalModel};
 pub use identify::{identify, Identification, IdentifySummary, RESIDUAL_LAGS};
 pub use method::{MethodKind, MethodSpec, METHOD_NAMES};
 pub use model::LinearModel;

@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::stream::Streamer;
-use feedid::ident::{EngineConfig, PaperConfig, Solver};
+use feedid::ident::{EngineConfig, MethodKind, MethodSpec, PaperConfig, Solver};
 use feedid::signal::Scenario;
 
 struct Counting;
@@ -108,5 +108,43 @@ fn steady_state_pushes_allocate_nothing_for_the_paper_method() {
             "{solver:?} hop {hop:?}: {n} allocations in steady state"
         );
         assert_eq!(s.stats().failed_windows, 0);
+    }
+}
+
+#[test]
+fn steady_state_pushes_allocate_nothing_for_the_default_and_linear_methods() {
+    let rate = 5000.0;
+    let command = Scenario::Chirp.command(rate, 0.5, 1).unwrap();
+    let rig = VirtualRig::new(RigParams::default())
+        .with_seed(3)
+        .simulate(&command, rate)
+        .unwrap();
+    for kind in [MethodKind::Auto, MethodKind::Rls, MethodKind::Arx] {
+        let spec = MethodSpec::new(kind);
+        let cfg = EngineConfig {
+            window: spec.default_window(),
+            ..EngineConfig::default()
+        };
+        let mut s = Streamer::new(spec.build().unwrap(), cfg).unwrap();
+        let warm = 400;
+        for k in 0..warm {
+            s.push(rig.time[k], rig.command[k], rig.position[k])
+                .unwrap();
+        }
+        let mut predictions = 0;
+        let n = allocations_in(|| {
+            for k in warm..rig.time.len() {
+                if let Some(p) = s
+                    .push(rig.time[k], rig.command[k], rig.position[k])
+                    .unwrap()
+                {
+                    if p.is_ok() {
+                        predictions += 1;
+                    }
+                }
+            }
+        });
+        assert!(predictions >= 150, "{kind}: {predictions}");
+        assert_eq!(n, 0, "{kind}: {n} allocations in steady state");
     }
 }

@@ -19,6 +19,7 @@ mod residuals;
 mod rls;
 mod srivc;
 pub mod stream;
+mod sweep;
 
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
@@ -38,3 +39,4 @@ pub use paper::{
 pub use residuals::{ResidualAnalysis, Z_99};
 pub use rls::{RlsConfig, RlsEstimator};
 pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};
+pub use sweep::{sweep, SweepConfig, SweepResult, SweepRow, PAPER_WINDOW};

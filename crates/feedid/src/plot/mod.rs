@@ -8,3 +8,4 @@ mod heatmap;
 pub use chart::{palette_hex, Band, LegendPosition, LineChart, Series};
 pub use decimate::decimate_minmax;
 pub use heatmap::HeatMap;
+pub(crate) use heatmap::sig3;

@@ -80,8 +80,8 @@ impl Series {
     }
 }
 
-/// Palette readable in print and by colour-blind readers (Okabe–Ito).
-const PALETTE: [RGBColor; 8] = [
+/// Palette readable in print and by colour-blind readers (Okabe–Ito), plus grey.
+const PALETTE: [RGBColor; 9] = [
     RGBColor(0, 0, 0),
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
@@ -90,6 +90,7 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(230, 159, 0),
     RGBColor(86, 180, 233),
     RGBColor(240, 228, 66),
+    RGBColor(150, 150, 150),
 ];
 
 /// Palette colour `k` as a CSS hex string.
@@ -424,11 +425,17 @@ impl LineChart {
         X: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
+        // linear axes: labels rounded relative to the axis span; log axes: to the value
+        let span = |r: std::ops::Range<f64>, log: bool| (!log).then(|| (r.end - r.start).abs());
+        let x_tick_span = span(chart.x_range(), self.log_x);
+        let y_tick_span = span(chart.y_range(), self.log_y);
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
             .label_style(("sans-serif", 14))
+            .x_label_formatter(&|v| tick_label(*v, x_tick_span))
+            .y_label_formatter(&|v| tick_label(*v, y_tick_span))
             .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
         for b in &self.bands {
@@ -493,6 +500,32 @@ impl LineChart {
         }
         Ok(())
     }
+}
+
+/// An axis tick label: the shortest form of the value rounded to 1e-6 of the
+/// axis span on a linear axis (`span = Some`), or to 12 significant digits on
+/// a log axis (so 0.30000000000000004 reads 0.3 and −5e−17 reads 0), with an
+/// exponent only for very large or small magnitudes.
+pub(crate) fn tick_label(v: f64, span: Option<f64>) -> String {
+    if !v.is_finite() {
+        return String::new();
+    }
+    if v == 0.0 || span.is_some_and(|s| v.abs() < 1e-9 * s) {
+        return "0".into();
+    }
+    let e = match span {
+        Some(s) if s > 0.0 && s.is_finite() => s.log10().floor() as i32 - 6,
+        _ => v.abs().log10().floor() as i32 - 11,
+    };
+    let scale = 10f64.powi(-e);
+    let r = (v * scale).round() / scale;
+    if r == 0.0 {
+        return "0".into();
+    }
+    if !(1e-4..1e7).contains(&r.abs()) {
+        return format!("{r:e}");
+    }
+    format!("{r}")
 }
 
 /// Width of the y-label area plus the left margin \[px\].
@@ -656,6 +689,21 @@ mod tests {
         c.push(Series::new("a", vec![1.0, 10.0, 100.0], vec![1.0, 0.0, 3.0]));
         let svg = c.to_svg().unwrap();
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    }
+
+    #[test]
+    fn tick_labels_are_short_and_never_negative_zero() {
+        let lin = Some(2.1);
+        assert_eq!(tick_label(0.1 + 0.2, lin), "0.3");
+        assert_eq!(tick_label(-0.0, lin), "0");
+        assert_eq!(tick_label(-5.551115123125783e-17, lin), "0");
+        assert_eq!(tick_label(-0.25, lin), "-0.25");
+        assert_eq!(tick_label(2500.0, Some(3000.0)), "2500");
+        assert_eq!(tick_label(1000.0, None), "1000");
+        assert_eq!(tick_label(0.1, None), "0.1");
+        assert_eq!(tick_label(3e7, Some(4e7)), "3e7");
+        assert_eq!(tick_label(2e-5, Some(1e-4)), "2e-5");
+        assert_eq!(tick_label(f64::NAN, lin), "");
     }
 
     #[test]

@@ -167,6 +167,8 @@ dl.facts dd { margin: 0; font-variant-numeric: tabular-nums; }
 nav.toc { background: #f6f7f9; border: 1px solid var(--rule); padding: 10px 18px; margin: 18px 0; }
 nav.toc h2 { border: none; margin: 4px 0; font-size: 17px; }
 nav.toc ol { margin: 4px 0; padding-left: 22px; }
+nav.toc > ol { columns: 2; column-gap: 28px; }
+nav.toc > ol > li { break-inside: avoid; }
 nav.toc li { margin: 1px 0; }
 nav.toc ol ol { font-size: 13.5px; color: var(--muted); }
 a { color: var(--accent); text-decoration: none; }
@@ -180,6 +182,7 @@ caption { text-align: left; color: var(--muted); font-size: 13.5px; padding-bott
 th, td { padding: 4px 10px; border-bottom: 1px solid var(--rule); }
 th { text-align: left; border-bottom: 2px solid var(--ink); background: #fafafa; }
 td.num, th.num { text-align: right; }
+td:first-child { white-space: nowrap; }
 footer { margin-top: 40px; color: var(--muted); font-size: 12.5px; border-top: 1px solid var(--rule); padding-top: 8px; }
 @media (max-width: 820px) { .grid { grid-template-columns: 1fr; } body { padding: 12px; } }
 @media print {

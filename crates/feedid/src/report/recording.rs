@@ -51,6 +51,16 @@ use crate::report::html::{Block, Figure, HtmlReport, Section, Table};
 use crate::solve::Termination;
 use crate::stats::ErrorStats;
 
+/// Palette colours of the methods (0 = measurement, 5 = simulation model, 8 = command).
+const METHOD_COLORS: [usize; 6] = [1, 2, 3, 4, 6, 7];
+const MEASUREMENT: usize = 0;
+const SIMULATION: usize = 5;
+const COMMAND: usize = 8;
+
+fn method_color(i: usize) -> usize {
+    METHOD_COLORS[i % METHOD_COLORS.len()]
+}
+
 /// Longest stretch fitted by the global models \[samples\].
 pub const GLOBAL_FIT_MAX_SAMPLES: usize = 100_000;
 
@@ -426,8 +436,8 @@ impl RecordingAnalysis {
         let r = &self.recording;
         let mut c = LineChart::new("Command and measured position", tl, &format!("position [{unit}]"))
             .with_legend(LegendPosition::Below);
-        c.push(self.whole("command (set-point)", &|k| Some(r.command()[k]), sc).dashed().with_color(5));
-        c.push(self.whole("measured position", &|k| Some(r.position()[k]), sc).with_color(0));
+        c.push(self.whole("measured position", &|k| Some(r.position()[k]), sc).with_color(MEASUREMENT));
+        c.push(self.whole("command (set-point)", &|k| Some(r.command()[k]), sc).dashed().with_color(COMMAND));
         let mut e = LineChart::new("Tracking error: command − measured position", tl, "tracking error [µm]")
             .with_legend(LegendPosition::Hidden);
         e.push(self.whole("command − position", &|k| Some(r.command()[k] - r.position()[k]), 1e6).with_color(1));
@@ -479,20 +489,20 @@ impl RecordingAnalysis {
         .with_legend(LegendPosition::Below);
         zoom.x_range = Some((0.0, self.zoom_ms()));
         let sim = &self.simulated;
-        full.push(self.whole("measurement", &|k| Some(r.position()[k]), sc).with_color(0));
-        full.push(self.whole("simulation model (nominal)", &|k| Some(sim[k]), sc).with_color(6).dashed());
-        zoom.push(self.zoomed("command", &|k| Some(r.command()[k] - y0), 1e6).with_color(5).dashed());
-        zoom.push(self.zoomed("measurement", &|k| Some(r.position()[k] - y0), 1e6).with_color(0));
-        zoom.push(self.zoomed("simulation model (nominal)", &|k| Some(sim[k] - y0), 1e6).with_color(6).dashed());
+        zoom.push(self.zoomed("command", &|k| Some(r.command()[k] - y0), 1e6).with_color(COMMAND).dashed());
         for (i, m) in self.runs.iter().enumerate() {
             let s = &m.identification.sliding;
-            let color = 1 + i % 5 + usize::from(i % 5 >= 4); // skip the command's colour 5
-            full.push(self.whole(&m.label, &|k| s.prediction(k), sc).with_color(color));
+            full.push(self.whole(&m.label, &|k| s.prediction(k), sc).with_color(method_color(i)));
             zoom.push(
                 self.zoomed(&m.label, &|k| s.prediction(k).map(|v| v - y0), 1e6)
-                    .with_color(color),
+                    .with_color(method_color(i)),
             );
         }
+        // measurement and simulation model on top, as the references
+        full.push(self.whole("simulation model (nominal)", &|k| Some(sim[k]), sc).with_color(SIMULATION).dashed());
+        full.push(self.whole("measurement", &|k| Some(r.position()[k]), sc).with_color(MEASUREMENT));
+        zoom.push(self.zoomed("simulation model (nominal)", &|k| Some(sim[k] - y0), 1e6).with_color(SIMULATION).dashed());
+        zoom.push(self.zoomed("measurement", &|k| Some(r.position()[k] - y0), 1e6).with_color(MEASUREMENT));
         // Keep the zoom readable when a method blows up: the y range covers
         // the measurement and the command with a margin; lines leaving it are cut.
         let idx = self.zoom_indices();
@@ -519,8 +529,8 @@ impl RecordingAnalysis {
                 format!("{p}-response"),
                 "Whole recording",
                 &full,
-                "At this scale all curves should lie on top of each other; a curve that leaves the measurement \
-                 shows where a method blows up. Gaps are samples without a prediction (before the first window, or a failed window).",
+                "The black measurement is drawn on top; at this scale all curves should lie under it, and a \
+                 coloured curve that leaves it shows where a method blows up. Gaps are samples without a prediction (before the first window, or a failed window).",
             )?))
             .with(Block::Figure(Self::figure(
                 format!("{p}-response-zoom"),
@@ -554,7 +564,7 @@ impl RecordingAnalysis {
             ys.push(1e6 * s.rms);
         }
         let (xs, ys) = decimate_minmax(&xs, &ys, self.options.max_points);
-        per.push(Series::new("simulation model (nominal)", xs, ys).with_color(6).dashed());
+        per.push(Series::new("simulation model (nominal)", xs, ys).with_color(SIMULATION).dashed());
         let mut zoom = LineChart::new(
             &format!("Error in the first {:.0} ms (as the paper's figures 6 and 8)", self.zoom_ms()),
             "time since motion start [ms]",
@@ -562,10 +572,9 @@ impl RecordingAnalysis {
         )
         .with_legend(LegendPosition::Below);
         zoom.x_range = Some((0.0, self.zoom_ms()));
-        zoom.push(self.zoomed("simulation model (nominal)", &|k| Some(y[k] - self.simulated[k]), 1e6).with_color(6).dashed());
         for (i, m) in self.runs.iter().enumerate() {
             let s = &m.identification.sliding;
-            let color = 1 + i % 5 + usize::from(i % 5 >= 4);
+            let color = method_color(i);
             let (mut xs, mut ys) = (Vec::new(), Vec::new());
             for w in &s.windows {
                 let pairs = w
@@ -585,6 +594,19 @@ impl RecordingAnalysis {
             per.push(Series::new(&m.label, xs, ys).with_color(color));
             zoom.push(self.zoomed(&m.label, &|k| s.prediction(k).map(|v| y[k] - v), 1e6).with_color(color));
         }
+        zoom.push(
+            self.zoomed("simulation model (nominal)", &|k| Some(y[k] - self.simulated[k]), 1e6)
+                .with_color(SIMULATION)
+                .dashed(),
+        );
+        // the same, with the y axis at the simulation model's error scale
+        let mut detail = zoom.clone();
+        detail.title = format!(
+            "Error in the first {:.0} ms, detail at the simulation model's scale",
+            self.zoom_ms()
+        );
+        let lim = 1.3 * (1e6 * self.simulation_zoom.max_abs).max(1.0);
+        detail.y_range = Some((-lim, lim));
         Ok(Section::new(&format!("{p}-error-sec"), "Prediction error per method")
             .with(Block::Figure(Self::figure(
                 format!("{p}-error"),
@@ -598,8 +620,18 @@ impl RecordingAnalysis {
                 format!("{p}-error-zoom"),
                 &format!("Error in the first {:.0} ms of the motion", self.zoom_ms()),
                 &zoom,
-                "Measurement − model, sample by sample, in µm. Compare each method with the simulation model: the \
-                 paper reports its identified model tracking the measurement better than the simulation model.",
+                "Measurement − model, sample by sample, in µm, at full scale: the largest errors of any method.",
+            )?))
+            .with(Block::Figure(Self::figure(
+                format!("{p}-error-zoom-detail"),
+                &format!("Error in the first {:.0} ms, detail", self.zoom_ms()),
+                &detail,
+                &format!(
+                    "The same errors with the y axis limited to ±{lim:.1} µm (1.3 × the simulation model's largest \
+                     error here), so the accurate methods can be compared with the simulation model; larger errors \
+                     are cut at the edge. The paper reports its identified model tracking the measurement better \
+                     than the simulation model."
+                ),
             )?)))
     }
 
@@ -615,7 +647,7 @@ impl RecordingAnalysis {
             let mut c = LineChart::new(
                 &format!("{}: identified coefficients", m.label),
                 tl,
-                "coefficient / median |coefficient|",
+                "coef. / median |coef.|",
             )
             .with_legend(LegendPosition::Below)
             .with_size(900, 380);
@@ -655,11 +687,25 @@ impl RecordingAnalysis {
                 c.push(series);
             }
             all.sort_by(f64::total_cmp);
+            let mut log = false;
             if !all.is_empty() {
                 let q = |f: f64| all[((all.len() - 1) as f64 * f).round() as usize];
                 let (lo, hi) = (q(0.02).min(-1.2), q(0.98).max(1.2));
-                let pad = 0.08 * (hi - lo);
-                c.y_range = Some((lo - pad, hi + pad));
+                if hi - lo > 40.0 {
+                    // coefficients spanning decades: magnitudes on a log axis
+                    log = true;
+                    c.log_y = true;
+                    c.y_label = "|coef.| / median |coef.| (log scale)".into();
+                    c.y_range = Some((1e-3, 1e3));
+                    for series in &mut c.series {
+                        for v in &mut series.y {
+                            *v = v.abs();
+                        }
+                    }
+                } else {
+                    let pad = 0.08 * (hi - lo);
+                    c.y_range = Some((lo - pad, hi + pad));
+                }
             }
             let more = if names.len() > nc {
                 format!(" Only the first {nc} of {} coefficients are drawn.", names.len())
@@ -670,17 +716,25 @@ impl RecordingAnalysis {
                 format!("{p}-coef-{}", m.slug),
                 &format!("{} coefficients over time", m.label),
                 &c,
-                &format!(
-                    "Each coefficient of each window, divided by the median of its magnitude over all windows, so a \
-                     steady coefficient is a flat line at +1 or −1 and the scale is the same for all. A method that \
-                     identifies a consistent model gives flat lines while the motion is informative; lines leaving \
-                     the plot (beyond the 2nd/98th percentile) are cut.{more}"
-                ),
+                &if log {
+                    format!(
+                        "Magnitude of each coefficient of each window divided by the median of its magnitude over \
+                         all windows, on a log axis because the values span decades (the sign is not shown): a steady \
+                         coefficient is a flat line at 1; the plot is cut at 1/1000 and 1000 of the median.{more}"
+                    )
+                } else {
+                    format!(
+                        "Each coefficient of each window divided by the median of its magnitude over all windows, so \
+                         a steady coefficient is a flat line at +1 or −1 and the scale is the same for all. A method \
+                         that identifies a consistent model gives flat lines while the motion is informative; lines \
+                         leaving the plot (beyond the 2nd/98th percentile) are cut.{more}"
+                    )
+                },
             )?);
         }
         let mut sec = Section::new(&format!("{p}-coef-sec"), "Identified coefficients over time");
         sec.blocks.push(Block::Paragraph(
-            "One point per window, at the window's last sample. Names as in `feedid identify --coefficients`: \
+            "One point per window, at the window's last sample. Names as in the coefficients file of feedid identify: \
              the paper method's N2…N0, D7…D0 (eq. 6), ARX/RLS a1…a_na, b_nk…, OE N…, D…."
                 .into(),
         ));
@@ -790,7 +844,7 @@ impl RecordingAnalysis {
         )];
         for (i, g) in self.global.iter().enumerate() {
             curves.push((
-                format!("{} (fit {:.1} %)", g.label, g.simulation.fit_percent),
+                format!("{} (free-run rms {:.2} µm)", g.label, 1e6 * g.simulation.rms),
                 response_model(&g.model, &freqs)?,
                 i + 1,
             ));
@@ -819,7 +873,7 @@ impl RecordingAnalysis {
         let mut sec = Section::new(&format!("{p}-bode-sec"), "Frequency response: identified global models vs nominal model")
             .with(Block::Paragraph(format!(
                 "Models fitted over the whole recording (not per window), next to the nominal physical model from {}. \
-                 The free-run simulation fit of each global model is in the legend. An identified model is only \
+                 The rms error of each global model's free-run simulation is in the legend. An identified model is only \
                  trustworthy at frequencies the command excited: a ramp or step mostly determines the low-frequency \
                  gain and lag; chirps, PRBS or multisines reveal the resonances.",
                 self.options.params_source
@@ -855,7 +909,8 @@ impl RecordingAnalysis {
                 m.label.clone(),
                 format!("{}", s.window),
                 format!("{}", s.horizon),
-                format!("{} ({} failed)", s.windows, s.failed_windows),
+                format!("{}", s.windows),
+                format!("{}", s.failed_windows),
                 format!("{}", s.samples_predicted),
                 um(s.rms_error_m),
                 um(s.max_abs_error_m),
@@ -866,6 +921,7 @@ impl RecordingAnalysis {
         }
         rows.push(vec![
             "simulation model (nominal)".into(),
+            "–".into(),
             "–".into(),
             "–".into(),
             "–".into(),
@@ -888,6 +944,7 @@ impl RecordingAnalysis {
                 "W".into(),
                 "H".into(),
                 "windows".into(),
+                "failed".into(),
                 "samples".into(),
                 "rms [µm]".into(),
                 "max [µm]".into(),
@@ -1033,6 +1090,7 @@ mod tests {
             "rec-response-zoom",
             "rec-error",
             "rec-error-zoom",
+            "rec-error-zoom-detail",
             "rec-coef-paper1",
             "rec-coef-arx2",
         ]
@@ -1078,7 +1136,7 @@ mod tests {
         };
         assert_eq!(t.rows.len(), 3);
         let s = a.runs[1].identification.summary();
-        assert_eq!(t.rows[1][5], format!("{:.3}", 1e6 * s.rms_error_m));
+        assert_eq!(t.rows[1][6], format!("{:.3}", 1e6 * s.rms_error_m));
         assert_eq!(t.rows[2][0], "simulation model (nominal)");
     }
 

@@ -34,7 +34,10 @@ pub fn method_specs(m: &MethodListArgs, default: &str) -> Result<Vec<MethodSpec>
 pub fn run(a: &ReportArgs) -> Result<()> {
     let specs = method_specs(&a.methods, "paper,arx,rls,oe")?;
     if !(a.zoom.is_finite() && a.zoom > 0.0) {
-        bail!("invalid --zoom {}: must be a positive number of milliseconds", a.zoom);
+        bail!(
+            "invalid --zoom {}: must be a positive number of milliseconds",
+            a.zoom
+        );
     }
     let params = load_params(a.params.as_deref())?;
     let rec = recording::load(&a.input, &a.recording)?;
@@ -52,10 +55,10 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         None => "built-in default rig".to_string(),
     };
     opts.zoom_s = a.zoom / 1e3;
-    let name = a
-        .input
-        .file_name()
-        .map_or_else(|| a.input.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let name = a.input.file_name().map_or_else(
+        || a.input.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
     let analysis = RecordingAnalysis::run(&name, rec, &opts)?;
     let page = recording_report(&analysis)?;
     let html = page.to_html();

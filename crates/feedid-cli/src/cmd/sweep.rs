@@ -85,7 +85,9 @@ fn table(res: &SweepResult) -> String {
                 .iter()
                 .find(|r| &r.model_label() == m && r.horizon == *h && r.window == *w)
                 .filter(|r| r.ok())
-                .map_or("–".to_string(), |r| format!("{:.3}", 1e6 * r.rms_common_m));
+                .map_or("–".to_string(), |r| {
+                    format!("{:.3}", 1e6 * r.rms_common_m)
+                });
             let _ = write!(s, " {cell:>10}");
         }
         s.push('\n');
@@ -165,13 +167,19 @@ mod tests {
 
     #[test]
     fn lists_are_parsed_and_bad_values_named() {
-        assert_eq!(parse_counts("--windows", "10, 20,10,40").unwrap(), vec![10, 20, 40]);
+        assert_eq!(
+            parse_counts("--windows", "10, 20,10,40").unwrap(),
+            vec![10, 20, 40]
+        );
         let e = parse_counts("--windows", "0,abc").unwrap_err().to_string();
         assert!(e.contains("`0`"), "{e}");
         let e = parse_counts("--windows", "10,abc").unwrap_err().to_string();
         assert!(e.contains("`abc`") && e.contains("--windows"), "{e}");
         assert!(parse_counts("--horizons", "").is_err());
         assert_eq!(parse_order("4, 4,1").unwrap(), ArxOrders::new(4, 4, 1));
-        assert!(parse_order("4,4").unwrap_err().to_string().contains("`4,4`"));
+        assert!(parse_order("4,4")
+            .unwrap_err()
+            .to_string()
+            .contains("`4,4`"));
     }
 }

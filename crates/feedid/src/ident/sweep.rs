@@ -153,10 +153,7 @@ pub fn sweep(
     cfg: &SweepConfig,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<SweepResult> {
-    for (name, list) in [
-        ("windows", &cfg.windows),
-        ("horizons", &cfg.horizons),
-    ] {
+    for (name, list) in [("windows", &cfg.windows), ("horizons", &cfg.horizons)] {
         if list.is_empty() {
             return Err(Error::InvalidParameter {
                 name,
@@ -252,9 +249,9 @@ pub fn sweep(
             match outcome {
                 Ok(res) => {
                     let mut acc = ErrorAccumulator::default();
-                    for k in common_start..n {
+                    for (k, &yk) in y.iter().enumerate().skip(common_start) {
                         if let Some(p) = res.prediction(k) {
-                            acc.push(y[k], p);
+                            acc.push(yk, p);
                         }
                     }
                     let common = acc.finish();
@@ -356,9 +353,11 @@ impl SweepResult {
         );
         for r in &self.rows {
             let ok = r.ok();
-            let (na, nb, nk) = r.order.map_or((String::new(), String::new(), String::new()), |o| {
-                (o.na.to_string(), o.nb.to_string(), o.nk.to_string())
-            });
+            let (na, nb, nk) = r
+                .order
+                .map_or((String::new(), String::new(), String::new()), |o| {
+                    (o.na.to_string(), o.nb.to_string(), o.nk.to_string())
+                });
             let _ = writeln!(
                 s,
                 "{},{},{},{na},{nb},{nk},{},{},{},{},{},{},{},{},{}",
@@ -386,7 +385,11 @@ impl SweepResult {
         let windows = self.window_list();
         let groups = self.groups();
         let several_h = self.horizon_list().len() > 1;
-        let dt_ms = if self.rate_hz > 0.0 { 1e3 / self.rate_hz } else { 0.0 };
+        let dt_ms = if self.rate_hz > 0.0 {
+            1e3 / self.rate_hz
+        } else {
+            0.0
+        };
         let mut h = HeatMap::new(
             &format!(
                 "Prediction rms error over the common samples (from {:.1} ms on)",
@@ -448,7 +451,11 @@ impl SweepResult {
     /// every method/order, the paper's W = 20 against that method's best window.
     pub fn summary_text(&self) -> String {
         let mut s = String::new();
-        let dt_ms = if self.rate_hz > 0.0 { 1e3 / self.rate_hz } else { 0.0 };
+        let dt_ms = if self.rate_hz > 0.0 {
+            1e3 / self.rate_hz
+        } else {
+            0.0
+        };
         let um = |v: f64| format!("{} µm", sig3(1e6 * v));
         let _ = writeln!(
             s,
@@ -483,28 +490,39 @@ impl SweepResult {
                 continue;
             };
             let at20 = rows.iter().find(|r| r.window == PAPER_WINDOW);
-            let line = match at20 {
-                Some(p) if p.window == best.window => format!(
-                    "{model}, H={hz}: the paper's W={PAPER_WINDOW} is the best window here ({})",
-                    um(p.rms_common_m)
-                ),
-                Some(p) => format!(
-                    "{model}, H={hz}: paper's W={PAPER_WINDOW} gives {}; best W={} gives {} ({:.1}× {})",
-                    um(p.rms_common_m),
-                    best.window,
-                    um(best.rms_common_m),
-                    if best.rms_common_m > 0.0 {
-                        p.rms_common_m / best.rms_common_m
-                    } else {
-                        f64::INFINITY
-                    },
-                    "lower"
-                ),
-                None => format!(
-                    "{model}, H={hz}: best W={} gives {} (W={PAPER_WINDOW} not in the sweep)",
-                    best.window,
+            let worst = rows
+                .iter()
+                .map(|r| r.rms_common_m)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+            let line = if rows.len() > 1 && same(worst, best.rms_common_m) {
+                format!(
+                    "{model}, H={hz}: {} for every window (the window does not change this method here)",
                     um(best.rms_common_m)
-                ),
+                )
+            } else {
+                match at20 {
+                    Some(p) if same(p.rms_common_m, best.rms_common_m) => format!(
+                        "{model}, H={hz}: the paper's W={PAPER_WINDOW} is the best window here ({})",
+                        um(p.rms_common_m)
+                    ),
+                    Some(p) => format!(
+                        "{model}, H={hz}: paper's W={PAPER_WINDOW} gives {}; best W={} gives {} ({:.1}× lower)",
+                        um(p.rms_common_m),
+                        best.window,
+                        um(best.rms_common_m),
+                        if best.rms_common_m > 0.0 {
+                            p.rms_common_m / best.rms_common_m
+                        } else {
+                            f64::INFINITY
+                        }
+                    ),
+                    None => format!(
+                        "{model}, H={hz}: best W={} gives {} (W={PAPER_WINDOW} not in the sweep)",
+                        best.window,
+                        um(best.rms_common_m)
+                    ),
+                }
             };
             let _ = writeln!(s, "{line}");
         }
@@ -559,14 +577,23 @@ mod tests {
         .unwrap();
         // paper: 3 windows × 2 horizons; arx: 2 orders × 3 × 2
         assert_eq!(res.rows.len(), 18);
-        assert_eq!(calls.load(Ordering::Relaxed), 19, "once at 0, then once per combination");
+        assert_eq!(
+            calls.load(Ordering::Relaxed),
+            19,
+            "once at 0, then once per combination"
+        );
         // largest window 80 + the ARX 4,4,1 warm-up of 4 samples
         assert_eq!(res.common_start, 84);
         // a row equals the same run done alone
         let r = res
             .rows
             .iter()
-            .find(|r| r.method == "arx" && r.order == Some(ArxOrders::new(4, 4, 1)) && r.window == 40 && r.horizon == 10)
+            .find(|r| {
+                r.method == "arx"
+                    && r.order == Some(ArxOrders::new(4, 4, 1))
+                    && r.window == 40
+                    && r.horizon == 10
+            })
             .unwrap();
         let mut spec = MethodSpec::new(MethodKind::Arx);
         spec.arx.orders = ArxOrders::new(4, 4, 1);
@@ -574,18 +601,28 @@ mod tests {
         let run = identify(
             &rec,
             est.as_mut(),
-            &EngineConfig { window: 40, horizon: 10, hop: None, warm_up: 0 },
+            &EngineConfig {
+                window: 40,
+                horizon: 10,
+                hop: None,
+                warm_up: 0,
+            },
             None,
         )
         .unwrap();
         assert_eq!(r.rms_m, run.sliding.stats.rms);
         assert_eq!(r.samples_predicted, run.sliding.stats.samples);
         let common = crate::stats::ErrorStats::from_pairs(
-            (84..rec.len()).filter_map(|k| run.sliding.prediction(k).map(|p| (rec.position()[k], p))),
+            (84..rec.len())
+                .filter_map(|k| run.sliding.prediction(k).map(|p| (rec.position()[k], p))),
         );
         assert_eq!(r.rms_common_m, common.rms);
         let best = res.best().unwrap();
-        assert!(res.rows.iter().filter(|r| r.ok()).all(|r| r.rms_common_m >= best.rms_common_m));
+        assert!(res
+            .rows
+            .iter()
+            .filter(|r| r.ok())
+            .all(|r| r.rms_common_m >= best.rms_common_m));
     }
 
     #[test]
@@ -620,8 +657,15 @@ mod tests {
         // the oversized window does not move the common start
         assert_eq!(res.common_start, 84);
         let text = res.summary_text();
-        assert!(text.contains("paper, H=10: paper's W=20 gives") || text.contains("paper, H=10: the paper's W=20 is the best"), "{text}");
-        assert!(text.contains("6 of 24 combinations could not run"), "{text}");
+        assert!(
+            text.contains("paper, H=10: paper's W=20 gives")
+                || text.contains("paper, H=10: the paper's W=20 is the best"),
+            "{text}"
+        );
+        assert!(
+            text.contains("6 of 24 combinations could not run"),
+            "{text}"
+        );
     }
 
     #[test]

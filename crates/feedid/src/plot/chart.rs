@@ -371,8 +371,8 @@ impl LineChart {
         } else {
             LEGEND_ROW * rows.len() as u32 + 8
         };
-        let root = SVGBackend::with_string(out, (self.width, self.height + legend_h))
-            .into_drawing_area();
+        let root =
+            SVGBackend::with_string(out, (self.width, self.height + legend_h)).into_drawing_area();
         root.fill(&WHITE)?;
         let (plot, below) = root.split_vertically(self.height);
         let mut builder = ChartBuilder::on(&plot);
@@ -597,11 +597,7 @@ where
             } else {
                 area.draw(&PathElement::new(vec![(x, y), (x + 22, y)], style))?;
             }
-            area.draw(&Text::new(
-                it.label.clone(),
-                (x + 28, y - 7),
-                font.clone(),
-            ))?;
+            area.draw(&Text::new(it.label.clone(), (x + 28, y - 7), font.clone()))?;
         }
     }
     Ok(())
@@ -686,7 +682,11 @@ mod tests {
         let mut c = LineChart::new("T", "f [Hz]", "|e| [µm]");
         c.log_x = true;
         c.log_y = true;
-        c.push(Series::new("a", vec![1.0, 10.0, 100.0], vec![1.0, 0.0, 3.0]));
+        c.push(Series::new(
+            "a",
+            vec![1.0, 10.0, 100.0],
+            vec![1.0, 0.0, 3.0],
+        ));
         let svg = c.to_svg().unwrap();
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
     }

@@ -106,7 +106,10 @@ mod tests {
         let max_points = 2000;
         let (xd, yd) = decimate_minmax(&x, &y, max_points);
         assert!(xd.len() <= max_points, "{}", xd.len());
-        assert!(xd.windows(2).all(|w| w[0] < w[1]), "abscissae stay increasing");
+        assert!(
+            xd.windows(2).all(|w| w[0] < w[1]),
+            "abscissae stay increasing"
+        );
         let b = n.div_ceil(max_points / 2);
         for chunk in (0..n).step_by(b) {
             let hi = (chunk + b).min(n);

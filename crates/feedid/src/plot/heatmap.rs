@@ -68,7 +68,11 @@ const VIRIDIS: [(f64, f64, f64); 9] = [
 
 /// Viridis colour at `t ∈ [0, 1]` (clamped) as `(r, g, b)`.
 fn viridis(t: f64) -> (u8, u8, u8) {
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let x = t * 8.0;
     let i = (x.floor() as usize).min(7);
     let f = x - i as f64;
@@ -105,9 +109,17 @@ pub(crate) fn sig3(v: f64) -> String {
     }
 }
 
+/// `3.00` → `3`, `30.0` → `30`, `0.250` → `0.25` (tick labels).
+fn trim_zeros(s: &str) -> String {
+    if s.contains('.') && !s.contains('e') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s.to_string()
+    }
+}
+
 const CELL_W: f64 = 92.0;
-const CELL_H: f64 = 34.0;
-const TOP: f64 = 64.0;
+const TOP: f64 = 84.0;
 
 impl HeatMap {
     /// An empty heat map with a logarithmic colour scale.
@@ -173,12 +185,14 @@ impl HeatMap {
             * 7.6
             + 44.0;
         let left = label_w.max(90.0);
+        // few rows get taller cells so the map is not a thin strip
+        let cell_h = (150.0 / nr.max(1) as f64).clamp(34.0, 56.0);
         let map_w = CELL_W * nc as f64;
-        let map_h = CELL_H * nr as f64;
-        let bar_h = map_h.max(160.0);
+        let map_h = cell_h * nr as f64;
+        let bar_h = map_h.max(120.0);
         let bar_x = left + map_w + 28.0;
         let width = (bar_x + 20.0 + 90.0).max(left + self.title.chars().count() as f64 * 9.5);
-        let height = TOP + bar_h + 56.0;
+        let height = TOP + bar_h + 24.0;
         let mut s = String::new();
         let _ = write!(
             s,
@@ -201,7 +215,7 @@ impl HeatMap {
             s,
             r#"<text x="{:.1}" y="{:.1}" font-size="14" text-anchor="middle">{}</text>"#,
             left + map_w / 2.0,
-            TOP - 26.0,
+            TOP - 30.0,
             xml(&self.x_label)
         );
         for (j, c) in self.columns.iter().enumerate() {
@@ -222,12 +236,12 @@ impl HeatMap {
         );
         let range = self.range();
         for (i, r) in self.rows.iter().enumerate() {
-            let y = TOP + CELL_H * i as f64;
+            let y = TOP + cell_h * i as f64;
             let _ = write!(
                 s,
                 r#"<text x="{:.1}" y="{:.1}" font-size="13" text-anchor="end">{}</text>"#,
                 left - 8.0,
-                y + CELL_H / 2.0 + 4.5,
+                y + cell_h / 2.0 + 4.5,
                 xml(r)
             );
             for (j, c) in self.columns.iter().enumerate() {
@@ -236,8 +250,7 @@ impl HeatMap {
                 let (fill, text_color, text) = match range {
                     Some((lo, hi)) if self.usable(v) => {
                         let (r8, g8, b8) = viridis(self.position(v, lo, hi));
-                        let lum =
-                            0.2126 * r8 as f64 + 0.7152 * g8 as f64 + 0.0722 * b8 as f64;
+                        let lum = 0.2126 * r8 as f64 + 0.7152 * g8 as f64 + 0.0722 * b8 as f64;
                         let tc = if lum < 140.0 { "#ffffff" } else { "#000000" };
                         (format!("#{r8:02x}{g8:02x}{b8:02x}"), tc, sig3(v))
                     }
@@ -245,7 +258,7 @@ impl HeatMap {
                 };
                 let _ = write!(
                     s,
-                    r##"<rect class="cell" x="{x:.1}" y="{y:.1}" width="{CELL_W:.1}" height="{CELL_H:.1}" fill="{fill}" stroke="#ffffff" stroke-width="1"><title>{} · {}: {}</title></rect>"##,
+                    r##"<rect class="cell" x="{x:.1}" y="{y:.1}" width="{CELL_W:.1}" height="{cell_h:.1}" fill="{fill}" stroke="#ffffff" stroke-width="1"><title>{} · {}: {}</title></rect>"##,
                     xml(r),
                     xml(c),
                     text
@@ -254,7 +267,7 @@ impl HeatMap {
                     s,
                     r#"<text x="{:.1}" y="{:.1}" font-size="13" text-anchor="middle" fill="{text_color}">{}</text>"#,
                     x + CELL_W / 2.0,
-                    y + CELL_H / 2.0 + 4.5,
+                    y + cell_h / 2.0 + 4.5,
                     text
                 );
             }
@@ -265,9 +278,9 @@ impl HeatMap {
                     s,
                     r##"<rect class="mark" x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="none" stroke="#d55e00" stroke-width="3.5"/>"##,
                     left + CELL_W * j as f64 + 1.75,
-                    TOP + CELL_H * i as f64 + 1.75,
+                    TOP + cell_h * i as f64 + 1.75,
                     CELL_W - 3.5,
-                    CELL_H - 3.5
+                    cell_h - 3.5
                 );
             }
         }
@@ -313,7 +326,7 @@ impl HeatMap {
                 x + 25.0,
                 x + 28.0,
                 y + 4.0,
-                sig3(v)
+                trim_zeros(&sig3(v))
             );
         }
     }
@@ -359,7 +372,9 @@ mod tests {
         let mut h = HeatMap::new("t", "window W [samples]", "method", "rms [µm]");
         h.columns = (0..cols).map(|j| format!("{}", 10 << j)).collect();
         h.rows = (0..rows).map(|i| format!("m<{i}>")).collect();
-        h.values = (0..rows * cols).map(|k| 0.1 * 3f64.powi(k as i32)).collect();
+        h.values = (0..rows * cols)
+            .map(|k| 0.1 * 3f64.powi(k as i32))
+            .collect();
         h
     }
 
@@ -391,6 +406,10 @@ mod tests {
         let h = map(1, 3);
         let (lo, hi) = (1.0, 100.0);
         assert!((h.position(10.0, lo, hi) - 0.5).abs() < 1e-12);
+        assert_eq!(trim_zeros("3.00"), "3");
+        assert_eq!(trim_zeros("30.0"), "30");
+        assert_eq!(trim_zeros("0.250"), "0.25");
+        assert_eq!(trim_zeros("270"), "270");
         assert_eq!(viridis(0.0), (68, 1, 84));
         assert_eq!(viridis(1.0), (253, 231, 37));
         assert_eq!(viridis(0.5), (33, 144, 141));

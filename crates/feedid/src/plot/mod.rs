@@ -7,5 +7,5 @@ mod heatmap;
 
 pub use chart::{palette_hex, Band, LegendPosition, LineChart, Series};
 pub use decimate::decimate_minmax;
-pub use heatmap::HeatMap;
 pub(crate) use heatmap::sig3;
+pub use heatmap::HeatMap;

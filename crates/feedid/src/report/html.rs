@@ -438,10 +438,11 @@ mod tests {
                 header: vec!["name".into(), "rms [µm]".into()],
                 rows: vec![vec!["<m>".into(), "1.25".into()]],
             }));
-        s.subsections.push(Section::new("sec-b", "Sub").with(Block::Grid(vec![
-            Figure::new("f2", "Second", &svg(), "c2"),
-            Figure::new("f3", "Third", &svg(), "c3"),
-        ])));
+        s.subsections
+            .push(Section::new("sec-b", "Sub").with(Block::Grid(vec![
+                Figure::new("f2", "Second", &svg(), "c2"),
+                Figure::new("f3", "Third", &svg(), "c3"),
+            ])));
         p.sections.push(s);
         p
     }
@@ -481,7 +482,10 @@ mod tests {
 
     #[test]
     fn escape_html_handles_every_special_character() {
-        assert_eq!(escape_html("<a href='x'>&\"</a>"), "&lt;a href=&#39;x&#39;&gt;&amp;&quot;&lt;/a&gt;");
+        assert_eq!(
+            escape_html("<a href='x'>&\"</a>"),
+            "&lt;a href=&#39;x&#39;&gt;&amp;&quot;&lt;/a&gt;"
+        );
         assert_eq!(escape_html("µm – ok"), "µm – ok");
     }
 }

@@ -202,7 +202,15 @@ mod tests {
         let page = paper_report(&results, &cfg, &[MethodSpec::new(MethodKind::Arx)]).unwrap();
         let ids = page.figure_ids();
         for exp in ["ramp", "step"] {
-            for f in ["overview", "response-zoom", "error-zoom", "bode-mag", "coef-paper1", "coef-arx2", "ree-arx2"] {
+            for f in [
+                "overview",
+                "response-zoom",
+                "error-zoom",
+                "bode-mag",
+                "coef-paper1",
+                "coef-arx2",
+                "ree-arx2",
+            ] {
                 let id = format!("{exp}-{f}");
                 assert!(ids.contains(&id), "{id} in {ids:?}");
             }

@@ -177,8 +177,8 @@ impl RecordingAnalysis {
     pub fn run(name: &str, recording: Recording, opts: &ReportOptions) -> Result<Self> {
         let dt = recording.dt();
         let simulated = simulate_nominal(&opts.params, recording.command(), dt)?;
-        let nominal = closed_loop_coefficients(&opts.params, D1Variant::Corrected)
-            .transfer_function()?;
+        let nominal =
+            closed_loop_coefficients(&opts.params, D1Variant::Corrected).transfer_function()?;
         let motion_start = recording.motion_start_time();
         let t = recording.time();
         let y = recording.position();
@@ -339,10 +339,7 @@ impl RecordingAnalysis {
                     format!("H = {h} samples ({:.2} ms)", 1e3 * h as f64 * r.dt())
                 }),
             ),
-            (
-                "nominal model".into(),
-                self.options.params_source.clone(),
-            ),
+            ("nominal model".into(), self.options.params_source.clone()),
         ]
     }
 
@@ -434,13 +431,35 @@ impl RecordingAnalysis {
         let (sc, unit) = self.position_unit();
         let (_, tl) = self.time_axis();
         let r = &self.recording;
-        let mut c = LineChart::new("Command and measured position", tl, &format!("position [{unit}]"))
-            .with_legend(LegendPosition::Below);
-        c.push(self.whole("measured position", &|k| Some(r.position()[k]), sc).with_color(MEASUREMENT));
-        c.push(self.whole("command (set-point)", &|k| Some(r.command()[k]), sc).dashed().with_color(COMMAND));
-        let mut e = LineChart::new("Tracking error: command − measured position", tl, "tracking error [µm]")
-            .with_legend(LegendPosition::Hidden);
-        e.push(self.whole("command − position", &|k| Some(r.command()[k] - r.position()[k]), 1e6).with_color(1));
+        let mut c = LineChart::new(
+            "Command and measured position",
+            tl,
+            &format!("position [{unit}]"),
+        )
+        .with_legend(LegendPosition::Below);
+        c.push(
+            self.whole("measured position", &|k| Some(r.position()[k]), sc)
+                .with_color(MEASUREMENT),
+        );
+        c.push(
+            self.whole("command (set-point)", &|k| Some(r.command()[k]), sc)
+                .dashed()
+                .with_color(COMMAND),
+        );
+        let mut e = LineChart::new(
+            "Tracking error: command − measured position",
+            tl,
+            "tracking error [µm]",
+        )
+        .with_legend(LegendPosition::Hidden);
+        e.push(
+            self.whole(
+                "command − position",
+                &|k| Some(r.command()[k] - r.position()[k]),
+                1e6,
+            )
+            .with_color(1),
+        );
         Ok(Section::new(&format!("{p}-overview-sec"), "Recording overview")
             .with(Block::Paragraph(format!(
                 "The whole recording as read: the command the controller received and the position the encoder measured. \
@@ -489,20 +508,41 @@ impl RecordingAnalysis {
         .with_legend(LegendPosition::Below);
         zoom.x_range = Some((0.0, self.zoom_ms()));
         let sim = &self.simulated;
-        zoom.push(self.zoomed("command", &|k| Some(r.command()[k] - y0), 1e6).with_color(COMMAND).dashed());
+        zoom.push(
+            self.zoomed("command", &|k| Some(r.command()[k] - y0), 1e6)
+                .with_color(COMMAND)
+                .dashed(),
+        );
         for (i, m) in self.runs.iter().enumerate() {
             let s = &m.identification.sliding;
-            full.push(self.whole(&m.label, &|k| s.prediction(k), sc).with_color(method_color(i)));
+            full.push(
+                self.whole(&m.label, &|k| s.prediction(k), sc)
+                    .with_color(method_color(i)),
+            );
             zoom.push(
                 self.zoomed(&m.label, &|k| s.prediction(k).map(|v| v - y0), 1e6)
                     .with_color(method_color(i)),
             );
         }
         // measurement and simulation model on top, as the references
-        full.push(self.whole("simulation model (nominal)", &|k| Some(sim[k]), sc).with_color(SIMULATION).dashed());
-        full.push(self.whole("measurement", &|k| Some(r.position()[k]), sc).with_color(MEASUREMENT));
-        zoom.push(self.zoomed("simulation model (nominal)", &|k| Some(sim[k] - y0), 1e6).with_color(SIMULATION).dashed());
-        zoom.push(self.zoomed("measurement", &|k| Some(r.position()[k] - y0), 1e6).with_color(MEASUREMENT));
+        full.push(
+            self.whole("simulation model (nominal)", &|k| Some(sim[k]), sc)
+                .with_color(SIMULATION)
+                .dashed(),
+        );
+        full.push(
+            self.whole("measurement", &|k| Some(r.position()[k]), sc)
+                .with_color(MEASUREMENT),
+        );
+        zoom.push(
+            self.zoomed("simulation model (nominal)", &|k| Some(sim[k] - y0), 1e6)
+                .with_color(SIMULATION)
+                .dashed(),
+        );
+        zoom.push(
+            self.zoomed("measurement", &|k| Some(r.position()[k] - y0), 1e6)
+                .with_color(MEASUREMENT),
+        );
         // Keep the zoom readable when a method blows up: the y range covers
         // the measurement and the command with a margin; lines leaving it are cut.
         let idx = self.zoom_indices();
@@ -517,7 +557,10 @@ impl RecordingAnalysis {
             let m = 0.15 * (hi - lo);
             zoom.y_range = Some((lo - m, hi + m));
         }
-        let h = self.runs.first().map_or(10, |m| m.identification.config.horizon);
+        let h = self
+            .runs
+            .first()
+            .map_or(10, |m| m.identification.config.horizon);
         Ok(Section::new(&format!("{p}-response-sec"), "Measured vs simulation model vs predictions")
             .with(Block::Paragraph(format!(
                 "Each method fits a model to the last W samples and predicts the next H = {h} samples ({:.1} ms) \
@@ -555,7 +598,11 @@ impl RecordingAnalysis {
         .with_legend(LegendPosition::Below);
         per.log_y = true;
         // simulation model over blocks as long as the first method's horizon
-        let h = self.runs.first().map_or(10, |m| m.identification.config.horizon).max(1);
+        let h = self
+            .runs
+            .first()
+            .map_or(10, |m| m.identification.config.horizon)
+            .max(1);
         let (mut xs, mut ys) = (Vec::new(), Vec::new());
         for start in (0..y.len()).step_by(h) {
             let end = (start + h).min(y.len());
@@ -564,9 +611,16 @@ impl RecordingAnalysis {
             ys.push(1e6 * s.rms);
         }
         let (xs, ys) = decimate_minmax(&xs, &ys, self.options.max_points);
-        per.push(Series::new("simulation model (nominal)", xs, ys).with_color(SIMULATION).dashed());
+        per.push(
+            Series::new("simulation model (nominal)", xs, ys)
+                .with_color(SIMULATION)
+                .dashed(),
+        );
         let mut zoom = LineChart::new(
-            &format!("Error in the first {:.0} ms (as the paper's figures 6 and 8)", self.zoom_ms()),
+            &format!(
+                "Error in the first {:.0} ms (as the paper's figures 6 and 8)",
+                self.zoom_ms()
+            ),
             "time since motion start [ms]",
             "measurement − model [µm]",
         )
@@ -592,12 +646,19 @@ impl RecordingAnalysis {
             }
             let (xs, ys) = decimate_minmax(&xs, &ys, self.options.max_points);
             per.push(Series::new(&m.label, xs, ys).with_color(color));
-            zoom.push(self.zoomed(&m.label, &|k| s.prediction(k).map(|v| y[k] - v), 1e6).with_color(color));
+            zoom.push(
+                self.zoomed(&m.label, &|k| s.prediction(k).map(|v| y[k] - v), 1e6)
+                    .with_color(color),
+            );
         }
         zoom.push(
-            self.zoomed("simulation model (nominal)", &|k| Some(y[k] - self.simulated[k]), 1e6)
-                .with_color(SIMULATION)
-                .dashed(),
+            self.zoomed(
+                "simulation model (nominal)",
+                &|k| Some(y[k] - self.simulated[k]),
+                1e6,
+            )
+            .with_color(SIMULATION)
+            .dashed(),
         );
         // the same, with the y axis at the simulation model's error scale
         let mut detail = zoom.clone();
@@ -708,7 +769,10 @@ impl RecordingAnalysis {
                 }
             }
             let more = if names.len() > nc {
-                format!(" Only the first {nc} of {} coefficients are drawn.", names.len())
+                format!(
+                    " Only the first {nc} of {} coefficients are drawn.",
+                    names.len()
+                )
             } else {
                 String::new()
             };
@@ -732,7 +796,10 @@ impl RecordingAnalysis {
                 },
             )?);
         }
-        let mut sec = Section::new(&format!("{p}-coef-sec"), "Identified coefficients over time");
+        let mut sec = Section::new(
+            &format!("{p}-coef-sec"),
+            "Identified coefficients over time",
+        );
         sec.blocks.push(Block::Paragraph(
             "One point per window, at the window's last sample. Names as in the coefficients file of feedid identify: \
              the paper method's N2…N0, D7…D0 (eq. 6), ARX/RLS a1…a_na, b_nk…, OE N…, D…."
@@ -776,23 +843,43 @@ impl RecordingAnalysis {
                 }
                 (x, y)
             };
-            let mut ee = LineChart::new(&format!("{}: r_ee", m.label), "lag τ [ms]", "autocorrelation [–]")
-                .with_legend(LegendPosition::Below)
-                .with_size(560, 320);
+            let mut ee = LineChart::new(
+                &format!("{}: r_ee", m.label),
+                "lag τ [ms]",
+                "autocorrelation [–]",
+            )
+            .with_legend(LegendPosition::Below)
+            .with_size(560, 320);
             let (x, y) = stems(&mut ra.r_ee.iter().enumerate().map(|(k, &v)| (k as isize, v)));
             ee.push(Series::new("r_ee(τ)", x, y).with_color(1));
             ee.bands.push(band.clone());
             ee.y_range = Some((-1.05, 1.05));
-            let mut ue = LineChart::new(&format!("{}: r_ue", m.label), "lag τ [ms]", "cross-correlation [–]")
-                .with_legend(LegendPosition::Below)
-                .with_size(560, 320);
+            let mut ue = LineChart::new(
+                &format!("{}: r_ue", m.label),
+                "lag τ [ms]",
+                "cross-correlation [–]",
+            )
+            .with_legend(LegendPosition::Below)
+            .with_size(560, 320);
             let ml = ra.max_lag as isize;
-            let (x, y) = stems(&mut ra.r_ue.iter().enumerate().map(|(k, &v)| (k as isize - ml, v)));
+            let (x, y) = stems(
+                &mut ra
+                    .r_ue
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &v)| (k as isize - ml, v)),
+            );
             ue.push(Series::new("r_ue(τ)", x, y).with_color(2));
             ue.bands.push(band);
             let peak = ra.r_ue.iter().fold(ra.bound, |a, v| a.max(v.abs()));
             ue.y_range = Some((-1.1 * peak, 1.1 * peak));
-            let verdict = |inside: bool| if inside { "inside the band" } else { "outside the band" };
+            let verdict = |inside: bool| {
+                if inside {
+                    "inside the band"
+                } else {
+                    "outside the band"
+                }
+            };
             sec.blocks.push(Block::Grid(vec![
                 Self::figure(
                     format!("{p}-ree-{}", m.slug),
@@ -803,7 +890,11 @@ impl RecordingAnalysis {
                         ra.ee_outside,
                         ra.max_lag,
                         ra.samples,
-                        if ra.ee_inside { "white enough" } else { "correlated — predictable structure is left in the error" }
+                        if ra.ee_inside {
+                            "white enough"
+                        } else {
+                            "correlated — predictable structure is left in the error"
+                        }
                     ),
                 )?,
                 Self::figure(
@@ -831,8 +922,12 @@ impl RecordingAnalysis {
         let freqs: Vec<f64> = (0..n)
             .map(|i| f_lo * (f_hi / f_lo).powf(i as f64 / (n - 1) as f64))
             .collect();
-        let mut mag = LineChart::new("Bode magnitude", "frequency [Hz] (log scale)", "magnitude [dB]")
-            .with_legend(LegendPosition::Below);
+        let mut mag = LineChart::new(
+            "Bode magnitude",
+            "frequency [Hz] (log scale)",
+            "magnitude [dB]",
+        )
+        .with_legend(LegendPosition::Below);
         mag.log_x = true;
         let mut ph = LineChart::new("Bode phase", "frequency [Hz] (log scale)", "phase [deg]")
             .with_legend(LegendPosition::Below);
@@ -844,7 +939,11 @@ impl RecordingAnalysis {
         )];
         for (i, g) in self.global.iter().enumerate() {
             curves.push((
-                format!("{} (free-run rms {:.2} µm)", g.label, 1e6 * g.simulation.rms),
+                format!(
+                    "{} (free-run rms {:.2} µm)",
+                    g.label,
+                    1e6 * g.simulation.rms
+                ),
                 response_model(&g.model, &freqs)?,
                 i + 1,
             ));
@@ -899,8 +998,20 @@ impl RecordingAnalysis {
     }
 
     fn summary_section(&self, p: &str) -> Section {
-        let um = |v: f64| if v.is_finite() { format!("{:.3}", 1e6 * v) } else { "–".into() };
-        let pct = |v: f64| if v.is_finite() && v > -1e6 { format!("{v:.2}") } else { "–".into() };
+        let um = |v: f64| {
+            if v.is_finite() {
+                format!("{:.3}", 1e6 * v)
+            } else {
+                "–".into()
+            }
+        };
+        let pct = |v: f64| {
+            if v.is_finite() && v > -1e6 {
+                format!("{v:.2}")
+            } else {
+                "–".into()
+            }
+        };
         let z = self.zoom_ms();
         let mut rows = Vec::new();
         for m in &self.runs {
@@ -915,7 +1026,11 @@ impl RecordingAnalysis {
                 um(s.rms_error_m),
                 um(s.max_abs_error_m),
                 pct(s.fit_percent),
-                if m.zoom_stats.samples > 0 { um(m.zoom_stats.rms) } else { "–".into() },
+                if m.zoom_stats.samples > 0 {
+                    um(m.zoom_stats.rms)
+                } else {
+                    "–".into()
+                },
                 format!("{:.2}", s.per_window_us),
             ]);
         }
@@ -934,11 +1049,11 @@ impl RecordingAnalysis {
         ]);
         let table = Table {
             id: format!("{p}-summary"),
-            caption: format!(
+            caption:
                 "k-step-ahead prediction errors (measurement − prediction) over every predicted sample; the \
                  simulation model over all samples. Fit = NRMSE fit (100 % is perfect). Time = identification and \
                  prediction per window, methods run in parallel."
-            ),
+                .into(),
             header: vec![
                 "method".into(),
                 "W".into(),
@@ -954,7 +1069,8 @@ impl RecordingAnalysis {
             ],
             rows,
         };
-        let mut sec = Section::new(&format!("{p}-summary-sec"), "Summary").with(Block::Table(table));
+        let mut sec =
+            Section::new(&format!("{p}-summary-sec"), "Summary").with(Block::Table(table));
         if !self.global.is_empty() {
             sec.blocks.push(Block::Table(Table {
                 id: format!("{p}-global"),
@@ -1057,7 +1173,10 @@ mod tests {
 
     fn ramp() -> Recording {
         let cmd = Scenario::Ramp.command(5000.0, 0.2, 1).unwrap();
-        let out = VirtualRig::new(RigParams::default()).with_seed(1).simulate(&cmd, 5000.0).unwrap();
+        let out = VirtualRig::new(RigParams::default())
+            .with_seed(1)
+            .simulate(&cmd, 5000.0)
+            .unwrap();
         Recording::new(out.time, out.command, out.position).unwrap()
     }
 
@@ -1111,13 +1230,26 @@ mod tests {
         for id in &ids {
             assert!(html.contains(&format!("<figure id=\"{id}\">")), "{id}");
         }
-        for sec in ["overview-sec", "response-sec", "error-sec", "coef-sec", "resid-sec", "bode-sec", "summary-sec"] {
-            assert!(html.contains(&format!("<section id=\"rec-{sec}\">")), "{sec}");
+        for sec in [
+            "overview-sec",
+            "response-sec",
+            "error-sec",
+            "coef-sec",
+            "resid-sec",
+            "bode-sec",
+            "summary-sec",
+        ] {
+            assert!(
+                html.contains(&format!("<section id=\"rec-{sec}\">")),
+                "{sec}"
+            );
         }
         assert_eq!(html.matches("<svg ").count(), ids.len());
         assert!(html.contains("ramp &lt;test&gt;.csv"));
         assert!(!html.contains("ramp <test>"));
-        for bad in ["http://", "https://", "<script", "<link", "<img", "<iframe", "NaN", "inf\""] {
+        for bad in [
+            "http://", "https://", "<script", "<link", "<img", "<iframe", "NaN", "inf\"",
+        ] {
             assert!(!html.contains(bad), "{bad}");
         }
         assert!(html.contains("[µm]") && html.contains("[ms]"));

@@ -51,8 +51,8 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     let mut opts = ReportOptions::new(methods);
     opts.params = params;
     opts.params_source = match &a.params {
-        Some(p) => format!("rig parameters {}", p.display()),
-        None => "built-in default rig".to_string(),
+        Some(p) => format!("the rig parameters in {}", p.display()),
+        None => "the built-in default rig".to_string(),
     };
     opts.zoom_s = a.zoom / 1e3;
     let name = a.input.file_name().map_or_else(

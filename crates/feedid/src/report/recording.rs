@@ -71,7 +71,7 @@ pub struct ReportOptions {
     pub methods: Vec<(MethodSpec, EngineConfig)>,
     /// Rig parameters of the nominal model; default: the default rig.
     pub params: RigParams,
-    /// Where the parameters came from (shown in the header); default "built-in default rig".
+    /// Where the parameters came from (shown in the header); default "the built-in default rig".
     pub params_source: String,
     /// Zoom after the motion start \[s\]; default 0.06 (the paper's figures 5 and 7).
     pub zoom_s: f64,
@@ -89,7 +89,7 @@ impl ReportOptions {
         Self {
             methods,
             params: RigParams::default(),
-            params_source: "built-in default rig".to_string(),
+            params_source: "the built-in default rig".to_string(),
             zoom_s: 0.06,
             max_points: 3000,
             max_lag: 30,
@@ -256,7 +256,18 @@ impl RecordingAnalysis {
                 .map(|(s, _)| s.oe.clone())
                 .unwrap_or_default();
             let arx_label = format!("global ARX {},{},{}", orders.na, orders.nb, orders.nk);
-            let oe_label = format!("global OE {} poles, {} zeros", oe_cfg.poles, oe_cfg.zeros);
+            let plural = |n: usize, what: &str| {
+                if n == 1 {
+                    format!("1 {what}")
+                } else {
+                    format!("{n} {what}s")
+                }
+            };
+            let oe_label = format!(
+                "global OE {}, {}",
+                plural(oe_cfg.poles, "pole"),
+                plural(oe_cfg.zeros, "zero")
+            );
             let (arx, oe) = rayon::join(
                 || global_arx(ug, yg, dt, orders),
                 || global_oe(ug, yg, dt, &oe_cfg),

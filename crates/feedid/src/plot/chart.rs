@@ -195,7 +195,8 @@ impl LineChart {
 
     /// Cut a polyline at the fixed axis ranges (exact intersections, in the
     /// axes' linear or log coordinates) so out-of-range data leave the plot
-    /// where they really do instead of being pinned to its edge.
+    /// where they really do; between leaving and coming back through the
+    /// same top or bottom edge the line runs along that edge.
     fn clip(&self, seg: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
         if self.x_range.is_none() && self.y_range.is_none() {
             return vec![seg];
@@ -220,47 +221,62 @@ impl LineChart {
             }
             return out;
         }
+        // A line that leaves through the top or bottom edge and comes back
+        // through the same edge continues along that edge (one polyline,
+        // drawn as if pinned there) instead of starting a new polyline.
+        let mut parked: Option<usize> = None;
         for w in seg.windows(2) {
             let (p, q) = ((fx(w[0].0), fy(w[0].1)), (fx(w[1].0), fy(w[1].1)));
-            // Liang–Barsky: p + t·(q − p), t ∈ [t0, t1]
+            // Liang–Barsky: p + t·(q − p), t ∈ [t0, t1]; edges 0 left, 1 right, 2 bottom, 3 top
             let (dx, dy) = (q.0 - p.0, q.1 - p.1);
             let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+            let (mut e0, mut e1) = (usize::MAX, usize::MAX);
             let mut visible = true;
-            for (pk, qk) in [
+            for (edge, (pk, qk)) in [
                 (-dx, p.0 - xa),
                 (dx, xb - p.0),
                 (-dy, p.1 - ya),
                 (dy, yb - p.1),
-            ] {
+            ]
+            .into_iter()
+            .enumerate()
+            {
                 if pk == 0.0 {
                     if qk < 0.0 {
                         visible = false;
                     }
                 } else {
                     let r = qk / pk;
-                    if pk < 0.0 {
-                        t0 = t0.max(r);
-                    } else {
-                        t1 = t1.min(r);
+                    if pk < 0.0 && r > t0 {
+                        t0 = r;
+                        e0 = edge;
+                    } else if pk > 0.0 && r < t1 {
+                        t1 = r;
+                        e1 = edge;
                     }
                 }
             }
             if !visible || t0 > t1 {
-                if !cur.is_empty() {
+                if parked.is_none() && !cur.is_empty() {
                     out.push(std::mem::take(&mut cur));
                 }
                 continue;
             }
             let at = |t: f64| (gx(p.0 + t * dx), gy(p.1 + t * dy));
-            if t0 > 0.0 && !cur.is_empty() {
+            if t0 > 0.0 && !cur.is_empty() && parked != Some(e0) {
                 out.push(std::mem::take(&mut cur));
             }
-            if cur.is_empty() {
+            parked = None;
+            if cur.is_empty() || t0 > 0.0 {
                 cur.push(if t0 > 0.0 { at(t0) } else { w[0] });
             }
             cur.push(if t1 < 1.0 { at(t1) } else { w[1] });
             if t1 < 1.0 {
-                out.push(std::mem::take(&mut cur));
+                if e1 >= 2 {
+                    parked = Some(e1);
+                } else {
+                    out.push(std::mem::take(&mut cur));
+                }
             }
         }
         if !cur.is_empty() {
@@ -639,13 +655,28 @@ mod tests {
         c.y_range = Some((0.0, 1.0));
         let seg = vec![(0.0, 0.5), (1.0, 100.0), (2.0, 0.5), (3.0, 0.25)];
         let parts = c.clip(seg);
-        assert_eq!(parts.len(), 2);
-        // leaves at y = 1: x = 0.5/99.5
-        let exit = parts[0][1];
-        assert!((exit.0 - 0.5 / 99.5).abs() < 1e-12 && (exit.1 - 1.0).abs() < 1e-12);
-        let back = parts[1][0];
-        assert!((back.0 - (2.0 - 0.5 / 99.5)).abs() < 1e-12);
-        assert_eq!(parts[1][2], (3.0, 0.25));
+        // one polyline: leaves at y = 1 (x = 0.5/99.5), runs along the top, comes back
+        assert_eq!(parts.len(), 1);
+        let p = &parts[0];
+        assert_eq!(p.len(), 5, "{p:?}");
+        assert!((p[1].0 - 0.5 / 99.5).abs() < 1e-12 && (p[1].1 - 1.0).abs() < 1e-12);
+        assert!((p[2].0 - (2.0 - 0.5 / 99.5)).abs() < 1e-12 && (p[2].1 - 1.0).abs() < 1e-12);
+        assert_eq!(p[3], (2.0, 0.5));
+        assert_eq!(p[4], (3.0, 0.25));
+        // a steep line crossing the plot from top to bottom is drawn where it crosses
+        let parts = c.clip(vec![(0.0, 0.5), (1.0, 100.0), (2.0, -100.0), (3.0, 0.5)]);
+        assert_eq!(parts.len(), 1);
+        assert_eq!(parts[0].len(), 6, "{parts:?}");
+        assert!((parts[0][2].0 - 1.495).abs() < 1e-12 && (parts[0][3].0 - 1.5).abs() < 1e-12);
+        // leaving through the right edge ends the polyline
+        c.x_range = Some((0.0, 1.0));
+        let parts = c.clip(vec![(0.5, 0.5), (2.0, 0.5), (3.0, 0.5)]);
+        assert_eq!(parts, vec![vec![(0.5, 0.5), (1.0, 0.5)]]);
+        c.x_range = None;
+        assert!(parts
+            .iter()
+            .flatten()
+            .all(|&(_, y)| (-1e-12..=1.0 + 1e-12).contains(&y)));
         // log axis: clipped in log coordinates
         c.log_y = true;
         c.y_range = Some((1.0, 100.0));

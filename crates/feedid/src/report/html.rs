@@ -189,6 +189,7 @@ footer { margin-top: 40px; color: var(--muted); font-size: 12.5px; border-top: 1
   body { max-width: none; padding: 0; font-size: 11pt; }
   nav.toc { break-after: page; }
   h2 { break-before: page; }
+  nav.toc h2 { break-before: auto; }
   a { color: inherit; }
   figure svg { border: none; }
 }

@@ -75,7 +75,8 @@ pub struct ReportOptions {
     pub params_source: String,
     /// Zoom after the motion start \[s\]; default 0.06 (the paper's figures 5 and 7).
     pub zoom_s: f64,
-    /// Points per curve after min/max decimation; default 3000.
+    /// Points per curve after min/max decimation; default 3000 (coefficient
+    /// curves, up to 16 per figure, get a fifth of it).
     pub max_points: usize,
     /// Largest lag of the residual analysis \[samples\]; default 30.
     pub max_lag: usize,
@@ -707,117 +708,151 @@ impl RecordingAnalysis {
             )?)))
     }
 
-    fn coefficient_section(&self, p: &str) -> Result<Section> {
-        let r = &self.recording;
-        let t = r.time();
+    /// One chart of the coefficients `idx` of run `m`; returns it and whether its y axis is log.
+    fn coefficient_chart(
+        &self,
+        m: &MethodRun,
+        idx: &[usize],
+        title: &str,
+        size: (u32, u32),
+    ) -> (LineChart, bool) {
+        let t = self.recording.time();
         let (tf, tl) = self.time_axis();
-        let mut figs = Vec::new();
-        for m in &self.runs {
-            let s = &m.identification.sliding;
-            let names = &s.coefficient_names;
-            let nc = names.len().min(16);
-            let mut c = LineChart::new(
-                &format!("{}: identified coefficients", m.label),
-                tl,
-                "coef. / median |coef.|",
-            )
+        let s = &m.identification.sliding;
+        let mut c = LineChart::new(title, tl, "coef. / median |coef.|")
             .with_legend(LegendPosition::Below)
-            .with_size(900, 380);
-            let mut all = Vec::new();
-            for (j, name) in names.iter().enumerate().take(nc) {
-                let vals: Vec<f64> = (0..s.windows.len())
-                    .map(|w| {
-                        if s.windows[w].fit.termination == Termination::Failed {
-                            f64::NAN
-                        } else {
-                            s.window_coefficients(w)[j]
-                        }
-                    })
-                    .collect();
-                let mut mags: Vec<f64> = vals
-                    .iter()
-                    .filter(|v| v.is_finite())
-                    .map(|v| v.abs())
-                    .collect();
-                mags.sort_by(f64::total_cmp);
-                let med = mags.get(mags.len() / 2).copied().unwrap_or(0.0);
-                let x: Vec<f64> = s
-                    .windows
-                    .iter()
-                    .map(|w| tf * (t[w.window.end - 1] - t[0]))
-                    .collect();
-                let y: Vec<f64> = vals
-                    .iter()
-                    .map(|&v| if med > 0.0 { v / med } else { f64::NAN })
-                    .collect();
-                all.extend(y.iter().copied().filter(|v| v.is_finite()));
-                let (x, y) = decimate_minmax(&x, &y, self.options.max_points);
-                let mut series = Series::new(name, x, y).with_color(j % 8);
-                if j >= 8 {
-                    series = series.dashed();
-                }
-                c.push(series);
-            }
-            all.sort_by(f64::total_cmp);
-            let mut log = false;
-            if !all.is_empty() {
-                let q = |f: f64| all[((all.len() - 1) as f64 * f).round() as usize];
-                let (lo, hi) = (q(0.02).min(-1.2), q(0.98).max(1.2));
-                if hi - lo > 40.0 {
-                    // coefficients spanning decades: magnitudes on a log axis
-                    log = true;
-                    c.log_y = true;
-                    c.y_label = "|coef.| / median |coef.| (log scale)".into();
-                    c.y_range = Some((1e-3, 1e3));
-                    for series in &mut c.series {
-                        for v in &mut series.y {
-                            *v = v.abs();
-                        }
+            .with_size(size.0, size.1);
+        let x: Vec<f64> = s
+            .windows
+            .iter()
+            .map(|w| tf * (t[w.window.end.saturating_sub(1)] - t[0]))
+            .collect();
+        let mut all = Vec::new();
+        for (k, &j) in idx.iter().enumerate() {
+            let vals: Vec<f64> = (0..s.windows.len())
+                .map(|w| {
+                    if s.windows[w].fit.termination == Termination::Failed {
+                        f64::NAN
+                    } else {
+                        s.window_coefficients(w)[j]
                     }
-                } else {
-                    let pad = 0.08 * (hi - lo);
-                    c.y_range = Some((lo - pad, hi + pad));
-                }
-            }
-            let more = if names.len() > nc {
-                format!(
-                    " Only the first {nc} of {} coefficients are drawn.",
-                    names.len()
-                )
-            } else {
-                String::new()
-            };
-            figs.push(Self::figure(
-                format!("{p}-coef-{}", m.slug),
-                &format!("{} coefficients over time", m.label),
-                &c,
-                &if log {
-                    format!(
-                        "Magnitude of each coefficient of each window divided by the median of its magnitude over \
-                         all windows, on a log axis because the values span decades (the sign is not shown): a steady \
-                         coefficient is a flat line at 1; the plot is cut at 1/1000 and 1000 of the median.{more}"
-                    )
-                } else {
-                    format!(
-                        "Each coefficient of each window divided by the median of its magnitude over all windows, so \
-                         a steady coefficient is a flat line at +1 or −1 and the scale is the same for all. A method \
-                         that identifies a consistent model gives flat lines while the motion is informative; lines \
-                         leaving the plot (beyond the 2nd/98th percentile) are cut.{more}"
-                    )
-                },
-            )?);
+                })
+                .collect();
+            let mut mags: Vec<f64> = vals
+                .iter()
+                .filter(|v| v.is_finite())
+                .map(|v| v.abs())
+                .collect();
+            mags.sort_by(f64::total_cmp);
+            let med = mags.get(mags.len() / 2).copied().unwrap_or(0.0);
+            let y: Vec<f64> = vals
+                .iter()
+                .map(|&v| if med > 0.0 { v / med } else { f64::NAN })
+                .collect();
+            all.extend(y.iter().copied().filter(|v| v.is_finite()));
+            let (xd, yd) = decimate_minmax(&x, &y, self.options.max_points / 5);
+            c.push(Series::new(&s.coefficient_names[j], xd, yd).with_color(k % 8));
         }
+        all.sort_by(f64::total_cmp);
+        let mut log = false;
+        if !all.is_empty() {
+            let q = |f: f64| all[((all.len() - 1) as f64 * f).round() as usize];
+            let (a, b) = (q(0.02), q(0.98));
+            // keep ±1 in view (only +1 when every value is positive, −1 when negative)
+            let lo = a.min(if a >= 0.0 { 0.8 } else { -1.2 });
+            let hi = b.max(if b <= 0.0 { -0.8 } else { 1.2 });
+            if hi - lo > 40.0 {
+                // coefficients spanning decades: magnitudes on a log axis
+                log = true;
+                c.log_y = true;
+                c.y_label = "|coef.| / median |coef.| (log scale)".into();
+                c.y_range = Some((1e-3, 1e3));
+                for series in &mut c.series {
+                    for v in &mut series.y {
+                        *v = v.abs();
+                    }
+                }
+            } else {
+                let pad = 0.08 * (hi - lo);
+                c.y_range = Some((lo - pad, hi + pad));
+            }
+        }
+        (c, log)
+    }
+
+    fn coefficient_section(&self, p: &str) -> Result<Section> {
         let mut sec = Section::new(
             &format!("{p}-coef-sec"),
             "Identified coefficients over time",
         );
         sec.blocks.push(Block::Paragraph(
-            "One point per window, at the window's last sample. Names as in the coefficients file of feedid identify: \
-             the paper method's N2…N0, D7…D0 (eq. 6), ARX/RLS a1…a_na, b_nk…, OE N…, D…."
+            "One point per window, at the window's last sample, each coefficient divided by the median of its \
+             magnitude over all windows so that all share one scale: a steady coefficient is a flat line at +1 or \
+             −1 (at 1 on a log axis, used when the values span decades; the sign is then not shown). A method that \
+             identifies a consistent model gives flat lines while the motion is informative. Lines leaving the plot \
+             (beyond the 2nd/98th percentile, or 1/1000 and 1000 of the median on a log axis) run along its edge. \
+             Names as in the coefficients file of feedid identify: the paper method's N2…N0, D7…D0 (eq. 6), ARX/RLS \
+             a1…a_na, b_nk…, OE N…, D…."
                 .into(),
         ));
-        for f in figs {
-            sec.blocks.push(Block::Figure(f));
+        for m in &self.runs {
+            let names = &m.identification.sliding.coefficient_names;
+            // groups by the name's first letter (N/D, a/b), merged while they fit 8 colours
+            let mut groups: Vec<Vec<usize>> = Vec::new();
+            let mut prev: Option<char> = None;
+            for (j, name) in names.iter().enumerate() {
+                let first = name.chars().next();
+                match groups.last_mut() {
+                    Some(g) if first == prev && g.len() < 8 => g.push(j),
+                    _ => groups.push(vec![j]),
+                }
+                prev = first;
+            }
+            let mut merged: Vec<Vec<usize>> = Vec::new();
+            for g in groups {
+                match merged.last_mut() {
+                    Some(last) if last.len() + g.len() <= 8 => last.extend(g),
+                    _ => merged.push(g),
+                }
+            }
+            let mut figs = Vec::new();
+            for (gi, idx) in merged.iter().enumerate() {
+                let (Some(&first), Some(&last)) = (idx.first(), idx.last()) else {
+                    continue;
+                };
+                let span = if first == last {
+                    names[first].clone()
+                } else {
+                    format!("{} … {}", names[first], names[last])
+                };
+                let title = format!("{}: coefficients {span}", m.label);
+                let size = if merged.len() > 1 {
+                    (620, 400)
+                } else {
+                    (900, 360)
+                };
+                let (chart, log) = self.coefficient_chart(m, idx, &title, size);
+                let id = if gi == 0 {
+                    format!("{p}-coef-{}", m.slug)
+                } else {
+                    format!("{p}-coef-{}-{}", m.slug, gi + 1)
+                };
+                figs.push(Self::figure(
+                    id,
+                    &format!("{} coefficients {span} over time", m.label),
+                    &chart,
+                    if log {
+                        "Magnitudes relative to their medians on a log axis (the values span decades)."
+                    } else {
+                        "Values relative to their median magnitudes."
+                    },
+                )?);
+            }
+            match figs.len() {
+                0 => {}
+                1 => sec.blocks.extend(figs.into_iter().map(Block::Figure)),
+                _ => sec.blocks.push(Block::Grid(figs)),
+            }
         }
         Ok(sec)
     }
@@ -1222,7 +1257,9 @@ mod tests {
             "rec-error-zoom",
             "rec-error-zoom-detail",
             "rec-coef-paper1",
+            "rec-coef-paper1-2",
             "rec-coef-arx2",
+            "rec-coef-arx2-2",
         ]
         .into_iter()
         .map(String::from)

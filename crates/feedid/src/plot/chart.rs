@@ -126,6 +126,11 @@ pub struct LineChart {
     pub legend: LegendPosition,
     /// Shaded horizontal bands drawn under the lines (e.g. confidence bands).
     pub bands: Vec<Band>,
+    /// With a fixed y range: a line that leaves through the top or bottom
+    /// and comes back through the same edge runs along that edge (one
+    /// polyline instead of many; for dense curves). Default false: the line
+    /// is cut where it leaves.
+    pub pin_to_edges: bool,
 }
 
 /// Placement of a chart's legend.
@@ -167,6 +172,7 @@ impl LineChart {
             log_y: false,
             legend: LegendPosition::Inside,
             bands: Vec::new(),
+            pin_to_edges: false,
         }
     }
 
@@ -195,8 +201,9 @@ impl LineChart {
 
     /// Cut a polyline at the fixed axis ranges (exact intersections, in the
     /// axes' linear or log coordinates) so out-of-range data leave the plot
-    /// where they really do; between leaving and coming back through the
-    /// same top or bottom edge the line runs along that edge.
+    /// where they really do; with [`LineChart::pin_to_edges`], between leaving
+    /// and coming back through the same top or bottom edge the line runs
+    /// along that edge.
     fn clip(&self, seg: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
         if self.x_range.is_none() && self.y_range.is_none() {
             return vec![seg];
@@ -272,7 +279,7 @@ impl LineChart {
             }
             cur.push(if t1 < 1.0 { at(t1) } else { w[1] });
             if t1 < 1.0 {
-                if e1 >= 2 {
+                if e1 >= 2 && self.pin_to_edges {
                     parked = Some(e1);
                 } else {
                     out.push(std::mem::take(&mut cur));
@@ -654,6 +661,15 @@ mod tests {
         let mut c = LineChart::new("T", "x", "y");
         c.y_range = Some((0.0, 1.0));
         let seg = vec![(0.0, 0.5), (1.0, 100.0), (2.0, 0.5), (3.0, 0.25)];
+        // default: cut where the line leaves, a new polyline where it comes back
+        let parts = c.clip(seg.clone());
+        assert_eq!(parts.len(), 2);
+        let exit = parts[0][1];
+        assert!((exit.0 - 0.5 / 99.5).abs() < 1e-12 && (exit.1 - 1.0).abs() < 1e-12);
+        let back = parts[1][0];
+        assert!((back.0 - (2.0 - 0.5 / 99.5)).abs() < 1e-12);
+        assert_eq!(parts[1][2], (3.0, 0.25));
+        c.pin_to_edges = true;
         let parts = c.clip(seg);
         // one polyline: leaves at y = 1 (x = 0.5/99.5), runs along the top, comes back
         assert_eq!(parts.len(), 1);

@@ -182,7 +182,7 @@ caption { text-align: left; color: var(--muted); font-size: 13.5px; padding-bott
 th, td { padding: 4px 10px; border-bottom: 1px solid var(--rule); }
 th { text-align: left; border-bottom: 2px solid var(--ink); background: #fafafa; }
 td.num, th.num { text-align: right; }
-td:first-child { white-space: nowrap; }
+td:not(.num) { white-space: nowrap; }
 footer { margin-top: 40px; color: var(--muted); font-size: 12.5px; border-top: 1px solid var(--rule); padding-top: 8px; }
 @media (max-width: 820px) { .grid { grid-template-columns: 1fr; } body { padding: 12px; } }
 @media print {

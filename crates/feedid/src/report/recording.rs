@@ -722,6 +722,7 @@ impl RecordingAnalysis {
         let mut c = LineChart::new(title, tl, "coef. / median |coef.|")
             .with_legend(LegendPosition::Below)
             .with_size(size.0, size.1);
+        c.pin_to_edges = true;
         let x: Vec<f64> = s
             .windows
             .iter()

@@ -30,6 +30,10 @@ pub enum Command {
     Model(ModelArgs),
     /// Identify and predict online: CSV samples on stdin, predictions on stdout as they are due.
     Stream(StreamArgs),
+    /// Write a self-contained HTML report of a recording: figures, residuals, Bode plot, summary.
+    Report(Box<ReportArgs>),
+    /// Error of every window × horizon × method × order combination, heat map, best choice.
+    Sweep(Box<SweepArgs>),
 }
 
 /// Which D1 coefficient to use.
@@ -232,6 +236,9 @@ pub struct ReproduceArgs {
     /// Solver of the paper method: qr or simplex.
     #[arg(long, default_value = "simplex", value_name = "NAME")]
     pub solver: String,
+    /// Methods compared with the paper's in report.html (comma-separated).
+    #[arg(long, default_value = "arx,rls,oe", value_name = "LIST")]
+    pub compare: String,
 }
 
 /// `feedid order`.
@@ -274,4 +281,86 @@ pub struct StreamArgs {
     /// Sampling rate [Hz] when lines are `command,position` without a time.
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
+}
+
+/// Several methods and the per-method options of `identify` (report, sweep).
+#[derive(Debug, Clone, Args)]
+pub struct MethodListArgs {
+    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: report paper,arx,rls,oe,auto; sweep paper,arx].
+    #[arg(long, value_name = "LIST")]
+    pub methods: Option<String>,
+    /// Solver of the paper method: qr (exact least squares) or simplex (Nelder–Mead, as in the paper).
+    #[arg(long, default_value = "qr", value_name = "NAME")]
+    pub solver: String,
+    /// Time origin of the paper method: motion or window.
+    #[arg(long, default_value = "motion", value_name = "NAME")]
+    pub time_origin: String,
+    /// Prediction of the paper method: polynomial or tf.
+    #[arg(long, default_value = "polynomial", value_name = "NAME")]
+    pub prediction: String,
+    /// ARX/RLS orders `na,nb,nk` [default: 8,8,1].
+    #[arg(long, value_name = "NA,NB,NK")]
+    pub order: Option<String>,
+    /// RLS forgetting factor λ [default: 0.999].
+    #[arg(long, value_name = "LAMBDA")]
+    pub lambda: Option<f64>,
+    /// auto: largest recent rms error of an emitted prediction [µm] [default: 5].
+    #[arg(long, value_name = "UM")]
+    pub tolerance: Option<f64>,
+}
+
+/// `feedid report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Recording: CSV/text or MATLAB v5 .mat file.
+    pub input: PathBuf,
+    /// How to read it.
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// Methods.
+    #[command(flatten)]
+    pub methods: MethodListArgs,
+    /// Windows (one --window applies to every method).
+    #[command(flatten)]
+    pub windows: WindowArgs,
+    /// Rig parameters of the nominal model (TOML); default: the built-in rig.
+    #[arg(long, value_name = "rig.toml")]
+    pub params: Option<PathBuf>,
+    /// Length of the zoom after the motion start [ms].
+    #[arg(long, value_name = "MS", default_value_t = 60.0)]
+    pub zoom: f64,
+    /// Output HTML file.
+    #[arg(short, long, value_name = "report.html")]
+    pub output: PathBuf,
+}
+
+/// `feedid sweep`.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Recording: CSV/text or MATLAB v5 .mat file.
+    pub input: PathBuf,
+    /// How to read it.
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// Methods.
+    #[command(flatten)]
+    pub methods: MethodListArgs,
+    /// Window lengths W [samples], comma-separated.
+    #[arg(long, value_name = "LIST", default_value = "10,20,40,80,160")]
+    pub windows: String,
+    /// Horizons H [samples], comma-separated.
+    #[arg(long, value_name = "LIST", default_value = "10")]
+    pub horizons: String,
+    /// ARX/RLS orders to sweep, each `na,nb,nk` (several after one flag, or the flag repeated).
+    #[arg(long, value_name = "NA,NB,NK", num_args = 1..)]
+    pub orders: Vec<String>,
+    /// Shift between windows [samples]; default: the horizon.
+    #[arg(long)]
+    pub hop: Option<usize>,
+    /// Output CSV, one row per combination.
+    #[arg(short, long, value_name = "sweep.csv")]
+    pub output: PathBuf,
+    /// Heat map SVG (window × method/order, colour = rms error).
+    #[arg(long, value_name = "sweep.svg")]
+    pub plot: Option<PathBuf>,
 }

@@ -23,6 +23,7 @@ pub mod io;
 pub mod lti;
 pub mod plot;
 pub mod recording;
+pub mod report;
 pub mod signal;
 pub mod solve;
 pub mod stats;

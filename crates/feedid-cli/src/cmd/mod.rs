@@ -10,6 +10,9 @@ mod simulate;
 
 mod stream;
 
+mod report;
+mod sweep;
+
 use std::path::{Path, PathBuf};
 
 use crate::args::{Cli, Command};
@@ -24,6 +27,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Reproduce(a) => reproduce::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Stream(a) => stream::run(&a),
+        Command::Report(a) => report::run(&a),
+        Command::Sweep(a) => sweep::run(&a),
     }
 }
 

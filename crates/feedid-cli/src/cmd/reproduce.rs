@@ -2,13 +2,15 @@
 
 use anyhow::{Context, Result};
 use feedid::experiment::{run_experiment, summary_markdown, PaperExperimentConfig};
+use feedid::ident::{MethodKind, MethodSpec};
 use feedid::io::write_string_atomic;
+use feedid::report::paper_report;
 use feedid::signal::Scenario;
 
 use crate::args::ReproduceArgs;
 use crate::cmd::{load_params, Outputs};
 
-/// Run ramp and step, write figures and summary.md, print the table.
+/// Run ramp and step, write figures, summary.md and report.html, print the table.
 pub fn run(a: &ReproduceArgs) -> Result<()> {
     let cfg = PaperExperimentConfig {
         params: load_params(a.params.as_deref())?,
@@ -30,6 +32,15 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
     }
     let md = summary_markdown(&results, &cfg);
     files.push(("summary.md".to_string(), md.clone()));
+    let others = a
+        .compare
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty() && *s != "none")
+        .map(|s| Ok(MethodSpec::new(s.parse::<MethodKind>()?)))
+        .collect::<Result<Vec<_>>>()?;
+    let page = paper_report(&results, &cfg, &others)?;
+    files.push(("report.html".to_string(), page.to_html()));
 
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("{}: cannot create directory", a.out.display()))?;

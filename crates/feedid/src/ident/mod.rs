@@ -21,6 +21,7 @@ mod residuals;
 mod rls;
 mod srivc;
 pub mod stream;
+mod sweep;
 
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
 pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
@@ -42,3 +43,4 @@ pub use paper::{
 pub use residuals::{ResidualAnalysis, Z_99};
 pub use rls::{RlsConfig, RlsEstimator};
 pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};
+pub use sweep::{sweep, SweepConfig, SweepResult, SweepRow, PAPER_WINDOW};

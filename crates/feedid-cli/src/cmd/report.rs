@@ -1,0 +1,102 @@
+//! `feedid report`: a self-contained HTML report of one recording.
+
+use anyhow::{bail, Result};
+use feedid::ident::MethodSpec;
+use feedid::io::write_string_atomic;
+use feedid::report::{recording_report, RecordingAnalysis, ReportOptions};
+
+use crate::args::{MethodArgs, MethodListArgs, ReportArgs};
+use crate::cmd::identify::{engine_config, method_spec};
+use crate::cmd::{load_params, recording, Outputs};
+
+/// The methods of `--methods` (or `default`), each with the shared per-method options.
+pub fn method_specs(m: &MethodListArgs, default: &str) -> Result<Vec<MethodSpec>> {
+    let list = m.methods.as_deref().unwrap_or(default);
+    let mut out = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        if name.is_empty() {
+            bail!("invalid --methods `{list}`: empty method name");
+        }
+        let args = MethodArgs {
+            method: name.to_string(),
+            solver: m.solver.clone(),
+            time_origin: m.time_origin.clone(),
+            prediction: m.prediction.clone(),
+            order: m.order.clone(),
+            lambda: m.lambda,
+            tolerance: m.tolerance,
+        };
+        out.push(method_spec(&args)?);
+    }
+    Ok(out)
+}
+
+/// Identify with every method, build the page, write it atomically.
+pub fn run(a: &ReportArgs) -> Result<()> {
+    let specs = method_specs(&a.methods, "paper,arx,rls,oe,auto")?;
+    if !(a.zoom.is_finite() && a.zoom > 0.0) {
+        bail!(
+            "invalid --zoom {}: must be a positive number of milliseconds",
+            a.zoom
+        );
+    }
+    let params = load_params(a.params.as_deref())?;
+    let rec = recording::load(&a.input, &a.recording)?;
+    let methods = specs
+        .into_iter()
+        .map(|s| {
+            let cfg = engine_config(&a.windows, &s);
+            (s, cfg)
+        })
+        .collect();
+    let mut opts = ReportOptions::new(methods);
+    opts.params = params;
+    opts.params_source = match &a.params {
+        Some(p) => format!("the rig parameters in {}", p.display()),
+        None => "the built-in default rig".to_string(),
+    };
+    opts.zoom_s = a.zoom / 1e3;
+    let name = a.input.file_name().map_or_else(
+        || a.input.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let analysis = RecordingAnalysis::run(&name, rec, &opts)?;
+    let page = recording_report(&analysis)?;
+    let html = page.to_html();
+    let mut outputs = Outputs::default();
+    outputs.write(&a.output, |p| write_string_atomic(p, &html))?;
+    outputs.commit();
+
+    println!(
+        "{}: {} samples at {:.2} Hz",
+        a.input.display(),
+        analysis.recording.len(),
+        analysis.recording.rate_hz()
+    );
+    for m in &analysis.runs {
+        let s = m.identification.summary();
+        println!(
+            "  {:<32} rms {:>10.3} µm  max {:>10.3} µm  fit {:>7.2} %",
+            m.label,
+            1e6 * s.rms_error_m,
+            1e6 * s.max_abs_error_m,
+            s.fit_percent
+        );
+    }
+    println!(
+        "  {:<32} rms {:>10.3} µm  max {:>10.3} µm",
+        "simulation model (nominal)",
+        1e6 * analysis.simulation_stats.rms,
+        1e6 * analysis.simulation_stats.max_abs
+    );
+    for n in &analysis.notes {
+        println!("  note: {n}");
+    }
+    println!(
+        "written {} ({} figures, {} kB)",
+        a.output.display(),
+        page.figure_ids().len(),
+        html.len().div_ceil(1024)
+    );
+    Ok(())
+}

@@ -1,0 +1,185 @@
+//! `feedid sweep`: prediction error of every window × horizon × method ×
+//! order combination, in parallel, with a heat map and the best choice.
+
+use std::fmt::Write as _;
+use std::io::IsTerminal;
+
+use anyhow::{bail, Result};
+use feedid::ident::{sweep, ArxOrders, SweepConfig, SweepResult};
+use feedid::io::write_string_atomic;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::args::SweepArgs;
+use crate::cmd::report::method_specs;
+use crate::cmd::{recording, Outputs};
+
+/// A comma-separated list of sample counts ≥ 1 (duplicates dropped, order kept).
+fn parse_counts(flag: &str, s: &str) -> Result<Vec<usize>> {
+    let mut out = Vec::new();
+    for item in s.split(',').map(str::trim) {
+        let v: usize = item.parse().map_err(|_| {
+            anyhow::anyhow!(
+                "invalid {flag} value `{item}` in `{s}`: expected whole numbers of samples, e.g. 10,20,40"
+            )
+        })?;
+        if v == 0 {
+            bail!("invalid {flag} value `0` in `{s}`: must be at least 1 sample");
+        }
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    Ok(out)
+}
+
+/// `na,nb,nk`.
+fn parse_order(s: &str) -> Result<ArxOrders> {
+    let err = || anyhow::anyhow!("invalid --orders value `{s}`: expected na,nb,nk (e.g. 4,4,1)");
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|x| x.trim().parse().map_err(|_| err()))
+        .collect::<Result<_>>()?;
+    match v.as_slice() {
+        [na, nb, nk] => Ok(ArxOrders::new(*na, *nb, *nk)),
+        _ => Err(err()),
+    }
+}
+
+/// A progress bar on standard error when it is a terminal; hidden otherwise (pipes, CI).
+fn progress_bar() -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template(
+        "sweep [{bar:40.cyan/blue}] {pos}/{len} combinations, {elapsed} (eta {eta})",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// The text table: one line per method/order/horizon, one column per window.
+fn table(res: &SweepResult) -> String {
+    let mut windows: Vec<usize> = res.rows.iter().map(|r| r.window).collect();
+    windows.sort_unstable();
+    windows.dedup();
+    let mut keys: Vec<(String, usize)> = Vec::new();
+    for r in &res.rows {
+        let k = (r.model_label(), r.horizon);
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    let mut s = String::new();
+    let _ = write!(s, "{:<20} {:>4}", "method", "H");
+    for w in &windows {
+        let _ = write!(s, " {:>10}", format!("W={w}"));
+    }
+    s.push('\n');
+    for (m, h) in &keys {
+        let _ = write!(s, "{m:<20} {h:>4}");
+        for w in &windows {
+            let cell = res
+                .rows
+                .iter()
+                .find(|r| &r.model_label() == m && r.horizon == *h && r.window == *w)
+                .filter(|r| r.ok())
+                .map_or("–".to_string(), |r| {
+                    format!("{:.3}", 1e6 * r.rms_common_m)
+                });
+            let _ = write!(s, " {cell:>10}");
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Parse, sweep in parallel, write CSV (and SVG), print the table and the best choice.
+pub fn run(a: &SweepArgs) -> Result<()> {
+    let methods = method_specs(&a.methods, "paper,arx")?;
+    let windows = parse_counts("--windows", &a.windows)?;
+    let horizons = parse_counts("--horizons", &a.horizons)?;
+    let orders = a
+        .orders
+        .iter()
+        .map(|o| parse_order(o))
+        .collect::<Result<Vec<_>>>()?;
+    if a.hop == Some(0) {
+        bail!("invalid --hop 0: must be at least 1 sample");
+    }
+    let rec = recording::load(&a.input, &a.recording)?;
+    let cfg = SweepConfig {
+        methods,
+        windows,
+        horizons,
+        orders,
+        hop: a.hop,
+    };
+    let bar = progress_bar();
+    let res = sweep(&rec, &cfg, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    let res = res?;
+    if !res.rows.iter().any(|r| r.ok()) {
+        let why = res
+            .rows
+            .iter()
+            .find_map(|r| r.error.clone())
+            .unwrap_or_else(|| "nothing predicted".into());
+        bail!("{}: no combination could run ({why})", a.input.display());
+    }
+    let csv = res.to_csv();
+    let svg = match &a.plot {
+        Some(_) => Some(res.heat_map().to_svg()?),
+        None => None,
+    };
+    let mut outputs = Outputs::default();
+    outputs.write(&a.output, |p| write_string_atomic(p, &csv))?;
+    if let (Some(p), Some(svg)) = (&a.plot, &svg) {
+        outputs.write(p, |p| write_string_atomic(p, svg))?;
+    }
+    outputs.commit();
+
+    println!(
+        "{}: {} samples at {:.2} Hz, {} combinations on {} threads",
+        a.input.display(),
+        res.samples,
+        res.rate_hz,
+        res.rows.len(),
+        rayon::current_num_threads()
+    );
+    println!("rms prediction error [µm] over the common samples:");
+    print!("{}", table(&res));
+    print!("{}", res.summary_text());
+    match &a.plot {
+        Some(p) => println!("written {} and {}", a.output.display(), p.display()),
+        None => println!("written {}", a.output.display()),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lists_are_parsed_and_bad_values_named() {
+        assert_eq!(
+            parse_counts("--windows", "10, 20,10,40").unwrap(),
+            vec![10, 20, 40]
+        );
+        let e = parse_counts("--windows", "0,abc").unwrap_err().to_string();
+        assert!(e.contains("`0`"), "{e}");
+        let e = parse_counts("--windows", "10,abc").unwrap_err().to_string();
+        assert!(e.contains("`abc`") && e.contains("--windows"), "{e}");
+        assert!(parse_counts("--horizons", "").is_err());
+        assert_eq!(parse_order("4, 4,1").unwrap(), ArxOrders::new(4, 4, 1));
+        assert!(parse_order("4,4")
+            .unwrap_err()
+            .to_string()
+            .contains("`4,4`"));
+    }
+}

@@ -18,6 +18,7 @@
 pub mod drive;
 pub mod error;
 pub mod experiment;
+pub mod greybox;
 pub mod ident;
 pub mod io;
 pub mod lti;

@@ -15,6 +15,7 @@
 )]
 #![warn(missing_docs)]
 
+pub mod compensate;
 pub mod drive;
 pub mod error;
 pub mod experiment;

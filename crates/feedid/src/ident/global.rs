@@ -1,0 +1,283 @@
+//! A global model of a whole recording — what `feedid identify --model-out`
+//! writes and `feedid compensate --model` reads — with where it came from.
+//!
+//! Two kinds, independent of the sliding-window method:
+//!
+//! * `arx` ([`fit_arx`]): discrete `B(q)/A(q)` at the recording's sample time
+//!   by least squares (orders `na,nb,nk`, default 8,8,1);
+//! * `oe` ([`fit_oe`]): continuous `N(s)/D(s)` by output-error
+//!   Levenberg–Marquardt (orders `poles,zeros`, default 7,2 — the cascade's
+//!   structure, so that `feedid greybox --from-model` can map it to physical
+//!   parameters).
+//!
+//! The file is JSON: `{"model": <LinearModel>, "identified_by": {...}}` with
+//! the method, orders, samples, sample time and the free-run simulation fit
+//! (NRMSE %, and the rms error in m) over the recording. A bare
+//! [`LinearModel`] JSON is read as well.
+//!
+//! ```
+//! use feedid::ident::{fit_global_model, GlobalModelKind, ModelFile};
+//! use feedid::lti::TransferFunction;
+//! let g = TransferFunction::new(vec![2.0e4], vec![1.0, 300.0, 2.0e4]).unwrap();
+//! let dt = 1e-3;
+//! let u: Vec<f64> = (0..800).map(|k| if (k / 50) % 2 == 1 { 1e-3 } else { 0.0 }).collect();
+//! let y = g.to_state_space().unwrap().discretize_zoh(dt).unwrap().simulate(&u, None).unwrap();
+//! let rec = feedid::Recording::from_rate(1000.0, u, y).unwrap();
+//! let file = fit_global_model(&rec, &GlobalModelKind::Oe { poles: 2, zeros: 0 }).unwrap();
+//! let back = ModelFile::from_json(&file.to_json()).unwrap();
+//! assert_eq!(back.model, file.model);
+//! assert!(file.identified_by.unwrap().fit_percent > 99.99);
+//! ```
+
+use std::path::Path;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::ident::{fit_arx, fit_oe, ArxConfig, ArxOrders, LinearModel, OeConfig};
+use crate::recording::Recording;
+use crate::stats::ErrorStats;
+
+/// Which global model to fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GlobalModelKind {
+    /// Discrete ARX with these orders.
+    Arx(ArxOrders),
+    /// Continuous output error with `poles` poles and `zeros` zeros.
+    Oe {
+        /// Number of poles.
+        poles: usize,
+        /// Number of zeros (< poles).
+        zeros: usize,
+    },
+}
+
+impl GlobalModelKind {
+    /// The default orders of a kind named `arx` (8,8,1) or `oe` (7,2).
+    pub fn default_for(name: &str) -> Result<Self> {
+        match name.trim().to_ascii_lowercase().as_str() {
+            "arx" => Ok(GlobalModelKind::Arx(ArxOrders::default())),
+            "oe" => Ok(GlobalModelKind::Oe { poles: 7, zeros: 2 }),
+            _ => Err(Error::InvalidChoice {
+                what: "model kind",
+                value: name.to_string(),
+                expected: "arx, oe",
+            }),
+        }
+    }
+
+    /// A kind with orders `na,nb,nk` (arx) or `poles,zeros` (oe).
+    pub fn with_orders(name: &str, orders: &str) -> Result<Self> {
+        let bad = || Error::InvalidChoice {
+            what: "model order",
+            value: orders.to_string(),
+            expected: "na,nb,nk for arx (e.g. 8,8,1); poles,zeros for oe (e.g. 7,2)",
+        };
+        let v: Vec<usize> = orders
+            .split(',')
+            .map(|x| x.trim().parse::<usize>().map_err(|_| bad()))
+            .collect::<Result<_>>()?;
+        match (Self::default_for(name)?, v.as_slice()) {
+            (GlobalModelKind::Arx(_), [na, nb, nk]) => {
+                let o = ArxOrders::new(*na, *nb, *nk);
+                o.validate()?;
+                Ok(GlobalModelKind::Arx(o))
+            }
+            (GlobalModelKind::Oe { .. }, [p, z]) => Ok(GlobalModelKind::Oe {
+                poles: *p,
+                zeros: *z,
+            }),
+            _ => Err(bad()),
+        }
+    }
+
+    /// Method name (`"arx"`, `"oe"`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            GlobalModelKind::Arx(_) => "arx",
+            GlobalModelKind::Oe { .. } => "oe",
+        }
+    }
+
+    /// Orders as written on the command line.
+    pub fn orders(&self) -> String {
+        match self {
+            GlobalModelKind::Arx(o) => format!("{},{},{}", o.na, o.nb, o.nk),
+            GlobalModelKind::Oe { poles, zeros } => format!("{poles},{zeros}"),
+        }
+    }
+}
+
+impl FromStr for GlobalModelKind {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Self> {
+        Self::default_for(s)
+    }
+}
+
+/// Where a model came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelProvenance {
+    /// `"arx"` or `"oe"`.
+    pub method: String,
+    /// Orders (`na,nb,nk` or `poles,zeros`).
+    pub orders: String,
+    /// Samples of the recording.
+    pub samples: usize,
+    /// Sample time of the recording \[s\].
+    pub sample_time_s: f64,
+    /// Free-run simulation fit over the recording \[%\] (NRMSE).
+    pub fit_percent: f64,
+    /// RMS of the free-run simulation error \[m\].
+    pub simulation_rms_m: f64,
+    /// The recording's file, if known.
+    #[serde(default)]
+    pub source: Option<String>,
+}
+
+/// A model file: the model and its provenance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// The identified model.
+    pub model: LinearModel,
+    /// How it was identified (absent for a bare model).
+    #[serde(default)]
+    pub identified_by: Option<ModelProvenance>,
+}
+
+impl ModelFile {
+    /// Pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+
+    /// Parse `{"model": …, "identified_by": …}` or a bare model; the
+    /// coefficients are checked.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::ParamsFile {
+            path: None,
+            message: format!("model JSON: {e}"),
+        })?;
+        let file: ModelFile = if value.get("model").is_some() {
+            serde_json::from_value(value).map_err(|e| Error::ParamsFile {
+                path: None,
+                message: format!("model JSON: {e}"),
+            })?
+        } else {
+            ModelFile {
+                model: LinearModel::from_json(text)?,
+                identified_by: None,
+            }
+        };
+        let model = LinearModel::from_json(&serde_json::to_string(&file.model).unwrap_or_default())?;
+        Ok(ModelFile { model, ..file })
+    }
+
+    /// Read a model file; errors name the file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json(&text).map_err(|e| match e {
+            Error::ParamsFile { message, .. } => Error::ParamsFile {
+                path: Some(path.to_path_buf()),
+                message,
+            },
+            other => Error::InFile {
+                path: path.to_path_buf(),
+                location: String::new(),
+                source: Box::new(other),
+            },
+        })
+    }
+}
+
+/// Fit a global model of `kind` to the whole recording.
+///
+/// Errors: those of [`fit_arx`] / [`fit_oe`] (too few samples, no
+/// excitation, no stable model).
+pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
+    let (u, y, dt) = (rec.command(), rec.position(), rec.dt());
+    let model = match kind {
+        GlobalModelKind::Arx(orders) => fit_arx(u, y, dt, *orders, &ArxConfig::default())?.model,
+        GlobalModelKind::Oe { poles, zeros } => {
+            let cfg = OeConfig {
+                poles: *poles,
+                zeros: *zeros,
+                ..OeConfig::default()
+            };
+            fit_oe(u, y, dt, &cfg)?.model
+        }
+    };
+    let sim = model.simulate_at(u, dt)?;
+    let stats = ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()));
+    Ok(ModelFile {
+        model,
+        identified_by: Some(ModelProvenance {
+            method: kind.name().to_string(),
+            orders: kind.orders(),
+            samples: rec.len(),
+            sample_time_s: dt,
+            fit_percent: stats.fit_percent,
+            simulation_rms_m: stats.rms,
+            source: None,
+        }),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::{simulate_nominal, RigParams};
+    use crate::signal::Scenario;
+
+    #[test]
+    fn arx_of_the_linear_rig_simulates_it_closely() {
+        let u = Scenario::Prbs.command(5000.0, 1.1, 1).unwrap();
+        let y = simulate_nominal(&RigParams::default(), &u, 2e-4).unwrap();
+        let rec = Recording::from_rate(5000.0, u, y).unwrap();
+        let f = fit_global_model(&rec, &GlobalModelKind::default_for("arx").unwrap()).unwrap();
+        let p = f.identified_by.as_ref().unwrap();
+        assert_eq!(p.method, "arx");
+        assert_eq!(p.orders, "8,8,1");
+        assert!(p.fit_percent > 99.9, "{}", p.fit_percent);
+        assert_eq!(f.model.dt(), Some(2e-4));
+    }
+
+    #[test]
+    fn orders_parse_per_kind_and_bad_ones_are_named() {
+        assert_eq!(
+            GlobalModelKind::with_orders("oe", "5,1").unwrap(),
+            GlobalModelKind::Oe { poles: 5, zeros: 1 }
+        );
+        assert_eq!(
+            GlobalModelKind::with_orders("arx", "4,4,1").unwrap(),
+            GlobalModelKind::Arx(ArxOrders::new(4, 4, 1))
+        );
+        let e = GlobalModelKind::with_orders("oe", "5,1,1").unwrap_err().to_string();
+        assert!(e.contains("5,1,1"), "{e}");
+        let e = GlobalModelKind::default_for("narx").unwrap_err().to_string();
+        assert!(e.contains("narx") && e.contains("arx, oe"), "{e}");
+    }
+
+    #[test]
+    fn bare_models_and_wrapped_ones_are_read_and_bad_json_is_refused() {
+        let m = LinearModel::discrete(vec![0.0, 0.5], vec![1.0, -0.5], 2e-4).unwrap();
+        let bare = ModelFile::from_json(&m.to_json()).unwrap();
+        assert_eq!(bare.model, m);
+        assert!(bare.identified_by.is_none());
+        let e = ModelFile::from_json("{\"model\": {\"kind\": \"discrete\", \"b\": [1.0]}}")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("model JSON"), "{e}");
+        let e = ModelFile::from_json("{\"model\": {\"kind\": \"discrete\", \"b\": [1.0], \"a\": [0.0], \"dt\": 1e-3}}")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a[0]"), "{e}");
+    }
+}

@@ -1,14 +1,21 @@
 //! A global model of a whole recording — what `feedid identify --model-out`
 //! writes and `feedid compensate --model` reads — with where it came from.
 //!
-//! Two kinds, independent of the sliding-window method:
+//! Kinds, independent of the sliding-window method:
 //!
 //! * `arx` ([`fit_arx`]): discrete `B(q)/A(q)` at the recording's sample time
 //!   by least squares (orders `na,nb,nk`, default 8,8,1);
 //! * `oe` ([`fit_oe`]): continuous `N(s)/D(s)` by output-error
 //!   Levenberg–Marquardt (orders `poles,zeros`, default 7,2 — the cascade's
 //!   structure, so that `feedid greybox --from-model` can map it to physical
-//!   parameters).
+//!   parameters);
+//! * `auto` (the default): arx 8,8,1, oe 7,2 and oe 5,1 are all fitted and
+//!   the one with the smallest free-run simulation error over the recording
+//!   is kept. Equation-error ARX is biased at low frequencies by noise, and
+//!   the output-error fit can stop in a poor local minimum; comparing the
+//!   free-run error catches both. On the virtual rig this picks oe 7,2 for a
+//!   PRBS or ramp recording, arx for a chirp or S-curve, oe 5,1 for a
+//!   multisine.
 //!
 //! The file is JSON: `{"model": <LinearModel>, "identified_by": {...}}` with
 //! the method, orders, samples, sample time and the free-run simulation fit
@@ -42,6 +49,8 @@ use crate::stats::ErrorStats;
 /// Which global model to fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum GlobalModelKind {
+    /// The best of arx 8,8,1, oe 7,2 and oe 5,1 by free-run simulation error.
+    Auto,
     /// Discrete ARX with these orders.
     Arx(ArxOrders),
     /// Continuous output error with `poles` poles and `zeros` zeros.
@@ -54,18 +63,26 @@ pub enum GlobalModelKind {
 }
 
 impl GlobalModelKind {
-    /// The default orders of a kind named `arx` (8,8,1) or `oe` (7,2).
+    /// The kind named `auto`, `arx` (orders 8,8,1) or `oe` (orders 7,2).
     pub fn default_for(name: &str) -> Result<Self> {
         match name.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(GlobalModelKind::Auto),
             "arx" => Ok(GlobalModelKind::Arx(ArxOrders::default())),
             "oe" => Ok(GlobalModelKind::Oe { poles: 7, zeros: 2 }),
             _ => Err(Error::InvalidChoice {
                 what: "model kind",
                 value: name.to_string(),
-                expected: "arx, oe",
+                expected: "auto, arx, oe",
             }),
         }
     }
+
+    /// The candidates of [`GlobalModelKind::Auto`].
+    pub const AUTO_CANDIDATES: [GlobalModelKind; 3] = [
+        GlobalModelKind::Arx(ArxOrders::new(8, 8, 1)),
+        GlobalModelKind::Oe { poles: 7, zeros: 2 },
+        GlobalModelKind::Oe { poles: 5, zeros: 1 },
+    ];
 
     /// A kind with orders `na,nb,nk` (arx) or `poles,zeros` (oe).
     pub fn with_orders(name: &str, orders: &str) -> Result<Self> {
@@ -88,13 +105,19 @@ impl GlobalModelKind {
                 poles: *p,
                 zeros: *z,
             }),
+            (GlobalModelKind::Auto, _) => Err(Error::InvalidChoice {
+                what: "model order for kind auto",
+                value: orders.to_string(),
+                expected: "no order (auto tries arx 8,8,1, oe 7,2, oe 5,1); name arx or oe to give one",
+            }),
             _ => Err(bad()),
         }
     }
 
-    /// Method name (`"arx"`, `"oe"`).
+    /// Method name (`"auto"`, `"arx"`, `"oe"`).
     pub fn name(&self) -> &'static str {
         match self {
+            GlobalModelKind::Auto => "auto",
             GlobalModelKind::Arx(_) => "arx",
             GlobalModelKind::Oe { .. } => "oe",
         }
@@ -103,6 +126,7 @@ impl GlobalModelKind {
     /// Orders as written on the command line.
     pub fn orders(&self) -> String {
         match self {
+            GlobalModelKind::Auto => String::new(),
             GlobalModelKind::Arx(o) => format!("{},{},{}", o.na, o.nb, o.nk),
             GlobalModelKind::Oe { poles, zeros } => format!("{poles},{zeros}"),
         }
@@ -136,6 +160,9 @@ pub struct ModelProvenance {
     /// The recording's file, if known.
     #[serde(default)]
     pub source: Option<String>,
+    /// With `auto`: every candidate tried, `"method orders: simulation rms"` or its error.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub candidates: Vec<String>,
 }
 
 /// A model file: the model and its provenance.
@@ -200,8 +227,53 @@ impl ModelFile {
 /// Fit a global model of `kind` to the whole recording.
 ///
 /// Errors: those of [`fit_arx`] / [`fit_oe`] (too few samples, no
-/// excitation, no stable model).
+/// excitation, no stable model); with `auto`, the last candidate's error
+/// when none succeeds.
 pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
+    if *kind != GlobalModelKind::Auto {
+        return fit_one(rec, kind);
+    }
+    let mut best: Option<ModelFile> = None;
+    let mut notes = Vec::new();
+    let mut last_err = None;
+    for cand in GlobalModelKind::AUTO_CANDIDATES {
+        match fit_one(rec, &cand) {
+            Ok(f) => {
+                let rms = f.identified_by.as_ref().map_or(f64::INFINITY, |p| p.simulation_rms_m);
+                notes.push(format!("{} {}: simulation rms {:.4e} m", cand.name(), cand.orders(), rms));
+                let better = match best.as_ref() {
+                    None => true,
+                    Some(b) => {
+                        rms < b
+                            .identified_by
+                            .as_ref()
+                            .map_or(f64::INFINITY, |p| p.simulation_rms_m)
+                    }
+                };
+                if rms.is_finite() && better {
+                    best = Some(f);
+                }
+            }
+            Err(e) => {
+                notes.push(format!("{} {}: {e}", cand.name(), cand.orders()));
+                last_err = Some(e);
+            }
+        }
+    }
+    match best {
+        Some(mut f) => {
+            if let Some(p) = f.identified_by.as_mut() {
+                p.candidates = notes;
+            }
+            Ok(f)
+        }
+        None => Err(last_err.unwrap_or(Error::InvalidModel {
+            reason: "no global model could be fitted",
+        })),
+    }
+}
+
+fn fit_one(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
     let (u, y, dt) = (rec.command(), rec.position(), rec.dt());
     let model = match kind {
         GlobalModelKind::Arx(orders) => fit_arx(u, y, dt, *orders, &ArxConfig::default())?.model,
@@ -213,9 +285,15 @@ pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<Model
             };
             fit_oe(u, y, dt, &cfg)?.model
         }
+        GlobalModelKind::Auto => return fit_global_model(rec, kind),
     };
     let sim = model.simulate_at(u, dt)?;
     let stats = ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()));
+    if !(stats.rms.is_finite()) {
+        return Err(Error::InvalidModel {
+            reason: "the global model's simulation is not finite",
+        });
+    }
     Ok(ModelFile {
         model,
         identified_by: Some(ModelProvenance {
@@ -226,6 +304,7 @@ pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<Model
             fit_percent: stats.fit_percent,
             simulation_rms_m: stats.rms,
             source: None,
+            candidates: Vec::new(),
         }),
     })
 }
@@ -250,6 +329,21 @@ mod tests {
     }
 
     #[test]
+    fn auto_keeps_the_candidate_with_the_smallest_simulation_error() {
+        let u = Scenario::Prbs.command(5000.0, 0.6, 1).unwrap();
+        let y = simulate_nominal(&RigParams::default(), &u, 2e-4).unwrap();
+        let rec = Recording::from_rate(5000.0, u, y).unwrap();
+        let f = fit_global_model(&rec, &GlobalModelKind::Auto).unwrap();
+        let p = f.identified_by.unwrap();
+        assert_eq!(p.candidates.len(), 3);
+        for cand in GlobalModelKind::AUTO_CANDIDATES {
+            if let Ok(c) = fit_global_model(&rec, &cand) {
+                assert!(p.simulation_rms_m <= c.identified_by.unwrap().simulation_rms_m);
+            }
+        }
+    }
+
+    #[test]
     fn orders_parse_per_kind_and_bad_ones_are_named() {
         assert_eq!(
             GlobalModelKind::with_orders("oe", "5,1").unwrap(),
@@ -262,7 +356,8 @@ mod tests {
         let e = GlobalModelKind::with_orders("oe", "5,1,1").unwrap_err().to_string();
         assert!(e.contains("5,1,1"), "{e}");
         let e = GlobalModelKind::default_for("narx").unwrap_err().to_string();
-        assert!(e.contains("narx") && e.contains("arx, oe"), "{e}");
+        assert!(e.contains("narx") && e.contains("auto, arx, oe"), "{e}");
+        assert!(GlobalModelKind::with_orders("auto", "7,2").is_err());
     }
 
     #[test]

@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use feedid::drive::RigParams;
-use feedid::ident::{identify, ArxOrders, EngineConfig, MethodSpec, PaperConfig};
+use feedid::ident::{
+    fit_global_model, identify, ArxOrders, EngineConfig, GlobalModelKind, MethodSpec, PaperConfig,
+};
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
 use rayon::prelude::*;
 
@@ -137,6 +139,16 @@ fn identify_file(
     paths: &OutputPaths,
 ) -> Result<String> {
     let mut est = spec.build()?;
+    let global_kind = match (&a.model_out, &a.model_kind, &a.model_order) {
+        (None, _, _) => None,
+        (Some(_), kind, Some(order)) => Some(GlobalModelKind::with_orders(
+            kind.as_deref().unwrap_or("auto"),
+            order,
+        )?),
+        (Some(_), kind, None) => Some(GlobalModelKind::default_for(
+            kind.as_deref().unwrap_or("auto"),
+        )?),
+    };
     let rec = recording::load(input, &a.recording)?;
     let run = identify(&rec, est.as_mut(), cfg, Some(params))?;
     let summary = run.summary();
@@ -158,6 +170,23 @@ fn identify_file(
     if let Some(p) = &paths.summary {
         let json = serde_json::to_string_pretty(&summary)?;
         outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+    }
+    let mut global_line = None;
+    if let (Some(p), Some(kind)) = (&a.model_out, &global_kind) {
+        let mut file = fit_global_model(&rec, kind)
+            .map_err(|e| anyhow::anyhow!("{}: global model: {e}", input.display()))?;
+        if let Some(prov) = file.identified_by.as_mut() {
+            prov.source = Some(input.display().to_string());
+            global_line = Some(format!(
+                "  global model: {} {}, free-run fit {:.3} % (rms {:.3} µm) -> {}",
+                prov.method,
+                prov.orders,
+                prov.fit_percent,
+                1e6 * prov.simulation_rms_m,
+                p.display()
+            ));
+        }
+        outputs.write(p, |p| write_string_atomic(p, &format!("{}\n", file.to_json())))?;
     }
     outputs.commit();
 
@@ -202,5 +231,8 @@ fn identify_file(
         1e3 * summary.identification_seconds,
         summary.per_window_us
     );
+    if let Some(line) = global_line {
+        let _ = writeln!(t, "{line}");
+    }
     Ok(t)
 }

@@ -10,6 +10,9 @@ mod simulate;
 
 mod stream;
 
+mod compensate;
+mod greybox;
+
 use std::path::{Path, PathBuf};
 
 use crate::args::{Cli, Command};
@@ -24,6 +27,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Reproduce(a) => reproduce::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Stream(a) => stream::run(&a),
+        Command::Greybox(a) => greybox::run(&a),
+        Command::Compensate(a) => compensate::run(&a),
     }
 }
 

@@ -353,7 +353,12 @@ pub struct CompensateArgs {
     #[arg(long, value_name = "NAME|N", default_value = "time_s")]
     pub desired_time: String,
     /// Identified model (`feedid identify --model-out`).
-    #[arg(long, value_name = "model.json", conflicts_with = "params", required_unless_present = "params")]
+    #[arg(
+        long,
+        value_name = "model.json",
+        conflicts_with = "params",
+        required_unless_present = "params"
+    )]
     pub model: Option<PathBuf>,
     /// Physical model instead: rig parameters (TOML), e.g. from `feedid greybox --params-out`.
     #[arg(long, value_name = "rig.toml")]

@@ -42,7 +42,11 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             Some(p) => load_effects(p)?,
             None => RigEffects::default(),
         };
-        Some(VirtualRig::new(params).with_effects(effects).with_seed(a.seed))
+        Some(
+            VirtualRig::new(params)
+                .with_effects(effects)
+                .with_seed(a.seed),
+        )
     } else {
         None
     };
@@ -106,15 +110,14 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     outputs.write(&a.output, |p| {
         write_atomic(p, |w| {
             writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
-            for k in 0..desired.len() {
-                writeln!(
-                    w,
-                    "{},{},{},{}",
-                    rec.time()[k],
-                    comp.command[k],
-                    desired[k],
-                    comp.predicted[k]
-                )?;
+            for (((t, u), d), y) in rec
+                .time()
+                .iter()
+                .zip(&comp.command)
+                .zip(desired)
+                .zip(&comp.predicted)
+            {
+                writeln!(w, "{t},{u},{d},{y}")?;
             }
             Ok(())
         })
@@ -126,15 +129,14 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
                     w,
                     "time_s,desired_m,position_uncompensated_m,position_compensated_m"
                 )?;
-                for k in 0..desired.len() {
-                    writeln!(
-                        w,
-                        "{},{},{},{}",
-                        rec.time()[k],
-                        desired[k],
-                        v.position_uncompensated[k],
-                        v.position_compensated[k]
-                    )?;
+                for (((t, d), a), b) in rec
+                    .time()
+                    .iter()
+                    .zip(desired)
+                    .zip(&v.position_uncompensated)
+                    .zip(&v.position_compensated)
+                {
+                    writeln!(w, "{t},{d},{a},{b}")?;
                 }
                 Ok(())
             })
@@ -148,7 +150,10 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             obj.insert("samples".into(), rec.len().into());
             obj.insert("rate_hz".into(), rec.rate_hz().into());
             obj.insert("max_velocity_limit".into(), json_limit(a.max_velocity));
-            obj.insert("max_acceleration_limit".into(), json_limit(a.max_acceleration));
+            obj.insert(
+                "max_acceleration_limit".into(),
+                json_limit(a.max_acceleration),
+            );
             if let Some(ver) = &verification {
                 let mut vv = serde_json::to_value(ver)?;
                 if let Some(o) = vv.as_object_mut() {
@@ -167,7 +172,9 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             "warning: the model has zeros on the unit circle; they were approximated (zero phase error), so even the model does not follow exactly"
         );
     }
-    if comp.pre_actuation_m > 1e-3 * comp.predicted_error.rms.max(1e-9) && comp.pre_actuation_m > 1e-9 {
+    if comp.pre_actuation_m > 1e-3 * comp.predicted_error.rms.max(1e-9)
+        && comp.pre_actuation_m > 1e-9
+    {
         eprintln!(
             "warning: the command would have to start moving {:.3} µm before the first sample (pre-actuation of non-minimum-phase zeros); give the trajectory more rest at its start",
             1e6 * comp.pre_actuation_m
@@ -213,10 +220,7 @@ fn describe(t: &mut String, c: &Compensation) {
 }
 
 fn describe_verification(t: &mut String, v: &Verification, seed: u64) {
-    let _ = writeln!(
-        t,
-        "  virtual rig (seed {seed}), measured − desired:"
-    );
+    let _ = writeln!(t, "  virtual rig (seed {seed}), measured − desired:");
     for (name, e) in [
         ("uncompensated", &v.uncompensated),
         ("compensated", &v.compensated),

@@ -9,8 +9,8 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use feedid::drive::RigEffects;
 use feedid::greybox::{
-    fit_coefficients, fit_greybox, track_greybox, Dynamics, GreyboxConfig, GreyboxFit,
-    LoopModel, Measurements, PhysicalParameter, TrackConfig, TrackWindow,
+    fit_coefficients, fit_greybox, track_greybox, Dynamics, GreyboxConfig, GreyboxFit, LoopModel,
+    Measurements, PhysicalParameter, TrackConfig, TrackWindow,
 };
 use feedid::ident::{LinearModel, ModelFile};
 use feedid::io::{cell, write_atomic, write_string_atomic};
@@ -22,9 +22,8 @@ use crate::cmd::{load_params, recording, Outputs};
 pub fn load_effects(path: &Path) -> Result<RigEffects> {
     let text =
         std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let fx: RigEffects = toml::from_str(&text).map_err(|e| {
-        anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-    })?;
+    let fx: RigEffects = toml::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " ")))?;
     fx.validate()
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     Ok(fx)
@@ -112,7 +111,11 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                 input.display(),
                 rec.len(),
                 rec.rate_hz(),
-                if a.friction { "nonlinear (friction)" } else { "linear" },
+                if a.friction {
+                    "nonlinear (friction)"
+                } else {
+                    "linear"
+                },
                 position_loop.name(),
                 if current.is_some() { ", current" } else { "" }
             );
@@ -295,11 +298,7 @@ fn write_track_csv(
         }
         writeln!(w, ",residual_rms_m,termination")?;
         for r in rows {
-            write!(
-                w,
-                "{},{},{}",
-                r.time_s, r.nut_position_m, r.mean_position_m
-            )?;
+            write!(w, "{},{},{}", r.time_s, r.nut_position_m, r.mean_position_m)?;
             for (v, s) in r.values.iter().zip(&r.std_errors) {
                 write!(w, ",{},{}", v, cell(*s))?;
             }

@@ -186,7 +186,9 @@ fn identify_file(
                 p.display()
             ));
         }
-        outputs.write(p, |p| write_string_atomic(p, &format!("{}\n", file.to_json())))?;
+        outputs.write(p, |p| {
+            write_string_atomic(p, &format!("{}\n", file.to_json()))
+        })?;
     }
     outputs.commit();
 

@@ -183,7 +183,11 @@ fn peaks(u: &[f64], dt: f64) -> ((f64, usize), (f64, usize)) {
 
 /// Compensate with a sampled model `sys` whose sample time equals the
 /// trajectory's (`sys.dt`); `desired` \[m\] one value per sample.
-pub fn compensate(sys: &DiscreteStateSpace, desired: &[f64], cfg: &CompensateConfig) -> Result<Compensation> {
+pub fn compensate(
+    sys: &DiscreteStateSpace,
+    desired: &[f64],
+    cfg: &CompensateConfig,
+) -> Result<Compensation> {
     let inverse = StableInverse::from_state_space(sys, cfg.unit_circle_margin)?;
     compensate_with(sys, inverse, desired, cfg)
 }
@@ -339,7 +343,8 @@ fn compensate_with(
     let predicted: Vec<f64> = yd.iter().map(|v| y0 + out_scale * v).collect();
     let u_rest = y0 / g;
     let command: Vec<f64> = dev.iter().map(|v| u_rest + v).collect();
-    let predicted_error = ErrorStats::from_pairs(desired.iter().copied().zip(predicted.iter().copied()));
+    let predicted_error =
+        ErrorStats::from_pairs(desired.iter().copied().zip(predicted.iter().copied()));
     Ok(Compensation {
         pre_actuation_m: dev[0].abs(),
         command,
@@ -384,14 +389,26 @@ mod tests {
         let desired = Scenario::Scurve.command(5000.0, 0.4, 0).unwrap();
         let c = compensate_model(&model, &desired, DT, &exact()).unwrap();
         assert!(c.exact_inverse);
-        assert!(c.predicted_error.max_abs < 1e-12, "{}", c.predicted_error.max_abs);
+        assert!(
+            c.predicted_error.max_abs < 1e-12,
+            "{}",
+            c.predicted_error.max_abs
+        );
         // the model as an independent user would simulate it
         let y = model.simulate_at(&c.command, DT).unwrap();
-        let err = y.iter().zip(&desired).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let err = y
+            .iter()
+            .zip(&desired)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
         assert!(err < 1e-12, "{err}");
         // and the physical 7-state model (another realisation of the same G)
         let y = simulate_nominal(&p, &c.command, DT).unwrap();
-        let err = y.iter().zip(&desired).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let err = y
+            .iter()
+            .zip(&desired)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
         assert!(err < 1e-11, "{err}");
         // sampling zeros of relative degree 5 lie outside the unit circle
         assert!(c
@@ -405,11 +422,19 @@ mod tests {
         let p = RigParams::default();
         let desired = Scenario::Ramp.command(5000.0, 0.8, 0).unwrap();
         let c = compensate_params(&p, LoopModel::Sampled, &desired, DT, &exact()).unwrap();
-        assert!(c.predicted_error.max_abs < 1e-12, "{}", c.predicted_error.max_abs);
+        assert!(
+            c.predicted_error.max_abs < 1e-12,
+            "{}",
+            c.predicted_error.max_abs
+        );
         let y = crate::greybox::PhysicalModel::linear(p, LoopModel::Sampled)
             .simulate(&c.command, DT)
             .unwrap();
-        let err = y.iter().zip(&desired).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let err = y
+            .iter()
+            .zip(&desired)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
         assert!(err < 1e-12, "{err}");
         // uncompensated: the 71.4 µm following error
         let y = crate::greybox::PhysicalModel::linear(p, LoopModel::Sampled)
@@ -431,7 +456,11 @@ mod tests {
         assert!(a <= cfg.max_acceleration * (1.0 + 1e-9));
         // the remaining error is the rounding of the two corners
         let corner = 0.05 * c.smoothing_s / (2.0 * std::f64::consts::PI).sqrt();
-        assert!(c.predicted_error.max_abs < 1.1 * corner, "{} vs {corner}", c.predicted_error.max_abs);
+        assert!(
+            c.predicted_error.max_abs < 1.1 * corner,
+            "{} vs {corner}",
+            c.predicted_error.max_abs
+        );
         // a fixed smoothing that is too small is an error naming the limit
         let tight = CompensateConfig {
             smoothing: Smoothing::Fixed(0.0),
@@ -447,7 +476,9 @@ mod tests {
     fn unit_dc_gain_rescales_an_identified_model() {
         // a lag with DC gain 1.01 (a slightly wrong identified model)
         let m = LinearModel::discrete(vec![0.0, 0.202], vec![1.0, -0.8], 1e-3).unwrap();
-        let desired: Vec<f64> = (0..300).map(|k| 0.03 * (k as f64 / 100.0 - 0.5).clamp(0.0, 1.0)).collect();
+        let desired: Vec<f64> = (0..300)
+            .map(|k| 0.03 * (k as f64 / 100.0 - 0.5).clamp(0.0, 1.0))
+            .collect();
         let cfg = CompensateConfig {
             max_acceleration: f64::INFINITY,
             ..CompensateConfig::default()

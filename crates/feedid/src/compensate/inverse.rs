@@ -162,7 +162,11 @@ impl StableInverse {
                 reason: "must be finite and >= 0",
             });
         }
-        if zeros.iter().chain(poles).any(|z| !(z.re.is_finite() && z.im.is_finite())) {
+        if zeros
+            .iter()
+            .chain(poles)
+            .any(|z| !(z.re.is_finite() && z.im.is_finite()))
+        {
             return Err(Error::InvalidModel {
                 reason: "non-finite pole or zero",
             });
@@ -179,7 +183,8 @@ impl StableInverse {
             } else {
                 if f.at_one().abs() < 1e-12 {
                     return Err(Error::InvalidModel {
-                        reason: "the model has a zero at z = 1 (zero DC gain) and cannot be inverted",
+                        reason:
+                            "the model has a zero at z = 1 (zero DC gain) and cannot be inverted",
                     });
                 }
                 zero_phase.push(f);
@@ -208,7 +213,11 @@ impl StableInverse {
             let m = f.modulus();
             if m > 0.0 {
                 let n = (SETTLE.ln() / m.ln()).ceil();
-                tail = tail.max(if n.is_finite() { n as usize + 4 } else { MAX_TAIL });
+                tail = tail.max(if n.is_finite() {
+                    n as usize + 4
+                } else {
+                    MAX_TAIL
+                });
             }
         }
         if tail > MAX_TAIL {
@@ -236,11 +245,20 @@ impl StableInverse {
                 reason: "discrete model needs a[0] != 0",
             });
         }
-        let delay = b.iter().position(|&v| v != 0.0).ok_or(Error::InvalidModel {
-            reason: "the model's numerator is zero",
-        })?;
+        let delay = b
+            .iter()
+            .position(|&v| v != 0.0)
+            .ok_or(Error::InvalidModel {
+                reason: "the model's numerator is zero",
+            })?;
         let beta = &b[delay..];
-        Self::from_roots(beta[0] / a0, delay, &poly_roots(beta)?, &poly_roots(a)?, margin)
+        Self::from_roots(
+            beta[0] / a0,
+            delay,
+            &poly_roots(beta)?,
+            &poly_roots(a)?,
+            margin,
+        )
     }
 
     /// From a discrete state-space model (its transfer function in `z`).
@@ -432,7 +450,10 @@ mod tests {
 
     fn simulate(b: &[f64], a: &[f64], u: &[f64]) -> Vec<f64> {
         let m = LinearModel::discrete(b.to_vec(), a.to_vec(), 1.0).unwrap();
-        m.discrete_state_space(None).unwrap().simulate(u, None).unwrap()
+        m.discrete_state_space(None)
+            .unwrap()
+            .simulate(u, None)
+            .unwrap()
     }
 
     fn trajectory(n: usize) -> Vec<f64> {
@@ -462,7 +483,10 @@ mod tests {
             Complex::new(-0.2, 0.0),
             Complex::new(0.6, 0.0),
         ];
-        let beta: Vec<f64> = crate::lti::poly_from_roots(&zeros).iter().map(|c| 0.3 * c).collect();
+        let beta: Vec<f64> = crate::lti::poly_from_roots(&zeros)
+            .iter()
+            .map(|c| 0.3 * c)
+            .collect();
         let mut b = vec![0.0];
         b.extend_from_slice(&beta);
         let a = crate::lti::poly_from_roots(&poles);
@@ -470,12 +494,22 @@ mod tests {
         assert!(inv.is_exact());
         assert_eq!(inv.delay(), 1);
         let handling: Vec<_> = inv.zeros().iter().map(|z| z.handling).collect();
-        assert_eq!(handling.iter().filter(|h| **h == ZeroHandling::AntiCausal).count(), 3);
+        assert_eq!(
+            handling
+                .iter()
+                .filter(|h| **h == ZeroHandling::AntiCausal)
+                .count(),
+            3
+        );
         let y = trajectory(300);
         let mut u = vec![0.0; 300];
         inv.apply_into(&y, &mut u, &mut Vec::new()).unwrap();
         let back = simulate(&b, &a, &u);
-        let err = back.iter().zip(&y).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        let err = back
+            .iter()
+            .zip(&y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
         assert!(err < 1e-13, "{err}");
         // the anti-causal part moves the input before the output
         assert!(u[95].abs() > 1e-6);
@@ -501,7 +535,11 @@ mod tests {
         let mut u = vec![0.0; 300];
         inv.apply_into(&y, &mut u, &mut Vec::new()).unwrap();
         let back = simulate(&b, &a, &u);
-        let err = back.iter().zip(&y).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        let err = back
+            .iter()
+            .zip(&y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
         assert!(err < 1e-3, "{err}");
     }
 

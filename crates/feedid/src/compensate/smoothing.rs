@@ -48,7 +48,9 @@ mod tests {
     fn a_ramp_is_kept_away_from_its_corners_and_rounded_at_them() {
         let n = 400;
         let v = 1e-3;
-        let y: Vec<f64> = (0..n).map(|k| v * (k as f64 - 100.0).clamp(0.0, 200.0)).collect();
+        let y: Vec<f64> = (0..n)
+            .map(|k| v * (k as f64 - 100.0).clamp(0.0, 200.0))
+            .collect();
         let mut s = vec![0.0; n];
         let sigma = 5.0;
         gaussian_smooth(&y, sigma, &mut s);
@@ -57,7 +59,11 @@ mod tests {
         }
         // corner error Δv·σ/√(2π)
         let want = v * sigma / (2.0 * std::f64::consts::PI).sqrt();
-        assert!((s[100] - y[100] - want).abs() < 1e-2 * want, "{} vs {want}", s[100] - y[100]);
+        assert!(
+            (s[100] - y[100] - want).abs() < 1e-2 * want,
+            "{} vs {want}",
+            s[100] - y[100]
+        );
     }
 
     #[test]

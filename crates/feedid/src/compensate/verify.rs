@@ -57,11 +57,21 @@ pub struct Verification {
     pub position_compensated: Vec<f64>,
 }
 
-fn run(rig: &VirtualRig, desired: &[f64], command: &[f64], rate_hz: f64) -> Result<(TrackingError, Vec<f64>)> {
+fn run(
+    rig: &VirtualRig,
+    desired: &[f64],
+    command: &[f64],
+    rate_hz: f64,
+) -> Result<(TrackingError, Vec<f64>)> {
     let y0 = desired[0];
     let shifted: Vec<f64> = command.iter().map(|u| u - y0).collect();
     let out = rig.simulate(&shifted, rate_hz)?;
-    let e: Vec<f64> = out.position.iter().zip(desired).map(|(p, d)| p + y0 - d).collect();
+    let e: Vec<f64> = out
+        .position
+        .iter()
+        .zip(desired)
+        .map(|(p, d)| p + y0 - d)
+        .collect();
     let et: Vec<f64> = out
         .true_position
         .iter()
@@ -87,7 +97,12 @@ fn run(rig: &VirtualRig, desired: &[f64], command: &[f64], rate_hz: f64) -> Resu
 ///
 /// Errors: [`Error::LengthMismatch`], [`Error::TooFewSamples`] for an empty
 /// trajectory, and the rig's errors.
-pub fn verify_on_rig(rig: &VirtualRig, desired: &[f64], command: &[f64], rate_hz: f64) -> Result<Verification> {
+pub fn verify_on_rig(
+    rig: &VirtualRig,
+    desired: &[f64],
+    command: &[f64],
+    rate_hz: f64,
+) -> Result<Verification> {
     if desired.len() != command.len() {
         return Err(Error::LengthMismatch {
             what: "desired trajectory and command",

@@ -88,7 +88,7 @@ pub fn fit_coefficients(
         });
     }
     let target = ratios(&nn, &dd);
-    if target.iter().any(|&v| v == 0.0) {
+    if target.contains(&0.0) {
         return Err(Error::InvalidModel {
             reason: "an identified coefficient is zero; the cascade has none",
         });
@@ -134,7 +134,6 @@ pub fn fit_coefficients(
     let report = lm.minimize(&mut residual, &mut theta, &lm_cfg)?;
     central_jacobian(&mut residual, &theta, RATIOS, &mut scratch, &mut jac);
     residual(&theta, &mut scratch);
-    drop(residual);
     let ss: f64 = scratch.iter().map(|v| v * v).sum();
     let analysis = analyse(&jac, RATIOS, estimate, ss, &cfg.thresholds)?;
     let mut params = *start;
@@ -177,12 +176,23 @@ mod tests {
         let num: Vec<f64> = c.num.iter().map(|v| v * s).collect();
         let den: Vec<f64> = c.den.iter().map(|v| v * s).collect();
         let set = [Kv, Kp, Ki, C2, M, K];
-        let fit = fit_coefficients(&num, &den, &RigParams::default(), &set, &GreyboxConfig::default())
-            .unwrap();
+        let fit = fit_coefficients(
+            &num,
+            &den,
+            &RigParams::default(),
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap();
         let fx = RigEffects::default();
         for (e, p) in fit.estimates.iter().zip(set) {
             let want = p.get(&truth, &fx);
-            assert!((e.value / want - 1.0).abs() < 1e-6, "{}: {} vs {want}", e.name, e.value);
+            assert!(
+                (e.value / want - 1.0).abs() < 1e-6,
+                "{}: {} vs {want}",
+                e.name,
+                e.value
+            );
             assert_eq!(e.verdict, Verdict::Identifiable);
         }
     }
@@ -192,9 +202,15 @@ mod tests {
         let c = closed_loop_coefficients(&RigParams::default(), D1Variant::Corrected);
         // Kpi, R, L, Ke scale together (a voltage unit): only their ratios matter
         let set = [Kv, Kpi, R, L, Ke];
-        let e = fit_coefficients(&c.num, &c.den, &RigParams::default(), &set, &GreyboxConfig::default())
-            .unwrap_err()
-            .to_string();
+        let e = fit_coefficients(
+            &c.num,
+            &c.den,
+            &RigParams::default(),
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("Kpi, R, L, Ke"), "{e}");
         assert!(!e.contains("Kv,"), "{e}");
     }

@@ -44,7 +44,9 @@
 
 use serde::Serialize;
 
-use super::identifiability::{analyse, Identifiability, IdentifiabilityThresholds, NullDirection, Verdict};
+use super::identifiability::{
+    analyse, Identifiability, IdentifiabilityThresholds, NullDirection, Verdict,
+};
 use super::model::{Dynamics, LoopModel, PhysicalModel};
 use super::names::PhysicalParameter;
 use crate::drive::{RigEffects, RigParams};
@@ -328,7 +330,9 @@ impl<'a> Measurements<'a> {
                     index,
                     value,
                 },
-                Error::LengthMismatch { expected, actual, .. } => Error::LengthMismatch {
+                Error::LengthMismatch {
+                    expected, actual, ..
+                } => Error::LengthMismatch {
                     what: "command and current",
                     expected,
                     actual,
@@ -370,10 +374,12 @@ impl Problem<'_> {
         );
         let m = self.data.command.len();
         let current = self.data.current.map(|_| &mut self.sim_current[..]);
-        match self
-            .model
-            .simulate_channels(self.data.command, self.data.dt, &mut self.sim_position, current)
-        {
+        match self.model.simulate_channels(
+            self.data.command,
+            self.data.dt,
+            &mut self.sim_position,
+            current,
+        ) {
             Ok(()) => {
                 let (wy, wi) = self.weights;
                 for ((ri, s), y) in r.iter_mut().zip(&self.sim_position).zip(self.data.position) {
@@ -439,7 +445,9 @@ pub fn fit_greybox(
         crate::stats::rms(&d)
     };
     let y_scale = deviation_rms(data.position).max(1e-12);
-    let i_scale = data.current.map_or(1.0, |c| crate::stats::rms(c).max(1e-12));
+    let i_scale = data
+        .current
+        .map_or(1.0, |c| crate::stats::rms(c).max(1e-12));
     let mut prob = Problem {
         data: *data,
         estimate,
@@ -466,7 +474,13 @@ pub fn fit_greybox(
     let mut theta = vec![0.0; n];
     let mut jac = vec![0.0; m * n];
     let mut r = vec![0.0; m];
-    central_jacobian(&mut |t: &[f64], out: &mut [f64]| prob.eval(t, out), &theta, m, &mut r, &mut jac);
+    central_jacobian(
+        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        &theta,
+        m,
+        &mut r,
+        &mut jac,
+    );
     prob.eval(&theta, &mut r);
     let ss0: f64 = r.iter().map(|v| v * v).sum();
     let at_start = analyse(&jac, m, estimate, ss0, &cfg.thresholds)?;
@@ -484,7 +498,11 @@ pub fn fit_greybox(
         max_iterations: cfg.max_iterations.max(1),
         ..LmConfig::default()
     };
-    let mut report = lm.minimize(|t: &[f64], out: &mut [f64]| prob.eval(t, out), &mut theta, &lm_cfg)?;
+    let mut report = lm.minimize(
+        |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        &mut theta,
+        &lm_cfg,
+    )?;
     if data.current.is_some() {
         // second pass: each channel weighted by its residual level
         prob.eval(&theta, &mut r);
@@ -494,14 +512,24 @@ pub fn fit_greybox(
             1.0 / floor(sy, y_scale),
             1.0 / floor(si.unwrap_or(i_scale), i_scale),
         );
-        let second = lm.minimize(|t: &[f64], out: &mut [f64]| prob.eval(t, out), &mut theta, &lm_cfg)?;
+        let second = lm.minimize(
+            |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+            &mut theta,
+            &lm_cfg,
+        )?;
         report.iterations += second.iterations;
         report.evaluations += second.evaluations;
         report.termination = second.termination;
         report.residual_norm = second.residual_norm;
     }
 
-    central_jacobian(&mut |t: &[f64], out: &mut [f64]| prob.eval(t, out), &theta, m, &mut r, &mut jac);
+    central_jacobian(
+        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        &theta,
+        m,
+        &mut r,
+        &mut jac,
+    );
     prob.eval(&theta, &mut r);
     let ss: f64 = r.iter().map(|v| v * v).sum();
     let analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
@@ -534,7 +562,12 @@ pub fn fit_greybox(
 }
 
 /// Lengths, finiteness, sample time.
-pub(crate) fn check_signals(command: &[f64], position: &[f64], dt: f64, needed: usize) -> Result<()> {
+pub(crate) fn check_signals(
+    command: &[f64],
+    position: &[f64],
+    dt: f64,
+    needed: usize,
+) -> Result<()> {
     if command.len() != position.len() {
         return Err(Error::LengthMismatch {
             what: "command and position",
@@ -604,11 +637,22 @@ mod tests {
         let truth = RigParams::default();
         let (u, y) = linear_data(Scenario::Chirp, 1.0);
         let start = perturbed(&set, &[1.2, 0.8, 1.25, 0.7, 1.3]);
-        let fit = fit_greybox(&Measurements::new(&u, &y, DT), &start, &set, &GreyboxConfig::default()).unwrap();
+        let fit = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &start,
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap();
         let fx = RigEffects::default();
         for (e, p) in fit.estimates.iter().zip(set) {
             let want = p.get(&truth, &fx);
-            assert!((e.value / want - 1.0).abs() < 1e-6, "{}: {} vs {want}", e.name, e.value);
+            assert!(
+                (e.value / want - 1.0).abs() < 1e-6,
+                "{}: {} vs {want}",
+                e.name,
+                e.value
+            );
             assert_eq!(e.verdict, Verdict::Identifiable, "{}", e.name);
         }
         assert!(fit.null_directions.is_empty());
@@ -632,7 +676,12 @@ mod tests {
         let fx = RigEffects::default();
         for (e, p) in fit.estimates.iter().zip(set) {
             let want = p.get(&truth, &fx);
-            assert!((e.value / want - 1.0).abs() < 1e-6, "{}: {} vs {want}", e.name, e.value);
+            assert!(
+                (e.value / want - 1.0).abs() < 1e-6,
+                "{}: {} vs {want}",
+                e.name,
+                e.value
+            );
         }
     }
 
@@ -648,9 +697,18 @@ mod tests {
         for seed in 0..3 {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let y: Vec<f64> = clean.iter().map(|v| v + noise.sample(&mut rng)).collect();
-            let fit = fit_greybox(&Measurements::new(&u, &y, DT), &start, &set, &GreyboxConfig::default())
-                .unwrap();
-            assert!((fit.residual_rms / 2e-7 - 1.0).abs() < 0.05, "{}", fit.residual_rms);
+            let fit = fit_greybox(
+                &Measurements::new(&u, &y, DT),
+                &start,
+                &set,
+                &GreyboxConfig::default(),
+            )
+            .unwrap();
+            assert!(
+                (fit.residual_rms / 2e-7 - 1.0).abs() < 0.05,
+                "{}",
+                fit.residual_rms
+            );
             for (e, p) in fit.estimates.iter().zip(set) {
                 let want = p.get(&truth, &fx);
                 let se = e.std_error.unwrap();
@@ -676,7 +734,9 @@ mod tests {
         let model = PhysicalModel::linear(truth, LoopModel::Sampled);
         let mut y = vec![0.0; u.len()];
         let mut i = vec![0.0; u.len()];
-        model.simulate_channels(&u, DT, &mut y, Some(&mut i)).unwrap();
+        model
+            .simulate_channels(&u, DT, &mut y, Some(&mut i))
+            .unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let ny = Normal::new(0.0, 2e-7).unwrap();
         let ni = Normal::new(0.0, 1e-2).unwrap();
@@ -701,7 +761,12 @@ mod tests {
         for (e, p) in both.estimates.iter().zip(set) {
             let want = p.get(&truth, &fx);
             let se = e.std_error.unwrap();
-            assert!((e.value - want).abs() < 3.0 * se, "{}: {} vs {want} (se {se})", e.name, e.value);
+            assert!(
+                (e.value - want).abs() < 3.0 * se,
+                "{}: {} vs {want} (se {se})",
+                e.name,
+                e.value
+            );
             assert!(se / want < 0.01, "{}: se {se}", e.name);
             assert_eq!(e.verdict, Verdict::Identifiable);
         }
@@ -717,7 +782,13 @@ mod tests {
             .simulate(&u, DT)
             .unwrap();
         let set = [Kp, Kt];
-        let e = fit_greybox(&Measurements::new(&u, &y, DT), &truth, &set, &GreyboxConfig::default()).unwrap_err();
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &truth,
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err();
         let msg = e.to_string();
         assert!(matches!(e, Error::NotIdentifiable { .. }), "{msg}");
         assert!(msg.contains("Kp, Kt"), "{msg}");
@@ -729,7 +800,10 @@ mod tests {
         };
         let fit = fit_greybox(&Measurements::new(&u, &y, DT), &truth, &set, &cfg).unwrap();
         assert!(!fit.all_identifiable());
-        assert!(fit.estimates.iter().all(|e| e.verdict == Verdict::NotIdentifiable));
+        assert!(fit
+            .estimates
+            .iter()
+            .all(|e| e.verdict == Verdict::NotIdentifiable));
         assert!(fit.warnings().iter().any(|w| w.contains("Kp")));
     }
 
@@ -738,9 +812,14 @@ mod tests {
         // Kt/c, Kp·c, Ke·c leave the closed loop unchanged (Ke·Kt and Kp·Kt fixed)
         let (u, y) = linear_data(Scenario::Prbs, 0.4);
         let set = [Kv, Kp, Kt, Ke];
-        let e = fit_greybox(&Measurements::new(&u, &y, DT), &RigParams::default(), &set, &GreyboxConfig::default())
-            .unwrap_err()
-            .to_string();
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &RigParams::default(),
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("Kp, Kt, Ke"), "{e}");
         assert!(!e.contains("Kv"), "{e}");
     }
@@ -748,9 +827,14 @@ mod tests {
     #[test]
     fn friction_levels_need_the_nonlinear_model() {
         let (u, y) = linear_data(Scenario::Prbs, 0.1);
-        let e = fit_greybox(&Measurements::new(&u, &y, DT), &RigParams::default(), &[Fc], &GreyboxConfig::default())
-            .unwrap_err()
-            .to_string();
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &RigParams::default(),
+            &[Fc],
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("Fc") && e.contains("nonlinear"), "{e}");
     }
 
@@ -759,9 +843,14 @@ mod tests {
         let (u, y) = linear_data(Scenario::Prbs, 0.1);
         let mut start = RigParams::default();
         start.damping.c2 = 0.0;
-        let e = fit_greybox(&Measurements::new(&u, &y, DT), &start, &[C2], &GreyboxConfig::default())
-            .unwrap_err()
-            .to_string();
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &start,
+            &[C2],
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("C2"), "{e}");
     }
 
@@ -793,7 +882,12 @@ mod tests {
         let fit = fit_greybox(&Measurements::new(&u, &y, DT), &start, &set, &cfg).unwrap();
         let want = [700.0, 100.0, 5.0];
         for (e, w) in fit.estimates.iter().zip(want) {
-            assert!((e.value / w - 1.0).abs() < 1e-5, "{}: {} vs {w}", e.name, e.value);
+            assert!(
+                (e.value / w - 1.0).abs() < 1e-5,
+                "{}: {} vs {w}",
+                e.name,
+                e.value
+            );
         }
     }
 }

@@ -189,8 +189,11 @@ impl PhysicalModel {
                 }
             }
         }
-        let channels = std::iter::once(("grey-box simulated position", &*position))
-            .chain(current.as_deref().map(|c| ("grey-box simulated current", c)));
+        let channels = std::iter::once(("grey-box simulated position", &*position)).chain(
+            current
+                .as_deref()
+                .map(|c| ("grey-box simulated current", c)),
+        );
         for (name, v) in channels {
             if let Some(i) = v.iter().position(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
@@ -217,7 +220,11 @@ const CURRENT_STATE: usize = 2;
 /// assert_eq!(sys.order(), 7);
 /// assert!((sys.dc_gain().unwrap() - 1.0).abs() < 1e-9);
 /// ```
-pub fn linear_discrete(params: &RigParams, position_loop: LoopModel, dt: f64) -> Result<DiscreteStateSpace> {
+pub fn linear_discrete(
+    params: &RigParams,
+    position_loop: LoopModel,
+    dt: f64,
+) -> Result<DiscreteStateSpace> {
     match position_loop {
         LoopModel::Continuous => closed_loop_state_space(params)?.discretize_zoh(dt),
         LoopModel::Sampled => {
@@ -271,7 +278,10 @@ mod tests {
                 position_loop: PositionLoop::Sampled,
                 ..RigEffects::linear()
             };
-            let rig = VirtualRig::new(p).with_effects(fx).simulate(&u, 5000.0).unwrap();
+            let rig = VirtualRig::new(p)
+                .with_effects(fx)
+                .simulate(&u, 5000.0)
+                .unwrap();
             let y = PhysicalModel::linear(p, LoopModel::Sampled)
                 .simulate(&u, 2e-4)
                 .unwrap();
@@ -296,7 +306,11 @@ mod tests {
             .simulate(&u, 2e-4)
             .unwrap();
         let k = 1200;
-        assert!((u[k] - y[k] - 0.05 / 700.0).abs() < 1e-10, "{}", u[k] - y[k]);
+        assert!(
+            (u[k] - y[k] - 0.05 / 700.0).abs() < 1e-10,
+            "{}",
+            u[k] - y[k]
+        );
     }
 
     #[test]
@@ -328,6 +342,10 @@ mod tests {
             "continuous".parse::<LoopModel>().unwrap(),
             LoopModel::Continuous
         );
-        assert!("held".parse::<LoopModel>().unwrap_err().to_string().contains("held"));
+        assert!("held"
+            .parse::<LoopModel>()
+            .unwrap_err()
+            .to_string()
+            .contains("held"));
     }
 }

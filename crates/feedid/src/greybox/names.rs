@@ -272,9 +272,13 @@ mod tests {
 
     #[test]
     fn unknown_and_repeated_names_are_errors_naming_them() {
-        let e = PhysicalParameter::parse_list("Kv,Kx").unwrap_err().to_string();
+        let e = PhysicalParameter::parse_list("Kv,Kx")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("Kx") && e.contains("Kv, Kp"), "{e}");
-        let e = PhysicalParameter::parse_list("Kv,kv").unwrap_err().to_string();
+        let e = PhysicalParameter::parse_list("Kv,kv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("twice") && e.contains("Kv"), "{e}");
         assert!(PhysicalParameter::parse_list("Kv,").is_err());
     }

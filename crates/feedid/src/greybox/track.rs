@@ -189,7 +189,6 @@ pub fn track_greybox(
         let report = lm.minimize(&mut residual, &mut theta, &lm_cfg)?;
         central_jacobian(&mut residual, &theta, w, &mut r, &mut jac);
         residual(&theta, &mut r);
-        drop(residual);
         let ss: f64 = r.iter().map(|v| v * v).sum();
         let a = analyse(&jac, w, estimate, ss, &cfg.thresholds)?;
         let values: Vec<f64> = base.iter().zip(&theta).map(|(b, t)| b * t.exp()).collect();
@@ -279,7 +278,11 @@ mod tests {
             let want = truth.stiffness_at(r.nut_position_m);
             let got = r.values[0];
             // the stiffness changes within a window; compare with the mean position's
-            assert!((got / want - 1.0).abs() < 0.01, "t {}: {got} vs {want}", r.time_s);
+            assert!(
+                (got / want - 1.0).abs() < 0.01,
+                "t {}: {got} vs {want}",
+                r.time_s
+            );
             moved |= want < 0.9 * truth.stiffness_k();
         }
         assert!(moved, "the move should soften the screw by more than 10 %");

@@ -108,7 +108,8 @@ impl GlobalModelKind {
             (GlobalModelKind::Auto, _) => Err(Error::InvalidChoice {
                 what: "model order for kind auto",
                 value: orders.to_string(),
-                expected: "no order (auto tries arx 8,8,1, oe 7,2, oe 5,1); name arx or oe to give one",
+                expected:
+                    "no order (auto tries arx 8,8,1, oe 7,2, oe 5,1); name arx or oe to give one",
             }),
             _ => Err(bad()),
         }
@@ -185,10 +186,11 @@ impl ModelFile {
     /// Parse `{"model": …, "identified_by": …}` or a bare model; the
     /// coefficients are checked.
     pub fn from_json(text: &str) -> Result<Self> {
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::ParamsFile {
-            path: None,
-            message: format!("model JSON: {e}"),
-        })?;
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| Error::ParamsFile {
+                path: None,
+                message: format!("model JSON: {e}"),
+            })?;
         let file: ModelFile = if value.get("model").is_some() {
             serde_json::from_value(value).map_err(|e| Error::ParamsFile {
                 path: None,
@@ -200,7 +202,8 @@ impl ModelFile {
                 identified_by: None,
             }
         };
-        let model = LinearModel::from_json(&serde_json::to_string(&file.model).unwrap_or_default())?;
+        let model =
+            LinearModel::from_json(&serde_json::to_string(&file.model).unwrap_or_default())?;
         Ok(ModelFile { model, ..file })
     }
 
@@ -239,8 +242,16 @@ pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<Model
     for cand in GlobalModelKind::AUTO_CANDIDATES {
         match fit_one(rec, &cand) {
             Ok(f) => {
-                let rms = f.identified_by.as_ref().map_or(f64::INFINITY, |p| p.simulation_rms_m);
-                notes.push(format!("{} {}: simulation rms {:.4e} m", cand.name(), cand.orders(), rms));
+                let rms = f
+                    .identified_by
+                    .as_ref()
+                    .map_or(f64::INFINITY, |p| p.simulation_rms_m);
+                notes.push(format!(
+                    "{} {}: simulation rms {:.4e} m",
+                    cand.name(),
+                    cand.orders(),
+                    rms
+                ));
                 let better = match best.as_ref() {
                     None => true,
                     Some(b) => {
@@ -353,9 +364,13 @@ mod tests {
             GlobalModelKind::with_orders("arx", "4,4,1").unwrap(),
             GlobalModelKind::Arx(ArxOrders::new(4, 4, 1))
         );
-        let e = GlobalModelKind::with_orders("oe", "5,1,1").unwrap_err().to_string();
+        let e = GlobalModelKind::with_orders("oe", "5,1,1")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("5,1,1"), "{e}");
-        let e = GlobalModelKind::default_for("narx").unwrap_err().to_string();
+        let e = GlobalModelKind::default_for("narx")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("narx") && e.contains("auto, arx, oe"), "{e}");
         assert!(GlobalModelKind::with_orders("auto", "7,2").is_err());
     }
@@ -370,9 +385,11 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("model JSON"), "{e}");
-        let e = ModelFile::from_json("{\"model\": {\"kind\": \"discrete\", \"b\": [1.0], \"a\": [0.0], \"dt\": 1e-3}}")
-            .unwrap_err()
-            .to_string();
+        let e = ModelFile::from_json(
+            "{\"model\": {\"kind\": \"discrete\", \"b\": [1.0], \"a\": [0.0], \"dt\": 1e-3}}",
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("a[0]"), "{e}");
     }
 }

@@ -40,7 +40,11 @@
 //! // first-order lag with one sample of delay
 //! let m = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
 //! let desired: Vec<f64> = (0..200).map(|k| 1e-3 * (k as f64 / 100.0).min(1.0)).collect();
-//! let cfg = CompensateConfig { smoothing: Smoothing::Fixed(0.0), ..CompensateConfig::default() };
+//! let cfg = CompensateConfig {
+//!     smoothing: Smoothing::Fixed(0.0),
+//!     max_acceleration: f64::INFINITY,
+//!     ..CompensateConfig::default()
+//! };
 //! let c = compensate_model(&m, &desired, 1e-3, &cfg).unwrap();
 //! assert!(c.predicted_error.max_abs < 1e-15);
 //! ```

@@ -183,6 +183,15 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     Ok(())
 }
 
+/// A length in µm, in scientific notation when below 1 nm.
+fn micrometres(m: f64) -> String {
+    if m != 0.0 && m.abs() < 1e-9 {
+        format!("{:.3e} µm", 1e6 * m)
+    } else {
+        format!("{:.4} µm", 1e6 * m)
+    }
+}
+
 /// A limit for JSON (∞ as null).
 fn json_limit(v: f64) -> serde_json::Value {
     if v.is_finite() {
@@ -213,9 +222,9 @@ fn describe(t: &mut String, c: &Compensation) {
     );
     let _ = writeln!(
         t,
-        "  predicted − desired: rms {:.4} µm, max {:.4} µm",
-        1e6 * c.predicted_error.rms,
-        1e6 * c.predicted_error.max_abs
+        "  predicted − desired: rms {}, max {}",
+        micrometres(c.predicted_error.rms),
+        micrometres(c.predicted_error.max_abs)
     );
 }
 

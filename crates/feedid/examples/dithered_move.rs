@@ -22,9 +22,7 @@ use feedid::signal::{Prbs, Ramp};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(path) = args.first().map(PathBuf::from) else {
-        return Err(
-            "usage: dithered_move <out.csv> [distance_m] [velocity_m_per_s] [seed]".into(),
-        );
+        return Err("usage: dithered_move <out.csv> [distance_m] [velocity_m_per_s] [seed]".into());
     };
     let distance: f64 = args.get(1).map_or(Ok(0.1), |s| s.parse())?;
     let velocity: f64 = args.get(2).map_or(Ok(0.1), |s| s.parse())?;

@@ -34,6 +34,10 @@ pub enum Command {
     Report(Box<ReportArgs>),
     /// Error of every window × horizon × method × order combination, heat map, best choice.
     Sweep(Box<SweepArgs>),
+    /// Estimate physical parameters (Kv, Kp, Ki, C2, M, K, ...) from a recording or identified N, D.
+    Greybox(Box<GreyboxArgs>),
+    /// Compute the command that makes the predicted position follow a desired trajectory.
+    Compensate(Box<CompensateArgs>),
 }
 
 /// Which D1 coefficient to use.
@@ -219,6 +223,16 @@ pub struct IdentifyArgs {
     /// Summary JSON.
     #[arg(long, value_name = "summary.json")]
     pub summary: Option<PathBuf>,
+    /// Also fit a global model of the whole recording and write it as JSON
+    /// (for `feedid compensate --model` and `feedid greybox --from-model`).
+    #[arg(long, value_name = "model.json", conflicts_with = "out_dir")]
+    pub model_out: Option<PathBuf>,
+    /// Kind of the global model: auto (best free-run fit of arx 8,8,1, oe 7,2, oe 5,1), arx, oe [default: auto].
+    #[arg(long, value_name = "NAME", requires = "model_out")]
+    pub model_kind: Option<String>,
+    /// Orders of the global model: na,nb,nk (arx) or poles,zeros (oe) [default: 8,8,1 / 7,2].
+    #[arg(long, value_name = "ORDERS", requires = "model_out")]
+    pub model_order: Option<String>,
 }
 
 /// `feedid reproduce`.
@@ -363,4 +377,122 @@ pub struct SweepArgs {
     /// Heat map SVG (window × method/order, colour = rms error).
     #[arg(long, value_name = "sweep.svg")]
     pub plot: Option<PathBuf>,
+}
+
+/// `feedid greybox`.
+#[derive(Debug, Args)]
+pub struct GreyboxArgs {
+    /// Recording: CSV/text or MATLAB v5 .mat file (omit with --from-model).
+    #[arg(required_unless_present = "from_model", conflicts_with = "from_model")]
+    pub input: Option<PathBuf>,
+    /// How to read it.
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// Starting (nominal) rig parameters; the others stay fixed at these values [default: the built-in rig].
+    #[arg(long, value_name = "rig.toml")]
+    pub params: Option<PathBuf>,
+    /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc.
+    #[arg(long, value_name = "LIST")]
+    pub estimate: String,
+    /// Measured motor-current column/variable [A], used as a second output.
+    #[arg(long, value_name = "NAME")]
+    pub current: Option<String>,
+    /// Simulate the nonlinear virtual rig (friction, variable stiffness, limits) instead of the linear model.
+    #[arg(long)]
+    pub friction: bool,
+    /// Friction law and limits of the nonlinear model (TOML, as for `feedid simulate --effects`).
+    #[arg(long, value_name = "effects.toml", requires = "friction")]
+    pub effects: Option<PathBuf>,
+    /// Position loop of the model: sampled (P controller at the sample rate) or continuous.
+    #[arg(long, default_value = "sampled", value_name = "NAME")]
+    pub position_loop: String,
+    /// Estimate from an identified model's N and D instead of a recording
+    /// (continuous, 7 poles and 2 zeros: `feedid identify --model-out M --model-kind oe`).
+    #[arg(long, value_name = "model.json")]
+    pub from_model: Option<PathBuf>,
+    /// Fit a set that is not identifiable anyway and report it, instead of refusing.
+    #[arg(long)]
+    pub allow_unidentifiable: bool,
+    /// Levenberg–Marquardt iteration cap.
+    #[arg(long, default_value_t = 100, value_name = "N")]
+    pub max_iterations: usize,
+    /// Summary JSON.
+    #[arg(long, value_name = "gb.json")]
+    pub summary: Option<PathBuf>,
+    /// Write the rig parameters with the estimates in place (TOML), e.g. for `feedid compensate --params`.
+    #[arg(long, value_name = "rig.toml")]
+    pub params_out: Option<PathBuf>,
+    /// Track the parameters over sliding windows of this length [s] (linear model).
+    #[arg(long, value_name = "S", conflicts_with = "from_model")]
+    pub track_window: Option<f64>,
+    /// Shift between tracking windows [s] [default: half the window].
+    #[arg(long, value_name = "S", requires = "track_window")]
+    pub track_hop: Option<f64>,
+    /// Tracking CSV: time_s,nut_position_m,mean_position_m, then NAME,NAME_std_error per parameter, residual_rms_m.
+    #[arg(long, value_name = "track.csv", requires = "track_window")]
+    pub track_out: Option<PathBuf>,
+}
+
+/// `feedid compensate`.
+#[derive(Debug, Args)]
+pub struct CompensateArgs {
+    /// Desired trajectory: CSV with a time column and a position column.
+    #[arg(long, value_name = "desired.csv")]
+    pub desired: PathBuf,
+    /// Column of the desired position, by name or 1-based index.
+    #[arg(long, value_name = "NAME|N", default_value = "position_m")]
+    pub desired_column: String,
+    /// Time column of the desired trajectory, by name or 1-based index.
+    #[arg(long, value_name = "NAME|N", default_value = "time_s")]
+    pub desired_time: String,
+    /// Identified model (`feedid identify --model-out`).
+    #[arg(
+        long,
+        value_name = "model.json",
+        conflicts_with = "params",
+        required_unless_present = "params"
+    )]
+    pub model: Option<PathBuf>,
+    /// Physical model instead: rig parameters (TOML), e.g. from `feedid greybox --params-out`.
+    #[arg(long, value_name = "rig.toml")]
+    pub params: Option<PathBuf>,
+    /// Position loop of the physical model: sampled or continuous.
+    #[arg(long, default_value = "sampled", value_name = "NAME")]
+    pub position_loop: String,
+    /// Output CSV: time_s,command_m,desired_m,predicted_m.
+    #[arg(short, long, value_name = "command.csv")]
+    pub output: PathBuf,
+    /// Zero-phase Gaussian smoothing σ of the desired trajectory [s], or auto (smallest σ within the limits).
+    #[arg(long, default_value = "auto", value_name = "S|auto")]
+    pub smooth: String,
+    /// Largest σ tried by --smooth auto [s].
+    #[arg(long, default_value_t = 0.02, value_name = "S")]
+    pub max_smoothing: f64,
+    /// Command velocity limit [m/s] (inf: none).
+    #[arg(long, default_value_t = 1.0, value_name = "M_PER_S")]
+    pub max_velocity: f64,
+    /// Command acceleration limit [m/s²] (inf: none).
+    #[arg(long, default_value_t = 30.0, value_name = "M_PER_S2")]
+    pub max_acceleration: f64,
+    /// Keep the model's DC gain instead of rescaling it to 1 (a position loop has 1).
+    #[arg(long)]
+    pub keep_dc_gain: bool,
+    /// Run the compensated and the plain command through the nonlinear virtual rig and report both tracking errors.
+    #[arg(long)]
+    pub verify: bool,
+    /// Rig parameters of the virtual rig for --verify [default: the built-in rig].
+    #[arg(long, value_name = "rig.toml", requires = "verify")]
+    pub rig: Option<PathBuf>,
+    /// Effects of the virtual rig for --verify (TOML) [default: all on, with noise].
+    #[arg(long, value_name = "effects.toml", requires = "verify")]
+    pub effects: Option<PathBuf>,
+    /// Noise seed of the virtual rig for --verify.
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub seed: u64,
+    /// Verification CSV: time_s,desired_m,position_uncompensated_m,position_compensated_m.
+    #[arg(long, value_name = "verify.csv", requires = "verify")]
+    pub verify_out: Option<PathBuf>,
+    /// Summary JSON.
+    #[arg(long, value_name = "comp.json")]
+    pub summary: Option<PathBuf>,
 }

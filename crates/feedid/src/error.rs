@@ -220,6 +220,35 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+
+    // --- greybox
+    /// A chosen set of physical parameters cannot be estimated separately
+    /// from the data (a null direction of the Jacobian).
+    #[error("not identifiable from these data: {parameters} (the response does not change along {direction}); fix some of them at their nominal values or record a richer excitation")]
+    NotIdentifiable {
+        /// The parameters of the null directions, comma separated.
+        parameters: String,
+        /// One null direction, e.g. `Kp·λ^1.00, Kt·λ^-1.00`.
+        direction: String,
+    },
+
+    // --- compensate
+    /// A computed command violates a velocity or acceleration limit.
+    #[error("command {quantity} {value:.4} {unit} at t = {time:.4} s exceeds the limit {limit} {unit}; {hint}")]
+    LimitExceeded {
+        /// `"velocity"` or `"acceleration"`.
+        quantity: &'static str,
+        /// The peak value (magnitude).
+        value: f64,
+        /// The limit.
+        limit: f64,
+        /// Unit of value and limit.
+        unit: &'static str,
+        /// Time of the peak \[s\].
+        time: f64,
+        /// What to change.
+        hint: &'static str,
+    },
 }
 
 impl Error {

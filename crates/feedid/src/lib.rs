@@ -5,7 +5,8 @@
 //! ([`drive`]), linear-system tools ([`lti`]), a nonlinear virtual rig and
 //! test commands ([`drive`], [`signal`]), the windowed identification methods
 //! and the sliding prediction engine ([`ident`]), solvers ([`solve`]) and
-//! file input ([`io`]).
+//! file input ([`io`]); physical parameters from data ([`greybox`]) and
+//! model-based compensation of the command ([`compensate`]).
 //!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
 //! Identification of Feed Drive Systems using Nonlinear Least Squares Method".
@@ -15,9 +16,11 @@
 )]
 #![warn(missing_docs)]
 
+pub mod compensate;
 pub mod drive;
 pub mod error;
 pub mod experiment;
+pub mod greybox;
 pub mod ident;
 pub mod io;
 pub mod lti;

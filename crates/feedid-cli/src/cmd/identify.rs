@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use feedid::drive::RigParams;
 use feedid::ident::{
-    fit_global_model, identify, select_order, ArxOrders, EngineConfig, MethodSpec, OrderSearch,
-    PaperConfig,
+    fit_global_model, global_model_for, identify, select_order, ArxOrders, EngineConfig,
+    GlobalModelKind, MethodSpec, OrderSearch, PaperConfig,
 };
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
 use rayon::prelude::*;
@@ -146,6 +146,16 @@ fn identify_file(
     params: &RigParams,
     paths: &OutputPaths,
 ) -> Result<String> {
+    let global_kind = match (&a.model_out, &a.model_kind, &a.model_order) {
+        (None, _, _) => None,
+        (Some(_), kind, Some(order)) => Some(GlobalModelKind::with_orders(
+            kind.as_deref().unwrap_or("auto"),
+            order,
+        )?),
+        (Some(_), kind, None) => Some(GlobalModelKind::default_for(
+            kind.as_deref().unwrap_or("auto"),
+        )?),
+    };
     let rec = recording::load(input, &a.recording)?;
     let mut spec = spec.clone();
     let mut chosen_order = None;
@@ -169,7 +179,7 @@ fn identify_file(
     let mut est = spec.build()?;
     let mut run = identify(&rec, est.as_mut(), cfg, Some(params))?;
     let mut global_note = None;
-    match fit_global_model(&rec, &spec) {
+    match global_model_for(&rec, &spec) {
         Ok(g) => run.global = g,
         Err(e) => global_note = Some(format!("  global model: not fitted ({e})")),
     }
@@ -192,6 +202,25 @@ fn identify_file(
     if let Some(p) = &paths.summary {
         let json = serde_json::to_string_pretty(&summary)?;
         outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+    }
+    let mut global_line = None;
+    if let (Some(p), Some(kind)) = (&a.model_out, &global_kind) {
+        let mut file = fit_global_model(&rec, kind)
+            .map_err(|e| anyhow::anyhow!("{}: global model: {e}", input.display()))?;
+        if let Some(prov) = file.identified_by.as_mut() {
+            prov.source = Some(input.display().to_string());
+            global_line = Some(format!(
+                "  global model: {} {}, free-run fit {:.3} % (rms {:.3} µm) -> {}",
+                prov.method,
+                prov.orders,
+                prov.fit_percent,
+                1e6 * prov.simulation_rms_m,
+                p.display()
+            ));
+        }
+        outputs.write(p, |p| {
+            write_string_atomic(p, &format!("{}\n", file.to_json()))
+        })?;
     }
     outputs.commit();
 
@@ -234,13 +263,11 @@ fn identify_file(
         1e6 * summary.max_abs_error_m,
         summary.fit_percent
     );
-    if let Some(g) = &run.global {
+    if let Some(p) = run.global.as_ref().and_then(|g| g.identified_by.as_ref()) {
         let _ = writeln!(
             t,
-            "  global model ({}): free-run fit {:.3} %{}",
-            g.structure,
-            g.sim_fit_percent,
-            if g.stable { "" } else { " (unstable)" }
+            "  global model of the method ({} {}): free-run fit {:.3} %",
+            p.method, p.orders, p.fit_percent
         );
     }
     if let Some(n) = global_note {
@@ -260,5 +287,8 @@ fn identify_file(
         1e3 * summary.identification_seconds,
         summary.per_window_us
     );
+    if let Some(line) = global_line {
+        let _ = writeln!(t, "{line}");
+    }
     Ok(t)
 }

@@ -10,6 +10,8 @@ mod simulate;
 
 mod stream;
 
+mod compensate;
+mod greybox;
 mod report;
 mod sweep;
 
@@ -29,6 +31,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Stream(a) => stream::run(&a),
         Command::Report(a) => report::run(&a),
         Command::Sweep(a) => sweep::run(&a),
+        Command::Greybox(a) => greybox::run(&a),
+        Command::Compensate(a) => compensate::run(&a),
     }
 }
 

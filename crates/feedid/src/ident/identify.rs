@@ -20,7 +20,7 @@ use serde::Serialize;
 use crate::drive::{simulate_nominal, RigParams};
 use crate::error::Result;
 use crate::ident::engine::{run as run_engine, EngineConfig, SlidingResult};
-use crate::ident::{Estimator, GlobalModel, ResidualAnalysis};
+use crate::ident::{Estimator, ModelFile, ResidualAnalysis};
 use crate::recording::Recording;
 use crate::solve::Termination;
 use crate::stats::ErrorStats;
@@ -44,8 +44,8 @@ pub struct Identification {
     /// Residual analysis of the prediction errors (see [`IdentifySummary::residuals`]).
     pub residuals: Option<ResidualAnalysis>,
     /// The method's global model, if one was fitted (set it with
-    /// [`crate::ident::fit_global_model`]; `identify` leaves it `None`).
-    pub global: Option<GlobalModel>,
+    /// [`crate::ident::global_model_for`]; `identify` leaves it `None`).
+    pub global: Option<ModelFile>,
 }
 
 /// Slide `estimator` over `recording` and compare with the nominal model of `params`.
@@ -208,9 +208,14 @@ impl Identification {
             sim_fit_percent: self
                 .global
                 .as_ref()
-                .map(|g| g.sim_fit_percent)
+                .and_then(|g| g.identified_by.as_ref())
+                .map(|p| p.fit_percent)
                 .filter(|f| f.is_finite()),
-            global_model: self.global.as_ref().map(|g| g.structure.clone()),
+            global_model: self
+                .global
+                .as_ref()
+                .and_then(|g| g.identified_by.as_ref())
+                .map(|p| format!("{} {}", p.method, p.orders)),
             sim_rms_error_m: self.simulation_stats.map(|x| x.rms),
             sim_max_abs_error_m: self.simulation_stats.map(|x| x.max_abs),
             nominal_fit_percent: self.simulation_stats.map(|x| x.fit_percent),

@@ -27,7 +27,7 @@ pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrder
 pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
 pub use engine::{EngineConfig, SlidingResult, WindowRecord};
 pub use estimator::{Estimator, Signals, WindowFit};
-pub use global::{fit_global_model, GlobalModel};
+pub use global::{fit_global_model, global_model_for, GlobalModelKind, ModelFile, ModelProvenance};
 pub use identify::{identify, Identification, IdentifySummary, RESIDUAL_LAGS};
 pub use method::{MethodKind, MethodSpec, METHOD_NAMES};
 pub use model::LinearModel;

@@ -1,0 +1,247 @@
+//! `feedid compensate`: the command that makes the predicted position follow
+//! a desired trajectory (identified model or physical model), optionally
+//! verified on the nonlinear virtual rig.
+
+use std::fmt::Write as _;
+
+use anyhow::Result;
+use feedid::compensate::{
+    compensate_model, compensate_params, verify_on_rig, CompensateConfig, Compensation, Smoothing,
+    Verification, ZeroHandling,
+};
+use feedid::drive::{RigEffects, VirtualRig};
+use feedid::greybox::LoopModel;
+use feedid::ident::ModelFile;
+use feedid::io::{read_recording, write_atomic, write_string_atomic, ChannelRef, ReadOptions};
+
+use crate::args::CompensateArgs;
+use crate::cmd::greybox::load_effects;
+use crate::cmd::{load_params, Outputs};
+
+/// Compute, write, verify, print.
+pub fn run(a: &CompensateArgs) -> Result<()> {
+    let smoothing = match a.smooth.trim() {
+        "auto" => Smoothing::Auto,
+        s => Smoothing::Fixed(s.parse::<f64>().map_err(|_| {
+            anyhow::anyhow!("invalid --smooth `{s}`: expected a time in seconds or auto")
+        })?),
+    };
+    let cfg = CompensateConfig {
+        smoothing,
+        max_velocity: a.max_velocity,
+        max_acceleration: a.max_acceleration,
+        max_smoothing: a.max_smoothing,
+        unit_dc_gain: !a.keep_dc_gain,
+        ..CompensateConfig::default()
+    };
+    cfg.validate()?;
+    let position_loop: LoopModel = a.position_loop.parse()?;
+    let verify_rig = if a.verify {
+        let params = load_params(a.rig.as_deref())?;
+        let effects = match &a.effects {
+            Some(p) => load_effects(p)?,
+            None => RigEffects::default(),
+        };
+        Some(
+            VirtualRig::new(params)
+                .with_effects(effects)
+                .with_seed(a.seed),
+        )
+    } else {
+        None
+    };
+
+    // the desired trajectory: one position column against time
+    let opts = ReadOptions {
+        time: Some(ChannelRef::parse(&a.desired_time)?),
+        command: Some(ChannelRef::parse(&a.desired_column)?),
+        position: Some(ChannelRef::parse(&a.desired_column)?),
+        ..ReadOptions::default()
+    };
+    let rec = read_recording(&a.desired, &opts)?;
+    let desired = rec.position();
+    let dt = rec.dt();
+
+    let mut text = String::new();
+    let (source, comp) = match (&a.model, &a.params) {
+        (Some(path), _) => {
+            let file = ModelFile::load(path)?;
+            let comp = compensate_model(&file.model, desired, dt, &cfg)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let how = match &file.identified_by {
+                Some(p) => format!("{} {} (fit {:.2} %)", p.method, p.orders, p.fit_percent),
+                None => "model".to_string(),
+            };
+            (format!("{} [{how}]", path.display()), comp)
+        }
+        (None, Some(path)) => {
+            let params = load_params(Some(path))?;
+            let comp = compensate_params(&params, position_loop, desired, dt, &cfg)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            (
+                format!(
+                    "{} [physical model, {} position loop]",
+                    path.display(),
+                    position_loop.name()
+                ),
+                comp,
+            )
+        }
+        (None, None) => anyhow::bail!("give --model model.json or --params rig.toml"),
+    };
+    let _ = writeln!(
+        text,
+        "{}: {} samples at {:.2} Hz; model {source}",
+        a.desired.display(),
+        rec.len(),
+        rec.rate_hz()
+    );
+    describe(&mut text, &comp);
+
+    let verification = match &verify_rig {
+        Some(rig) => Some(verify_on_rig(rig, desired, &comp.command, rec.rate_hz())?),
+        None => None,
+    };
+    if let Some(v) = &verification {
+        describe_verification(&mut text, v, a.seed);
+    }
+
+    let mut outputs = Outputs::default();
+    outputs.write(&a.output, |p| {
+        write_atomic(p, |w| {
+            writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
+            for (((t, u), d), y) in rec
+                .time()
+                .iter()
+                .zip(&comp.command)
+                .zip(desired)
+                .zip(&comp.predicted)
+            {
+                writeln!(w, "{t},{u},{d},{y}")?;
+            }
+            Ok(())
+        })
+    })?;
+    if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
+        outputs.write(p, |p| {
+            write_atomic(p, |w| {
+                writeln!(
+                    w,
+                    "time_s,desired_m,position_uncompensated_m,position_compensated_m"
+                )?;
+                for (((t, d), a), b) in rec
+                    .time()
+                    .iter()
+                    .zip(desired)
+                    .zip(&v.position_uncompensated)
+                    .zip(&v.position_compensated)
+                {
+                    writeln!(w, "{t},{d},{a},{b}")?;
+                }
+                Ok(())
+            })
+        })?;
+    }
+    if let Some(p) = &a.summary {
+        let mut v = serde_json::to_value(&comp)?;
+        if let Some(obj) = v.as_object_mut() {
+            obj.insert("desired".into(), a.desired.display().to_string().into());
+            obj.insert("model".into(), source.clone().into());
+            obj.insert("samples".into(), rec.len().into());
+            obj.insert("rate_hz".into(), rec.rate_hz().into());
+            obj.insert("max_velocity_limit".into(), json_limit(a.max_velocity));
+            obj.insert(
+                "max_acceleration_limit".into(),
+                json_limit(a.max_acceleration),
+            );
+            if let Some(ver) = &verification {
+                let mut vv = serde_json::to_value(ver)?;
+                if let Some(o) = vv.as_object_mut() {
+                    o.insert("seed".into(), a.seed.into());
+                }
+                obj.insert("verification".into(), vv);
+            }
+        }
+        let json = serde_json::to_string_pretty(&v)?;
+        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+    }
+    outputs.commit();
+    print!("{text}");
+    if !comp.exact_inverse {
+        eprintln!(
+            "warning: the model has zeros on the unit circle; they were approximated (zero phase error), so even the model does not follow exactly"
+        );
+    }
+    if comp.pre_actuation_m > 1e-3 * comp.predicted_error.rms.max(1e-9)
+        && comp.pre_actuation_m > 1e-9
+    {
+        eprintln!(
+            "warning: the command would have to start moving {:.3} µm before the first sample (pre-actuation of non-minimum-phase zeros); give the trajectory more rest at its start",
+            1e6 * comp.pre_actuation_m
+        );
+    }
+    Ok(())
+}
+
+/// A length in µm, in scientific notation when below 1 nm.
+fn micrometres(m: f64) -> String {
+    if m != 0.0 && m.abs() < 1e-9 {
+        format!("{:.3e} µm", 1e6 * m)
+    } else {
+        format!("{:.4} µm", 1e6 * m)
+    }
+}
+
+/// A limit for JSON (∞ as null).
+fn json_limit(v: f64) -> serde_json::Value {
+    if v.is_finite() {
+        v.into()
+    } else {
+        serde_json::Value::Null
+    }
+}
+
+fn describe(t: &mut String, c: &Compensation) {
+    let count = |h: ZeroHandling| c.zeros.iter().filter(|z| z.handling == h).count();
+    let _ = writeln!(
+        t,
+        "  sampled model: delay {} sample(s), DC gain {:.6}{}; zeros: {} inside (causal), {} outside (anti-causal), {} on the unit circle (zero-phase approximation)",
+        c.delay_samples,
+        c.model_dc_gain,
+        if (c.model_dc_gain - 1.0).abs() > 1e-12 { " (rescaled to 1)" } else { "" },
+        count(ZeroHandling::Causal),
+        count(ZeroHandling::AntiCausal),
+        count(ZeroHandling::ZeroPhase)
+    );
+    let _ = writeln!(
+        t,
+        "  smoothing σ {:.3} ms; command peak velocity {:.4} m/s, peak acceleration {:.3} m/s²",
+        1e3 * c.smoothing_s,
+        c.peak_velocity,
+        c.peak_acceleration
+    );
+    let _ = writeln!(
+        t,
+        "  predicted − desired: rms {}, max {}",
+        micrometres(c.predicted_error.rms),
+        micrometres(c.predicted_error.max_abs)
+    );
+}
+
+fn describe_verification(t: &mut String, v: &Verification, seed: u64) {
+    let _ = writeln!(t, "  virtual rig (seed {seed}), measured − desired:");
+    for (name, e) in [
+        ("uncompensated", &v.uncompensated),
+        ("compensated", &v.compensated),
+    ] {
+        let _ = writeln!(
+            t,
+            "    {name:<13}  rms {:>9.4} µm  max {:>9.4} µm  (true position: rms {:.4} µm)  peak current {:.2} A",
+            1e6 * e.rms_m,
+            1e6 * e.max_abs_m,
+            1e6 * e.rms_true_m,
+            e.peak_current_a
+        );
+    }
+    let _ = writeln!(t, "    rms reduced {:.1}-fold", v.improvement);
+}

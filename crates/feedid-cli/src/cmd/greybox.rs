@@ -1,0 +1,309 @@
+//! `feedid greybox`: physical parameters from a recording (simulation error
+//! of the physical model) or from identified N and D coefficients, with
+//! standard errors, correlations and identifiability; optional tracking over
+//! sliding windows.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use feedid::drive::RigEffects;
+use feedid::greybox::{
+    fit_coefficients, fit_greybox, track_greybox, Dynamics, GreyboxConfig, GreyboxFit, LoopModel,
+    Measurements, PhysicalParameter, TrackConfig, TrackWindow,
+};
+use feedid::ident::{LinearModel, ModelFile};
+use feedid::io::{cell, write_atomic, write_string_atomic};
+
+use crate::args::GreyboxArgs;
+use crate::cmd::{load_params, recording, Outputs};
+
+/// Rig effects from a TOML file (as `feedid simulate --effects`).
+pub fn load_effects(path: &Path) -> Result<RigEffects> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let fx: RigEffects = toml::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " ")))?;
+    fx.validate()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(fx)
+}
+
+/// Run the fit(s), write the outputs, print the report.
+pub fn run(a: &GreyboxArgs) -> Result<()> {
+    let estimate = PhysicalParameter::parse_list(&a.estimate)?;
+    let start = load_params(a.params.as_deref())?;
+    let position_loop: LoopModel = a.position_loop.parse()?;
+    let effects = match &a.effects {
+        Some(p) => load_effects(p)?,
+        None => RigEffects::default(),
+    };
+    let cfg = GreyboxConfig {
+        dynamics: if a.friction {
+            Dynamics::Nonlinear
+        } else {
+            Dynamics::Linear
+        },
+        position_loop,
+        effects,
+        max_iterations: a.max_iterations,
+        refuse_unidentifiable: !a.allow_unidentifiable,
+        ..GreyboxConfig::default()
+    };
+    if a.track_window.is_some() && a.track_out.is_none() {
+        bail!("--track-window needs --track-out track.csv");
+    }
+
+    let mut text = String::new();
+    let mut context = serde_json::Map::new();
+    let (fit, track) = match (&a.from_model, &a.input) {
+        (Some(path), _) => {
+            let file = ModelFile::load(path)?;
+            let (num, den) = match &file.model {
+                LinearModel::Continuous { num, den } if den.len() == 8 && num.len() <= 3 => {
+                    (num.clone(), den.clone())
+                }
+                _ => bail!(
+                    "{}: parameters from coefficients need a continuous model N(s)/D(s) with 7 poles and at most 2 zeros (identify with --model-out M --model-kind oe --model-order 7,2)",
+                    path.display()
+                ),
+            };
+            let fit = fit_coefficients(&num, &den, &start, &estimate, &cfg)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let _ = writeln!(
+                text,
+                "{}: N2…N0, D7…D0 of the identified model, {} coefficient ratios",
+                path.display(),
+                fit.residuals
+            );
+            context.insert("from_model".into(), path.display().to_string().into());
+            (fit, None)
+        }
+        (None, Some(input)) => {
+            let rec = recording::load(input, &a.recording)?;
+            let current = match &a.current {
+                Some(name) => Some(
+                    rec.extra()
+                        .iter()
+                        .find(|(n, _)| n == name || n.eq_ignore_ascii_case(name))
+                        .map(|(_, v)| v.as_slice())
+                        .ok_or_else(|| {
+                            let names: Vec<&str> =
+                                rec.extra().iter().map(|(n, _)| n.as_str()).collect();
+                            anyhow::anyhow!(
+                                "{}: no current column `{name}`; numeric columns besides time, command and position: {}",
+                                input.display(),
+                                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+                            )
+                        })?,
+                ),
+                None => None,
+            };
+            let mut data = Measurements::new(rec.command(), rec.position(), rec.dt());
+            if let Some(c) = current {
+                data = data.with_current(c);
+            }
+            let fit = fit_greybox(&data, &start, &estimate, &cfg)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+            let _ = writeln!(
+                text,
+                "{}: {} samples at {:.2} Hz; {} model, {} position loop; outputs: position{}",
+                input.display(),
+                rec.len(),
+                rec.rate_hz(),
+                if a.friction {
+                    "nonlinear (friction)"
+                } else {
+                    "linear"
+                },
+                position_loop.name(),
+                if current.is_some() { ", current" } else { "" }
+            );
+            context.insert("input".into(), input.display().to_string().into());
+            context.insert("samples".into(), rec.len().into());
+            context.insert("rate_hz".into(), rec.rate_hz().into());
+            context.insert(
+                "dynamics".into(),
+                (if a.friction { "nonlinear" } else { "linear" }).into(),
+            );
+            context.insert("position_loop".into(), position_loop.name().into());
+            context.insert("current".into(), a.current.clone().into());
+            let track = match a.track_window {
+                Some(w) => {
+                    let samples = |s: f64, what: &str| -> Result<usize> {
+                        let n = (s * rec.rate_hz()).round();
+                        if !(n.is_finite() && n >= 1.0) {
+                            bail!("invalid {what} {s} s: must be at least one sample");
+                        }
+                        Ok(n as usize)
+                    };
+                    let window = samples(w, "--track-window")?;
+                    let hop = match a.track_hop {
+                        Some(h) => samples(h, "--track-hop")?,
+                        None => (window / 2).max(1),
+                    };
+                    let tc = TrackConfig {
+                        window,
+                        hop,
+                        ..TrackConfig::default()
+                    };
+                    let start_track = fit.params;
+                    let rows = track_greybox(
+                        rec.command(),
+                        rec.position(),
+                        rec.dt(),
+                        &start_track,
+                        &estimate,
+                        &cfg,
+                        &tc,
+                    )
+                    .map_err(|e| anyhow::anyhow!("{}: tracking: {e}", input.display()))?;
+                    Some(rows)
+                }
+                None => None,
+            };
+            (fit, track)
+        }
+        (None, None) => bail!("give a recording or --from-model model.json"),
+    };
+
+    report(&mut text, &fit);
+    if let Some(rows) = &track {
+        report_track(&mut text, &estimate, rows);
+    }
+
+    let mut outputs = Outputs::default();
+    if let Some(p) = &a.summary {
+        let mut v = serde_json::to_value(&fit)?;
+        if let Some(obj) = v.as_object_mut() {
+            for (k, val) in context {
+                obj.insert(k, val);
+            }
+            if let Some(rows) = &track {
+                obj.insert("track".into(), serde_json::to_value(rows)?);
+            }
+        }
+        let json = serde_json::to_string_pretty(&v)?;
+        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+    }
+    if let Some(p) = &a.params_out {
+        outputs.write(p, |p| write_string_atomic(p, &fit.params.to_toml_string()))?;
+    }
+    if let (Some(p), Some(rows)) = (&a.track_out, &track) {
+        outputs.write(p, |p| write_track_csv(p, &estimate, rows))?;
+    }
+    outputs.commit();
+    print!("{text}");
+    for w in fit.warnings() {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
+}
+
+fn report(t: &mut String, fit: &GreyboxFit) {
+    let unit = if fit.source == "recording" {
+        format!("{:.4} µm", 1e6 * fit.residual_rms)
+    } else {
+        format!("{:.3e} (relative)", fit.residual_rms)
+    };
+    let _ = write!(
+        t,
+        "  Levenberg–Marquardt: {} after {} iterations ({} evaluations); rms residual {unit}",
+        fit.termination.label(),
+        fit.iterations,
+        fit.evaluations
+    );
+    if let Some(i) = fit.current_residual_rms {
+        let _ = write!(t, ", current {:.4} A", i);
+    }
+    if let Some(f) = fit.fit_percent {
+        let _ = write!(t, ", fit {f:.3} %");
+    }
+    let _ = writeln!(t);
+    let _ = writeln!(
+        t,
+        "  {:<4} {:>14} {:>14} {:>12} {:>9}  {:<10} verdict",
+        "name", "estimate", "start", "std error", "rel. %", "unit"
+    );
+    for e in &fit.estimates {
+        let _ = writeln!(
+            t,
+            "  {:<4} {:>14.6e} {:>14.6e} {:>12} {:>9}  {:<10} {}",
+            e.name,
+            e.value,
+            e.start,
+            e.std_error.map_or("-".to_string(), |s| format!("{s:.3e}")),
+            e.relative_std_error
+                .map_or("-".to_string(), |r| format!("{:.3}", 100.0 * r)),
+            e.unit,
+            e.verdict.label()
+        );
+    }
+    if fit.estimates.len() > 1 {
+        let _ = writeln!(t, "  correlation:");
+        let _ = write!(t, "  {:<4}", "");
+        for e in &fit.estimates {
+            let _ = write!(t, " {:>7}", e.name);
+        }
+        let _ = writeln!(t);
+        for (e, row) in fit.estimates.iter().zip(&fit.correlation) {
+            let _ = write!(t, "  {:<4}", e.name);
+            for c in row {
+                let _ = write!(t, " {c:>7.3}");
+            }
+            let _ = writeln!(t);
+        }
+    }
+    let _ = writeln!(
+        t,
+        "  condition number of the log-parameter Jacobian: {:.3e}",
+        fit.condition_number
+    );
+}
+
+fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWindow]) {
+    let _ = writeln!(t, "  tracking: {} windows", rows.len());
+    let _ = write!(t, "  {:>9} {:>10}", "time s", "nut m");
+    for p in estimate {
+        let _ = write!(t, " {:>12} {:>10}", p.name(), "std");
+    }
+    let _ = writeln!(t);
+    let step = (rows.len() / 10).max(1);
+    for (i, r) in rows.iter().enumerate() {
+        if i % step != 0 && i + 1 != rows.len() {
+            continue;
+        }
+        let _ = write!(t, "  {:>9.4} {:>10.5}", r.time_s, r.nut_position_m);
+        for (v, s) in r.values.iter().zip(&r.std_errors) {
+            let _ = write!(
+                t,
+                " {:>12.5e} {:>10}",
+                v,
+                s.map_or("-".to_string(), |s| format!("{s:.2e}"))
+            );
+        }
+        let _ = writeln!(t);
+    }
+}
+
+fn write_track_csv(
+    path: &Path,
+    estimate: &[PhysicalParameter],
+    rows: &[TrackWindow],
+) -> feedid::Result<()> {
+    write_atomic(path, |w| {
+        write!(w, "time_s,nut_position_m,mean_position_m")?;
+        for p in estimate {
+            write!(w, ",{},{}_std_error", p.name(), p.name())?;
+        }
+        writeln!(w, ",residual_rms_m,termination")?;
+        for r in rows {
+            write!(w, "{},{},{}", r.time_s, r.nut_position_m, r.mean_position_m)?;
+            for (v, s) in r.values.iter().zip(&r.std_errors) {
+                write!(w, ",{},{}", v, cell(*s))?;
+            }
+            writeln!(w, ",{},{}", r.residual_rms_m, r.termination.label())?;
+        }
+        Ok(())
+    })
+}

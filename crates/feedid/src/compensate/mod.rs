@@ -1,0 +1,25 @@
+//! Model-based compensation of the command (the paper's future work): the
+//! command that makes the predicted table position follow a desired
+//! trajectory, from an identified model or the physical rig model, and its
+//! check on the nonlinear virtual rig.
+//!
+//! * [`StableInverse`]: exact stable (non-causal) inversion of a sampled
+//!   model as a cascade of first- and second-order sections; zeros outside
+//!   the unit circle (the sampling zeros of a feed drive) are inverted
+//!   anti-causally, zeros on it by Tomizuka's zero-phase approximation.
+//! * [`compensate`], [`compensate_model`], [`compensate_params`]: smoothing
+//!   of the desired trajectory chosen to respect the command's velocity and
+//!   acceleration limits, the command and the model's prediction.
+//! * [`verify_on_rig`]: tracking error on the virtual rig before and after.
+
+mod command;
+mod inverse;
+mod smoothing;
+mod verify;
+
+pub use command::{
+    compensate, compensate_model, compensate_params, CompensateConfig, Compensation, Smoothing,
+};
+pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
+pub use smoothing::gaussian_smooth;
+pub use verify::{verify_on_rig, TrackingError, Verification};

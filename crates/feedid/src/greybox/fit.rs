@@ -1,0 +1,893 @@
+//! Grey-box estimation of chosen physical parameters from a command/position
+//! recording by minimising the simulation error of the physical model,
+//!
+//! ```text
+//!     θ̂ = argmin_θ Σ_k (x̂_a[k](p(θ)) − x_a[k])²,   p_j = p_j,start·exp(θ_j),
+//! ```
+//!
+//! the other parameters fixed at their values in the starting rig. The model
+//! is the linear cascade (exactly discretised, sampled or continuous position
+//! loop) or the nonlinear virtual rig ([`super::PhysicalModel`]). Levenberg–
+//! Marquardt ([`crate::solve::LevenbergMarquardt`], forward differences) runs
+//! on the log-parameters, so every unknown is O(1) whatever its unit and
+//! stays positive. A parameter set that makes the model diverge gets a
+//! large constant residual, so LM rejects the step.
+//!
+//! Before the fit, the Jacobian at the start (central differences, step
+//! 1e-5 in `θ`) is checked for null directions ([`super::identifiability`]):
+//! a set that the data cannot separate is refused with
+//! [`Error::NotIdentifiable`] naming the parameters (unless
+//! [`GreyboxConfig::refuse_unidentifiable`] is off). After the fit the same
+//! analysis at the estimate gives the standard errors, the correlation
+//! matrix, the condition number and a verdict per parameter.
+//!
+//! The recording must start at rest at its first command value (the
+//! simulation starts there); with measurement noise that is white, the
+//! standard errors are the usual asymptotic ones of output-error estimation.
+//!
+//! ```
+//! use feedid::drive::RigParams;
+//! use feedid::greybox::{fit_greybox, GreyboxConfig, Measurements, PhysicalModel, PhysicalParameter};
+//! use feedid::signal::Scenario;
+//! let truth = RigParams::default();
+//! let u = Scenario::Prbs.command(5000.0, 0.3, 1).unwrap();
+//! let y = PhysicalModel::linear(truth, Default::default()).simulate(&u, 2e-4).unwrap();
+//! let mut start = truth;
+//! start.control.kv *= 1.2;
+//! start.table.mass *= 0.8;
+//! let set = PhysicalParameter::parse_list("Kv,M").unwrap();
+//! let data = Measurements::new(&u, &y, 2e-4);
+//! let fit = fit_greybox(&data, &start, &set, &GreyboxConfig::default()).unwrap();
+//! assert!((fit.estimates[0].value / 700.0 - 1.0).abs() < 1e-6);
+//! assert!((fit.estimates[1].value / 3.0 - 1.0).abs() < 1e-6);
+//! ```
+
+use serde::Serialize;
+
+use super::identifiability::{
+    analyse, Identifiability, IdentifiabilityThresholds, NullDirection, Verdict,
+};
+use super::model::{Dynamics, LoopModel, PhysicalModel};
+use super::names::PhysicalParameter;
+use crate::drive::{RigEffects, RigParams};
+use crate::error::{Error, Result};
+use crate::solve::{LevenbergMarquardt, LmConfig, Termination};
+use crate::stats::ErrorStats;
+
+/// Step of the central differences of the identifiability analysis (in `θ = ln p`).
+pub(crate) const ANALYSIS_STEP: f64 = 1e-5;
+
+/// Settings of a grey-box fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GreyboxConfig {
+    /// Linear cascade (default) or nonlinear virtual rig.
+    pub dynamics: Dynamics,
+    /// Sampled (default) or continuous position loop.
+    pub position_loop: LoopModel,
+    /// Friction law, limits and variable stiffness of the nonlinear model; default [`RigEffects::default`].
+    pub effects: RigEffects,
+    /// Levenberg–Marquardt iteration cap. Default 100.
+    pub max_iterations: usize,
+    /// Relative LM tolerance (ftol = xtol = gtol). Default 1e-12.
+    pub tolerance: f64,
+    /// Thresholds of the identifiability verdicts.
+    pub thresholds: IdentifiabilityThresholds,
+    /// Refuse (with [`Error::NotIdentifiable`]) a set with a null direction at the start. Default true.
+    pub refuse_unidentifiable: bool,
+}
+
+impl Default for GreyboxConfig {
+    fn default() -> Self {
+        Self {
+            dynamics: Dynamics::Linear,
+            position_loop: LoopModel::Sampled,
+            effects: RigEffects::default(),
+            max_iterations: 100,
+            tolerance: 1e-12,
+            thresholds: IdentifiabilityThresholds::default(),
+            refuse_unidentifiable: true,
+        }
+    }
+}
+
+/// One estimated parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParameterEstimate {
+    /// Name as typed (`"Kv"`).
+    pub name: &'static str,
+    /// SI unit.
+    pub unit: &'static str,
+    /// Estimate.
+    pub value: f64,
+    /// Starting (nominal) value.
+    pub start: f64,
+    /// Standard error (`None` when the parameter is not determined).
+    pub std_error: Option<f64>,
+    /// Standard error relative to the estimate.
+    pub relative_std_error: Option<f64>,
+    /// How well the data determine it.
+    pub verdict: Verdict,
+}
+
+/// Result of a grey-box fit ([`fit_greybox`], [`super::fit_coefficients`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GreyboxFit {
+    /// What was fitted: `"recording"` (residuals in m) or `"coefficients"` (relative residuals).
+    pub source: &'static str,
+    /// The estimates, in the order asked for.
+    pub estimates: Vec<ParameterEstimate>,
+    /// Correlation matrix of the estimates (row-major).
+    pub correlation: Vec<Vec<f64>>,
+    /// Condition number of the log-parameter Jacobian at the estimate.
+    pub condition_number: f64,
+    /// Directions the data do not determine (empty when every parameter is identifiable).
+    pub null_directions: Vec<NullDirection>,
+    /// Why Levenberg–Marquardt stopped.
+    pub termination: Termination,
+    /// LM iterations.
+    pub iterations: usize,
+    /// Residual evaluations (simulations), including the analyses.
+    pub evaluations: usize,
+    /// RMS of the position residuals at the estimate (m, or relative for coefficients).
+    pub residual_rms: f64,
+    /// RMS of the current residuals \[A\] when a current was measured.
+    pub current_residual_rms: Option<f64>,
+    /// NRMSE fit \[%\] of the simulated position (recordings only).
+    pub fit_percent: Option<f64>,
+    /// Number of residuals (samples or coefficients).
+    pub residuals: usize,
+    /// The full rig parameters with the estimates in place.
+    #[serde(skip)]
+    pub params: RigParams,
+    /// The effects with the estimated friction levels in place.
+    #[serde(skip)]
+    pub effects: RigEffects,
+}
+
+impl GreyboxFit {
+    /// True when every estimate is identifiable or poor (no null direction).
+    pub fn all_identifiable(&self) -> bool {
+        self.estimates
+            .iter()
+            .all(|e| e.verdict != Verdict::NotIdentifiable)
+    }
+
+    /// One warning line per parameter that is not well determined.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w: Vec<String> = self
+            .estimates
+            .iter()
+            .filter(|e| e.verdict != Verdict::Identifiable)
+            .map(|e| match e.relative_std_error {
+                Some(r) => format!(
+                    "{} is {} from these data (relative standard error {:.1} %)",
+                    e.name,
+                    e.verdict.label(),
+                    100.0 * r
+                ),
+                None => format!("{} is not identifiable from these data", e.name),
+            })
+            .collect();
+        for d in &self.null_directions {
+            w.push(format!(
+                "the response does not change along {} (only other combinations are determined)",
+                d.describe()
+            ));
+        }
+        w
+    }
+}
+
+/// Check a parameter set against a model class and its starting values.
+pub(crate) fn check_set(
+    estimate: &[PhysicalParameter],
+    start: &RigParams,
+    effects: &RigEffects,
+    friction_allowed: bool,
+) -> Result<Vec<f64>> {
+    if estimate.is_empty() {
+        return Err(Error::TooFewSamples {
+            what: "parameters to estimate",
+            needed: 1,
+            actual: 0,
+        });
+    }
+    for (i, p) in estimate.iter().enumerate() {
+        if estimate[..i].contains(p) {
+            return Err(Error::InvalidChoice {
+                what: "parameter (listed twice)",
+                value: p.name().to_string(),
+                expected: super::names::PARAMETER_NAMES,
+            });
+        }
+        if p.needs_friction() && !friction_allowed {
+            return Err(Error::InvalidChoice {
+                what: "parameter for the linear model (friction levels need the nonlinear model)",
+                value: p.name().to_string(),
+                expected: "Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K",
+            });
+        }
+    }
+    estimate
+        .iter()
+        .map(|p| {
+            let v = p.get(start, effects);
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(Error::InvalidParameter {
+                    name: p.name(),
+                    value: v,
+                    reason: "the starting value must be finite and > 0 (estimated on a log scale)",
+                })
+            }
+        })
+        .collect()
+}
+
+/// Parameters and effects at log-parameters `theta` around `base`.
+pub(crate) fn apply(
+    estimate: &[PhysicalParameter],
+    base: &[f64],
+    theta: &[f64],
+    params: &mut RigParams,
+    effects: &mut RigEffects,
+) {
+    for ((p, b), t) in estimate.iter().zip(base).zip(theta) {
+        p.set(params, effects, b * t.exp());
+    }
+}
+
+/// Central-difference Jacobian of `residual` at `theta` (column-major, `m×n`).
+pub(crate) fn central_jacobian<R>(
+    residual: &mut R,
+    theta: &[f64],
+    m: usize,
+    scratch: &mut [f64],
+    jac: &mut [f64],
+) -> usize
+where
+    R: FnMut(&[f64], &mut [f64]),
+{
+    let n = theta.len();
+    let mut t = theta.to_vec();
+    let mut plus = vec![0.0; m];
+    for j in 0..n {
+        t[j] = theta[j] + ANALYSIS_STEP;
+        residual(&t, &mut plus);
+        t[j] = theta[j] - ANALYSIS_STEP;
+        residual(&t, scratch);
+        t[j] = theta[j];
+        for i in 0..m {
+            jac[i + j * m] = (plus[i] - scratch[i]) / (2.0 * ANALYSIS_STEP);
+        }
+    }
+    2 * n
+}
+
+/// Assemble the estimates from `theta` and an analysis.
+pub(crate) fn estimates(
+    estimate: &[PhysicalParameter],
+    base: &[f64],
+    theta: &[f64],
+    analysis: &Identifiability,
+) -> Vec<ParameterEstimate> {
+    estimate
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let value = base[k] * theta[k].exp();
+            let rel = analysis.relative_std_errors[k];
+            ParameterEstimate {
+                name: p.name(),
+                unit: p.unit(),
+                value,
+                start: base[k],
+                std_error: rel.map(|r| r * value),
+                relative_std_error: rel,
+                verdict: analysis.verdicts[k],
+            }
+        })
+        .collect()
+}
+
+/// Measured signals of one recording for a grey-box fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measurements<'a> {
+    /// Position command \[m\].
+    pub command: &'a [f64],
+    /// Measured table position \[m\].
+    pub position: &'a [f64],
+    /// Measured armature current \[A\], an optional second output.
+    pub current: Option<&'a [f64]>,
+    /// Sample interval \[s\].
+    pub dt: f64,
+}
+
+impl<'a> Measurements<'a> {
+    /// Command and position sampled every `dt` \[s\].
+    pub fn new(command: &'a [f64], position: &'a [f64], dt: f64) -> Self {
+        Self {
+            command,
+            position,
+            current: None,
+            dt,
+        }
+    }
+
+    /// Add the measured armature current \[A\] as a second output.
+    pub fn with_current(mut self, current: &'a [f64]) -> Self {
+        self.current = Some(current);
+        self
+    }
+
+    fn check(&self, needed: usize) -> Result<()> {
+        check_signals(self.command, self.position, self.dt, needed)?;
+        if let Some(c) = self.current {
+            check_signals(self.command, c, self.dt, needed).map_err(|e| match e {
+                Error::NonFinite { index, value, .. } => Error::NonFinite {
+                    channel: "current".to_string(),
+                    index,
+                    value,
+                },
+                Error::LengthMismatch {
+                    expected, actual, ..
+                } => Error::LengthMismatch {
+                    what: "command and current",
+                    expected,
+                    actual,
+                },
+                other => other,
+            })?;
+        }
+        Ok(())
+    }
+}
+
+/// Weighted simulation-error residuals of a recording.
+struct Problem<'a> {
+    data: Measurements<'a>,
+    estimate: &'a [PhysicalParameter],
+    base: Vec<f64>,
+    model: PhysicalModel,
+    sim_position: Vec<f64>,
+    sim_current: Vec<f64>,
+    /// Weights of the position and current residuals.
+    weights: (f64, f64),
+    penalty: f64,
+    evaluations: usize,
+}
+
+impl Problem<'_> {
+    fn residuals(&self) -> usize {
+        self.data.command.len() * if self.data.current.is_some() { 2 } else { 1 }
+    }
+
+    fn eval(&mut self, theta: &[f64], r: &mut [f64]) {
+        self.evaluations += 1;
+        apply(
+            self.estimate,
+            &self.base,
+            theta,
+            &mut self.model.params,
+            &mut self.model.effects,
+        );
+        let m = self.data.command.len();
+        let current = self.data.current.map(|_| &mut self.sim_current[..]);
+        match self.model.simulate_channels(
+            self.data.command,
+            self.data.dt,
+            &mut self.sim_position,
+            current,
+        ) {
+            Ok(()) => {
+                let (wy, wi) = self.weights;
+                for ((ri, s), y) in r.iter_mut().zip(&self.sim_position).zip(self.data.position) {
+                    *ri = wy * (s - y);
+                }
+                if let Some(c) = self.data.current {
+                    for ((ri, s), y) in r[m..].iter_mut().zip(&self.sim_current).zip(c) {
+                        *ri = wi * (s - y);
+                    }
+                }
+            }
+            Err(_) => r.iter_mut().for_each(|v| *v = self.penalty),
+        }
+    }
+
+    /// Unweighted rms of the position and current residuals at the last evaluation.
+    fn channel_rms(&self) -> (f64, Option<f64>) {
+        let e: Vec<f64> = self
+            .sim_position
+            .iter()
+            .zip(self.data.position)
+            .map(|(s, y)| s - y)
+            .collect();
+        let ei = self.data.current.map(|c| {
+            let d: Vec<f64> = self.sim_current.iter().zip(c).map(|(s, y)| s - y).collect();
+            crate::stats::rms(&d)
+        });
+        (crate::stats::rms(&e), ei)
+    }
+}
+
+/// Estimate the parameters `estimate` from the measurements `data`, starting
+/// from (and fixing the others at) `start`.
+///
+/// With a measured current the residuals of both outputs are stacked, each
+/// divided by its own residual rms after a first pass (weights
+/// `1/rms(signal)` in the first pass), i.e. approximately maximum likelihood
+/// for independent white noise on each channel.
+///
+/// Errors: [`Error::LengthMismatch`], [`Error::TooFewSamples`] (fewer samples
+/// than twice the parameters plus 2), [`Error::NonFinite`],
+/// [`Error::InvalidParameter`] (a start value ≤ 0, bad `dt`),
+/// [`Error::InvalidChoice`] (a friction level with the linear model),
+/// [`Error::NotIdentifiable`] (a null direction at the start, when refused).
+pub fn fit_greybox(
+    data: &Measurements<'_>,
+    start: &RigParams,
+    estimate: &[PhysicalParameter],
+    cfg: &GreyboxConfig,
+) -> Result<GreyboxFit> {
+    let base = check_set(
+        estimate,
+        start,
+        &cfg.effects,
+        cfg.dynamics == Dynamics::Nonlinear,
+    )?;
+    data.check(2 * estimate.len() + 2)?;
+    let n = estimate.len();
+    let len = data.command.len();
+    let deviation_rms = |v: &[f64]| {
+        let v0 = v.first().copied().unwrap_or(0.0);
+        let d: Vec<f64> = v.iter().map(|x| x - v0).collect();
+        crate::stats::rms(&d)
+    };
+    let y_scale = deviation_rms(data.position).max(1e-12);
+    let i_scale = data
+        .current
+        .map_or(1.0, |c| crate::stats::rms(c).max(1e-12));
+    let mut prob = Problem {
+        data: *data,
+        estimate,
+        base: base.clone(),
+        model: PhysicalModel {
+            params: *start,
+            effects: cfg.effects,
+            dynamics: cfg.dynamics,
+            position_loop: cfg.position_loop,
+        },
+        sim_position: vec![0.0; len],
+        sim_current: vec![0.0; if data.current.is_some() { len } else { 0 }],
+        weights: if data.current.is_some() {
+            (1.0 / y_scale, 1.0 / i_scale)
+        } else {
+            (1.0, 1.0)
+        },
+        penalty: 1e3 * if data.current.is_some() { 1.0 } else { y_scale },
+        evaluations: 0,
+    };
+    let m = prob.residuals();
+
+    // identifiability at the start
+    let mut theta = vec![0.0; n];
+    let mut jac = vec![0.0; m * n];
+    let mut r = vec![0.0; m];
+    central_jacobian(
+        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        &theta,
+        m,
+        &mut r,
+        &mut jac,
+    );
+    prob.eval(&theta, &mut r);
+    let ss0: f64 = r.iter().map(|v| v * v).sum();
+    let at_start = analyse(&jac, m, estimate, ss0, &cfg.thresholds)?;
+    if cfg.refuse_unidentifiable {
+        if let Some(e) = at_start.refusal() {
+            return Err(e);
+        }
+    }
+
+    let mut lm = LevenbergMarquardt::new(m, n);
+    let lm_cfg = LmConfig {
+        ftol: cfg.tolerance,
+        xtol: cfg.tolerance,
+        gtol: cfg.tolerance,
+        max_iterations: cfg.max_iterations.max(1),
+        ..LmConfig::default()
+    };
+    let mut report = lm.minimize(
+        |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        &mut theta,
+        &lm_cfg,
+    )?;
+    if data.current.is_some() {
+        // second pass: each channel weighted by its residual level
+        prob.eval(&theta, &mut r);
+        let (sy, si) = prob.channel_rms();
+        let floor = |s: f64, scale: f64| s.max(1e-9 * scale).max(f64::MIN_POSITIVE);
+        prob.weights = (
+            1.0 / floor(sy, y_scale),
+            1.0 / floor(si.unwrap_or(i_scale), i_scale),
+        );
+        let second = lm.minimize(
+            |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+            &mut theta,
+            &lm_cfg,
+        )?;
+        report.iterations += second.iterations;
+        report.evaluations += second.evaluations;
+        report.termination = second.termination;
+        report.residual_norm = second.residual_norm;
+    }
+
+    central_jacobian(
+        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        &theta,
+        m,
+        &mut r,
+        &mut jac,
+    );
+    prob.eval(&theta, &mut r);
+    let ss: f64 = r.iter().map(|v| v * v).sum();
+    let analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
+    let (rms_y, rms_i) = prob.channel_rms();
+    let stats = ErrorStats::from_pairs(
+        data.position
+            .iter()
+            .copied()
+            .zip(prob.sim_position.iter().copied()),
+    );
+    let mut params = *start;
+    let mut effects = cfg.effects;
+    apply(estimate, &base, &theta, &mut params, &mut effects);
+    Ok(GreyboxFit {
+        source: "recording",
+        estimates: estimates(estimate, &base, &theta, &analysis),
+        correlation: analysis.correlation.clone(),
+        condition_number: analysis.condition_number,
+        null_directions: analysis.null_directions.clone(),
+        termination: report.termination,
+        iterations: report.iterations,
+        evaluations: prob.evaluations,
+        residual_rms: rms_y,
+        current_residual_rms: rms_i,
+        fit_percent: Some(stats.fit_percent),
+        residuals: m,
+        params,
+        effects,
+    })
+}
+
+/// Lengths, finiteness, sample time.
+pub(crate) fn check_signals(
+    command: &[f64],
+    position: &[f64],
+    dt: f64,
+    needed: usize,
+) -> Result<()> {
+    if command.len() != position.len() {
+        return Err(Error::LengthMismatch {
+            what: "command and position",
+            expected: command.len(),
+            actual: position.len(),
+        });
+    }
+    if command.len() < needed {
+        return Err(Error::TooFewSamples {
+            what: "a grey-box fit",
+            needed,
+            actual: command.len(),
+        });
+    }
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "dt",
+            value: dt,
+            reason: "must be finite and > 0",
+        });
+    }
+    for (name, v) in [("command", command), ("position", position)] {
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(Error::NonFinite {
+                channel: name.to_string(),
+                index: i,
+                value: v[i],
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::VirtualRig;
+    use crate::signal::Scenario;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, Normal};
+    use PhysicalParameter::*;
+
+    const DT: f64 = 2e-4;
+
+    fn perturbed(set: &[PhysicalParameter], factors: &[f64]) -> RigParams {
+        let mut p = RigParams::default();
+        let mut fx = RigEffects::default();
+        for (q, f) in set.iter().zip(factors) {
+            let v = q.get(&p, &fx);
+            q.set(&mut p, &mut fx, v * f);
+        }
+        p
+    }
+
+    fn linear_data(scenario: Scenario, duration: f64) -> (Vec<f64>, Vec<f64>) {
+        let u = scenario.command(5000.0, duration, 1).unwrap();
+        let y = PhysicalModel::linear(RigParams::default(), LoopModel::Sampled)
+            .simulate(&u, DT)
+            .unwrap();
+        (u, y)
+    }
+
+    #[test]
+    fn noise_free_linear_data_recover_kv_kp_ki_c2_m_to_1e_6() {
+        let set = [Kv, Kp, Ki, C2, M];
+        let truth = RigParams::default();
+        let (u, y) = linear_data(Scenario::Chirp, 1.0);
+        let start = perturbed(&set, &[1.2, 0.8, 1.25, 0.7, 1.3]);
+        let fit = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &start,
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap();
+        let fx = RigEffects::default();
+        for (e, p) in fit.estimates.iter().zip(set) {
+            let want = p.get(&truth, &fx);
+            assert!(
+                (e.value / want - 1.0).abs() < 1e-6,
+                "{}: {} vs {want}",
+                e.name,
+                e.value
+            );
+            assert_eq!(e.verdict, Verdict::Identifiable, "{}", e.name);
+        }
+        assert!(fit.null_directions.is_empty());
+        assert!(fit.residual_rms < 1e-12, "{}", fit.residual_rms);
+    }
+
+    #[test]
+    fn noise_free_recovery_of_stiffness_inertia_and_current_loop_with_continuous_loop() {
+        let set = [K, J, Kpi, Kii];
+        let truth = RigParams::default();
+        let u = Scenario::Prbs.command(5000.0, 0.6, 2).unwrap();
+        let y = PhysicalModel::linear(truth, LoopModel::Continuous)
+            .simulate(&u, DT)
+            .unwrap();
+        let start = perturbed(&set, &[0.8, 1.15, 1.2, 0.85]);
+        let cfg = GreyboxConfig {
+            position_loop: LoopModel::Continuous,
+            ..GreyboxConfig::default()
+        };
+        let fit = fit_greybox(&Measurements::new(&u, &y, DT), &start, &set, &cfg).unwrap();
+        let fx = RigEffects::default();
+        for (e, p) in fit.estimates.iter().zip(set) {
+            let want = p.get(&truth, &fx);
+            assert!(
+                (e.value / want - 1.0).abs() < 1e-6,
+                "{}: {} vs {want}",
+                e.name,
+                e.value
+            );
+        }
+    }
+
+    #[test]
+    fn noisy_linear_data_recover_within_three_standard_errors() {
+        // position only: Kv, Kp, Ki, M (C2 needs the current, see below)
+        let set = [Kv, Kp, Ki, M];
+        let truth = RigParams::default();
+        let fx = RigEffects::default();
+        let (u, clean) = linear_data(Scenario::Prbs, 1.1);
+        let start = perturbed(&set, &[0.9, 1.1, 0.9, 0.85]);
+        let noise = Normal::new(0.0, 2e-7).unwrap();
+        for seed in 0..3 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let y: Vec<f64> = clean.iter().map(|v| v + noise.sample(&mut rng)).collect();
+            let fit = fit_greybox(
+                &Measurements::new(&u, &y, DT),
+                &start,
+                &set,
+                &GreyboxConfig::default(),
+            )
+            .unwrap();
+            assert!(
+                (fit.residual_rms / 2e-7 - 1.0).abs() < 0.05,
+                "{}",
+                fit.residual_rms
+            );
+            for (e, p) in fit.estimates.iter().zip(set) {
+                let want = p.get(&truth, &fx);
+                let se = e.std_error.unwrap();
+                assert!(
+                    (e.value - want).abs() < 3.0 * se,
+                    "seed {seed} {}: {} vs {want} (se {se})",
+                    e.name,
+                    e.value
+                );
+                assert!(se / want < 0.01, "{}: se {se}", e.name);
+            }
+        }
+    }
+
+    #[test]
+    fn table_damping_is_poor_from_position_alone_and_determined_with_the_current() {
+        // C2·v is a small force that the velocity loop's integral hides from
+        // the position; the motor current shows it directly.
+        let set = [Kv, Kp, Ki, C2, M];
+        let truth = RigParams::default();
+        let fx = RigEffects::default();
+        let u = Scenario::Prbs.command(5000.0, 1.1, 1).unwrap();
+        let model = PhysicalModel::linear(truth, LoopModel::Sampled);
+        let mut y = vec![0.0; u.len()];
+        let mut i = vec![0.0; u.len()];
+        model
+            .simulate_channels(&u, DT, &mut y, Some(&mut i))
+            .unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let ny = Normal::new(0.0, 2e-7).unwrap();
+        let ni = Normal::new(0.0, 1e-2).unwrap();
+        y.iter_mut().for_each(|v| *v += ny.sample(&mut rng));
+        i.iter_mut().for_each(|v| *v += ni.sample(&mut rng));
+        let start = perturbed(&set, &[0.9, 1.1, 0.9, 1.2, 0.85]);
+        let cfg = GreyboxConfig::default();
+
+        let alone = fit_greybox(&Measurements::new(&u, &y, DT), &start, &set, &cfg).unwrap();
+        assert_ne!(alone.estimates[3].verdict, Verdict::Identifiable);
+        assert!(alone.estimates[3].relative_std_error.unwrap() > 0.1);
+        assert!(alone.warnings().iter().any(|w| w.starts_with("C2")));
+
+        let both = fit_greybox(
+            &Measurements::new(&u, &y, DT).with_current(&i),
+            &start,
+            &set,
+            &cfg,
+        )
+        .unwrap();
+        assert!((both.current_residual_rms.unwrap() / 1e-2 - 1.0).abs() < 0.05);
+        for (e, p) in both.estimates.iter().zip(set) {
+            let want = p.get(&truth, &fx);
+            let se = e.std_error.unwrap();
+            assert!(
+                (e.value - want).abs() < 3.0 * se,
+                "{}: {} vs {want} (se {se})",
+                e.name,
+                e.value
+            );
+            assert!(se / want < 0.01, "{}: se {se}", e.name);
+            assert_eq!(e.verdict, Verdict::Identifiable);
+        }
+    }
+
+    #[test]
+    fn product_only_parameters_are_refused_by_name() {
+        // With Ke = 0, Kp and Kt only enter as the product Kp·Kt.
+        let mut truth = RigParams::default();
+        truth.motor.ke = 0.0;
+        let u = Scenario::Chirp.command(5000.0, 0.5, 0).unwrap();
+        let y = PhysicalModel::linear(truth, LoopModel::Sampled)
+            .simulate(&u, DT)
+            .unwrap();
+        let set = [Kp, Kt];
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &truth,
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::NotIdentifiable { .. }), "{msg}");
+        assert!(msg.contains("Kp, Kt"), "{msg}");
+        assert!(msg.contains("Kp·λ^1.00, Kt·λ^-1.00"), "{msg}");
+        // reported, not refused, when asked to go on
+        let cfg = GreyboxConfig {
+            refuse_unidentifiable: false,
+            ..GreyboxConfig::default()
+        };
+        let fit = fit_greybox(&Measurements::new(&u, &y, DT), &truth, &set, &cfg).unwrap();
+        assert!(!fit.all_identifiable());
+        assert!(fit
+            .estimates
+            .iter()
+            .all(|e| e.verdict == Verdict::NotIdentifiable));
+        assert!(fit.warnings().iter().any(|w| w.contains("Kp")));
+    }
+
+    #[test]
+    fn the_current_scaling_symmetry_is_found_on_the_default_rig() {
+        // Kt/c, Kp·c, Ke·c leave the closed loop unchanged (Ke·Kt and Kp·Kt fixed)
+        let (u, y) = linear_data(Scenario::Prbs, 0.4);
+        let set = [Kv, Kp, Kt, Ke];
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &RigParams::default(),
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("Kp, Kt, Ke"), "{e}");
+        assert!(!e.contains("Kv"), "{e}");
+    }
+
+    #[test]
+    fn friction_levels_need_the_nonlinear_model() {
+        let (u, y) = linear_data(Scenario::Prbs, 0.1);
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &RigParams::default(),
+            &[Fc],
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("Fc") && e.contains("nonlinear"), "{e}");
+    }
+
+    #[test]
+    fn zero_start_value_is_rejected_by_name() {
+        let (u, y) = linear_data(Scenario::Prbs, 0.1);
+        let mut start = RigParams::default();
+        start.damping.c2 = 0.0;
+        let e = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &start,
+            &[C2],
+            &GreyboxConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("C2"), "{e}");
+    }
+
+    #[test]
+    fn nonlinear_model_recovers_parameters_and_friction_from_a_noise_free_rig() {
+        // the rig with friction, limits, variable stiffness; no noise, no quantisation
+        let truth = RigParams::default();
+        let fx = RigEffects {
+            quantisation: false,
+            noise: false,
+            ..RigEffects::default()
+        };
+        let u = Scenario::Prbs.command(5000.0, 0.3, 4).unwrap();
+        let y = VirtualRig::new(truth)
+            .with_effects(fx)
+            .simulate(&u, 5000.0)
+            .unwrap()
+            .position;
+        let set = [Kv, C2, Fc];
+        let start = perturbed(&[Kv, C2], &[1.1, 0.8]);
+        let mut start_fx = fx;
+        start_fx.table_friction.coulomb *= 1.3;
+        start_fx.table_friction.breakaway *= 1.3;
+        let cfg = GreyboxConfig {
+            dynamics: Dynamics::Nonlinear,
+            effects: start_fx,
+            ..GreyboxConfig::default()
+        };
+        let fit = fit_greybox(&Measurements::new(&u, &y, DT), &start, &set, &cfg).unwrap();
+        let want = [700.0, 100.0, 5.0];
+        for (e, w) in fit.estimates.iter().zip(want) {
+            assert!(
+                (e.value / w - 1.0).abs() < 1e-5,
+                "{}: {} vs {w}",
+                e.name,
+                e.value
+            );
+        }
+    }
+}

@@ -251,7 +251,7 @@ pub struct ReproduceArgs {
     #[arg(long, default_value = "simplex", value_name = "NAME")]
     pub solver: String,
     /// Methods compared with the paper's in report.html (comma-separated).
-    #[arg(long, default_value = "arx,rls,oe", value_name = "LIST")]
+    #[arg(long, default_value = "arx,rls,oe,auto", value_name = "LIST")]
     pub compare: String,
 }
 

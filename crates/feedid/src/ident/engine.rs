@@ -239,23 +239,10 @@ pub fn run<E: Estimator + ?Sized>(
     for (w, (window, horizon)) in config.windows(n, est_warm).enumerate() {
         let coef = &mut coefficients[w * nc..(w + 1) * nc];
         let out = &mut buf[..horizon.len()];
-        let fit = match estimator.fit(signals, window.clone(), coef) {
-            Ok(fit) => match estimator.predict(signals, window.clone(), horizon.clone(), out) {
-                Ok(()) if out.iter().all(|v| v.is_finite()) => {
-                    predicted[horizon.clone()].copy_from_slice(out);
-                    has_prediction[horizon.clone()].fill(true);
-                    fit
-                }
-                Err(Error::PredictionWithheld { .. }) => WindowFit {
-                    termination: Termination::Withheld,
-                    ..fit
-                },
-                _ => failed(fit.residual_rms),
-            },
-            Err(_) => failed(f64::NAN),
-        };
-        if !coef.iter().all(|c| c.is_finite()) {
-            coef.fill(0.0);
+        let fit = fit_and_predict(estimator, signals, &window, &horizon, coef, out);
+        if fit.termination.predicted() {
+            predicted[horizon.clone()].copy_from_slice(out);
+            has_prediction[horizon.clone()].fill(true);
         }
         windows.push(WindowRecord {
             window,
@@ -283,8 +270,38 @@ pub fn run<E: Estimator + ?Sized>(
     })
 }
 
+/// Fit one window and predict its horizon into `out`, the one place where
+/// the outcome is decided for the batch engine and the streaming path: a
+/// prediction counts only if it is finite; a withheld prediction is
+/// [`Termination::Withheld`], any other failure [`Termination::Failed`];
+/// non-finite coefficients are zeroed.
+pub(crate) fn fit_and_predict<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    window: &Range<usize>,
+    horizon: &Range<usize>,
+    coef: &mut [f64],
+    out: &mut [f64],
+) -> WindowFit {
+    let fit = match estimator.fit(signals, window.clone(), coef) {
+        Ok(fit) => match estimator.predict(signals, window.clone(), horizon.clone(), out) {
+            Ok(()) if out.iter().all(|v| v.is_finite()) => fit,
+            Err(Error::PredictionWithheld { .. }) => WindowFit {
+                termination: Termination::Withheld,
+                ..fit
+            },
+            _ => failed(fit.residual_rms),
+        },
+        Err(_) => failed(f64::NAN),
+    };
+    if !coef.iter().all(|c| c.is_finite()) {
+        coef.fill(0.0);
+    }
+    fit
+}
+
 /// The record of a window whose fit or prediction failed.
-pub(crate) fn failed(residual_rms: f64) -> WindowFit {
+fn failed(residual_rms: f64) -> WindowFit {
     WindowFit {
         residual_rms: if residual_rms.is_finite() {
             residual_rms

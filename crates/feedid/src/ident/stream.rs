@@ -102,7 +102,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::engine::EngineConfig;
+use crate::ident::engine::{fit_and_predict, EngineConfig};
 use crate::ident::{Estimator, Signals, WindowFit};
 use crate::recording::MOTION_THRESHOLD;
 use crate::solve::Termination;
@@ -452,23 +452,10 @@ impl<E: Estimator> Streamer<E> {
         };
         let out = &mut pred[..he - we];
         coef.fill(0.0);
-        let fit = match est.fit(&signals, s..we, coef) {
-            Ok(fit) => match est.predict(&signals, s..we, we..he, out) {
-                Ok(()) if out.iter().all(|v| v.is_finite()) => {
-                    p[we - off..he - off].copy_from_slice(out);
-                    has[we - off..he - off].fill(true);
-                    fit
-                }
-                Err(Error::PredictionWithheld { .. }) => WindowFit {
-                    termination: Termination::Withheld,
-                    ..fit
-                },
-                _ => failed(fit.residual_rms),
-            },
-            Err(_) => failed(f64::NAN),
-        };
-        if !coef.iter().all(|c| c.is_finite()) {
-            coef.fill(0.0);
+        let fit = fit_and_predict(est, &signals, &(s..we), &(we..he), coef, out);
+        if fit.termination.predicted() {
+            p[we - off..he - off].copy_from_slice(out);
+            has[we - off..he - off].fill(true);
         }
         let ok = fit.termination.predicted();
         self.windows += 1;
@@ -607,18 +594,6 @@ impl<E: Estimator> Streamer<E> {
                 reason: "samples exceed the buffer: poll the due predictions until None",
             })
         }
-    }
-}
-
-fn failed(residual_rms: f64) -> WindowFit {
-    WindowFit {
-        residual_rms: if residual_rms.is_finite() {
-            residual_rms
-        } else {
-            0.0
-        },
-        iterations: 0,
-        termination: Termination::Failed,
     }
 }
 

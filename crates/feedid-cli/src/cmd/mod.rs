@@ -35,6 +35,18 @@ pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigPara
     })
 }
 
+/// A library error caused by the values of a parameter file, prefixed by the
+/// file (`rig.toml: these parameters give no usable model: …`).
+pub fn params_error(path: Option<&Path>, e: feedid::Error) -> anyhow::Error {
+    match path {
+        Some(p) => anyhow::anyhow!(
+            "{}: these parameters give no usable model: {e}",
+            p.display()
+        ),
+        None => e.into(),
+    }
+}
+
 /// Output files of one command: each is written atomically; if a later one
 /// fails, the ones already written are removed, so a failed command leaves
 /// no output behind.

@@ -5,7 +5,7 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
-use crate::cmd::load_params;
+use crate::cmd::{load_params, params_error};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
 pub fn run(a: &SimulateArgs) -> Result<()> {
@@ -29,7 +29,9 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let rig = VirtualRig::new(params)
         .with_effects(effects)
         .with_seed(a.seed);
-    let out = rig.simulate(&command, a.rate)?;
+    let out = rig
+        .simulate(&command, a.rate)
+        .map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
     feedid::io::write_atomic(&a.output, |w| {
         writeln!(
             w,

@@ -62,7 +62,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::io::options::{ChannelRef, ReadOptions};
-use crate::io::read::{build_recording, failing_sample, in_file, read_file, Role};
+use crate::io::read::{build_recording, failing_sample, in_file, read_file, short_list, Role};
 use crate::recording::Recording;
 
 const HEADER_LEN: usize = 128;
@@ -152,10 +152,7 @@ pub fn read_mat_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
         if vars.is_empty() {
             "none".to_string()
         } else {
-            vars.iter()
-                .map(|v| v.info.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
+            short_list(vars.iter().map(|v| v.info.to_string()))
         }
     };
     let mat_err = |reason: String| Error::MatFile {
@@ -231,7 +228,7 @@ pub fn read_mat_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
             continue;
         }
         if let Ok(values) = vector_of(v) {
-            if values.len() == n && values.iter().all(|x| x.is_finite()) {
+            if values.len() == n && values.iter().all(|&x| crate::recording::is_usable(x)) {
                 rec = rec.with_channel(name, values)?;
             }
         }

@@ -1,0 +1,105 @@
+//! Every estimator on arbitrary `f64` sequences through the batch engine and
+//! the streaming path: never panics; every prediction is finite.
+//!
+//! Layout of the input: byte 0 the method, byte 1 the window, byte 2 the
+//! horizon, byte 3 the hop, byte 4 options; then pairs of `f64` (command,
+//! position), little-endian. Non-finite values are kept in the streaming
+//! path (which must refuse them per sample) and replaced by 0 for the batch
+//! path (a `Recording` refuses them).
+#![no_main]
+
+use feedid::ident::engine::{run, EngineConfig};
+use feedid::ident::{MethodKind, MethodSpec, PredictionMode, Solver, Streamer, TimeOrigin};
+use feedid::Recording;
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    if data.len() < 5 {
+        return;
+    }
+    let (head, body) = data.split_at(5);
+    let kind = [MethodKind::Paper, MethodKind::Arx, MethodKind::Rls, MethodKind::Oe]
+        [usize::from(head[0] & 3)];
+    let mut spec = MethodSpec::new(kind);
+    let opt = head[4];
+    spec.paper.time_origin = if opt & 1 != 0 {
+        TimeOrigin::Window
+    } else {
+        TimeOrigin::Motion
+    };
+    spec.paper.prediction = if opt & 2 != 0 {
+        PredictionMode::TransferFunction
+    } else {
+        PredictionMode::Polynomial
+    };
+    if opt & 4 != 0 {
+        spec.paper.solver = Solver::Simplex;
+    }
+    if opt & 8 != 0 {
+        spec.arx.orders.na = usize::from(head[0] >> 4) % 5 + 1;
+        spec.arx.orders.nb = usize::from(head[0] >> 2) % 5 + 1;
+        spec.arx.orders.nk = usize::from(opt >> 6);
+        spec.rls.orders = spec.arx.orders;
+    }
+    // Keep OE cheap: it iterates a nonlinear solver per window.
+    let cap = if kind == MethodKind::Oe { 64 } else { 256 };
+    let cfg = EngineConfig {
+        window: usize::from(head[1]) % cap + 1,
+        horizon: usize::from(head[2]) % 32 + 1,
+        hop: Some(usize::from(head[3]) % 32 + 1),
+        warm_up: 0,
+    };
+    let n = body.len() / 16;
+    let mut u = Vec::with_capacity(n);
+    let mut y = Vec::with_capacity(n);
+    for c in body.chunks_exact(16) {
+        let mut a = [0u8; 8];
+        a.copy_from_slice(&c[..8]);
+        u.push(f64::from_le_bytes(a));
+        a.copy_from_slice(&c[8..]);
+        y.push(f64::from_le_bytes(a));
+    }
+    // Some inputs as magnitudes users meet (metres): scale by 1e-3 when asked.
+    if opt & 16 != 0 {
+        u.iter_mut().chain(y.iter_mut()).for_each(|v| *v *= 1e-3);
+    }
+    let dt = 2e-4;
+    // Absolute time far from zero (as in the EMPS file) when asked.
+    let t0 = if opt & 32 != 0 { 25.0 } else { 0.0 };
+
+    // Streaming: raw values, one sample at a time.
+    if let Ok(est) = spec.build() {
+        if let Ok(mut s) = Streamer::new(est, cfg) {
+            for k in 0..n {
+                if let Ok(Some(p)) = s.push(t0 + k as f64 * dt, u[k], y[k]) {
+                    assert!(p.position.iter().all(|v| v.is_finite()), "stream prediction");
+                }
+            }
+            s.finish();
+            while let Ok(Some(p)) = s.poll() {
+                assert!(p.position.iter().all(|v| v.is_finite()), "stream prediction");
+            }
+        }
+    }
+
+    // Batch: a checked recording (non-finite values replaced).
+    let clean = |v: &mut Vec<f64>| {
+        v.iter_mut().filter(|x| !x.is_finite()).for_each(|x| *x = 0.0)
+    };
+    clean(&mut u);
+    clean(&mut y);
+    let time: Vec<f64> = (0..n).map(|k| t0 + k as f64 * dt).collect();
+    let Ok(rec) = Recording::new(time, u, y) else {
+        return;
+    };
+    let Ok(mut est) = spec.build() else {
+        return;
+    };
+    if let Ok(res) = run(est.as_mut(), &rec.signals(), &cfg) {
+        for k in 0..rec.len() {
+            if let Some(p) = res.prediction(k) {
+                assert!(p.is_finite(), "batch prediction {k}: {p}");
+            }
+        }
+    }
+});

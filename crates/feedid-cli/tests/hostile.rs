@@ -1143,3 +1143,55 @@ fn a_reader_that_goes_away_ends_the_output_quietly() {
         assert_eq!(status.code(), Some(code), "{args:?}");
     }
 }
+
+#[test]
+fn paper_method_far_from_the_time_origin_warns_and_stays_finite() {
+    // 2 s with the motion from 10 ms on: late windows lie ~2 s after the
+    // motion start, 200 window widths (as the EMPS file's 25 s at 1 kHz)
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("late.csv");
+    let mut body = String::new();
+    for k in 0..2000 {
+        let t = k as f64 * 1e-3;
+        let move_ = |t: f64| {
+            if t < 0.01 {
+                0.0
+            } else {
+                0.01 * (1.0 - (3.0 * (t - 0.01)).cos())
+            }
+        };
+        body += &format!("{t},{},{}\n", move_(t), move_(t - 1.4e-3));
+    }
+    std::fs::write(&input, csv(&body)).unwrap();
+    let out = tmp.path().join("out");
+    for (origin, warns) in [("motion", true), ("window", false)] {
+        for solver in ["qr", "simplex"] {
+            for prediction in ["polynomial", "tf"] {
+                std::fs::create_dir_all(&out).unwrap();
+                let mut args = Cmd::Identify.args(&input, &out);
+                args.extend(
+                    [
+                        "--time-origin",
+                        origin,
+                        "--solver",
+                        solver,
+                        "--prediction",
+                        prediction,
+                    ]
+                    .map(String::from),
+                );
+                let o = run(&args, None);
+                let what = format!("{origin} {solver} {prediction}");
+                check(&o, Expect::Succeeds, "late.csv", &out)
+                    .unwrap_or_else(|e| panic!("{what}: {e}"));
+                let err = stderr(&o);
+                assert_eq!(
+                    err.contains("warning: ") && err.contains("lose about 16"),
+                    warns,
+                    "{what}: {err}"
+                );
+                std::fs::remove_dir_all(&out).unwrap();
+            }
+        }
+    }
+}

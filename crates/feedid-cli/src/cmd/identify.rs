@@ -5,7 +5,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use feedid::drive::RigParams;
-use feedid::ident::{identify, ArxOrders, EngineConfig, MethodSpec, PaperConfig};
+use feedid::ident::{
+    identify, ArxOrders, EngineConfig, MethodKind, MethodSpec, PaperConfig,
+    SHIFT_AMPLIFICATION_WARNING,
+};
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
 use rayon::prelude::*;
 
@@ -138,6 +141,18 @@ fn identify_file(
 ) -> Result<String> {
     let mut est = spec.build()?;
     let rec = recording::load(input, &a.recording)?;
+    if spec.kind == MethodKind::Paper {
+        let g = spec.paper.worst_shift_amplification(&rec.signals(), cfg);
+        if g > SHIFT_AMPLIFICATION_WARNING {
+            eprintln!(
+                "warning: {}: paper method: windows lie far from the time origin; the \
+                 coefficients N, D lose about {:.0} of their 16 digits (amplification {g:.1e}); \
+                 predictions are not affected (--time-origin window keeps the coefficients accurate)",
+                input.display(),
+                g.log10().min(16.0)
+            );
+        }
+    }
     let run = identify(&rec, est.as_mut(), cfg, Some(params))?;
     let summary = run.summary();
 

@@ -18,8 +18,12 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     let (head, body) = data.split_at(5);
-    let kind = [MethodKind::Paper, MethodKind::Arx, MethodKind::Rls, MethodKind::Oe]
-        [usize::from(head[0] & 3)];
+    let kind = [
+        MethodKind::Paper,
+        MethodKind::Arx,
+        MethodKind::Rls,
+        MethodKind::Oe,
+    ][usize::from(head[0] & 3)];
     let mut spec = MethodSpec::new(kind);
     let opt = head[4];
     spec.paper.time_origin = if opt & 1 != 0 {
@@ -72,19 +76,27 @@ fuzz_target!(|data: &[u8]| {
         if let Ok(mut s) = Streamer::new(est, cfg) {
             for k in 0..n {
                 if let Ok(Some(p)) = s.push(t0 + k as f64 * dt, u[k], y[k]) {
-                    assert!(p.position.iter().all(|v| v.is_finite()), "stream prediction");
+                    assert!(
+                        p.position.iter().all(|v| v.is_finite()),
+                        "stream prediction"
+                    );
                 }
             }
             s.finish();
             while let Ok(Some(p)) = s.poll() {
-                assert!(p.position.iter().all(|v| v.is_finite()), "stream prediction");
+                assert!(
+                    p.position.iter().all(|v| v.is_finite()),
+                    "stream prediction"
+                );
             }
         }
     }
 
     // Batch: a checked recording (non-finite values replaced).
     let clean = |v: &mut Vec<f64>| {
-        v.iter_mut().filter(|x| !x.is_finite()).for_each(|x| *x = 0.0)
+        v.iter_mut()
+            .filter(|x| !x.is_finite())
+            .for_each(|x| *x = 0.0)
     };
     clean(&mut u);
     clean(&mut y);

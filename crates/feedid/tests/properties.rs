@@ -193,8 +193,8 @@ proptest! {
         while let Some(p) = s.poll().unwrap() {
             take(p);
         }
-        for k in 0..n {
-            match (batch.prediction(k), streamed[k]) {
+        for (k, &c) in streamed.iter().enumerate() {
+            match (batch.prediction(k), c) {
                 (None, None) => {}
                 (Some(b), Some(c)) => prop_assert!(
                     (b - c).abs() <= 1e-9 * b.abs().max(1e-6),

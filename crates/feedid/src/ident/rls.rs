@@ -757,7 +757,7 @@ mod tests {
         let e = rls.predict(&s, 2..60, 60..65, &mut out).unwrap_err();
         assert!(matches!(e, Error::InvalidModel { .. }), "{e}");
         // window by window: a prediction exactly when the estimate is stable
-        let mut rls = rls.config().clone().build().unwrap();
+        let mut rls = rls.config().build().unwrap();
         let mut unstable = 0;
         for end in (25..95).step_by(5) {
             rls.fit(&s, end - 20..end, &mut coef).unwrap();

@@ -1,11 +1,12 @@
 //! Every estimator on arbitrary `f64` sequences through the batch engine and
 //! the streaming path: never panics; every prediction is finite.
 //!
-//! Layout of the input: byte 0 the method, byte 1 the window, byte 2 the
-//! horizon, byte 3 the hop, byte 4 options; then pairs of `f64` (command,
-//! position), little-endian. Non-finite values are kept in the streaming
-//! path (which must refuse them per sample) and replaced by 0 for the batch
-//! path (a `Recording` refuses them).
+//! Layout of the input: byte 0 the method (and orders), byte 1 the window,
+//! byte 2 the horizon, byte 3 the hop, byte 4 options; then pairs (command,
+//! position) of little-endian `f64` or, with option bit 6, of `i16` µm.
+//! Every value goes to the streaming path as it is (non-finite ones must be
+//! refused per sample, huge ones must not give non-finite predictions); for
+//! the batch path values a `Recording` refuses are replaced by 0.
 #![no_main]
 
 use feedid::ident::engine::{run, EngineConfig};
@@ -53,16 +54,24 @@ fuzz_target!(|data: &[u8]| {
         hop: Some(usize::from(head[3]) % 32 + 1),
         warm_up: 0,
     };
-    let n = body.len() / 16;
-    let mut u = Vec::with_capacity(n);
-    let mut y = Vec::with_capacity(n);
-    for c in body.chunks_exact(16) {
-        let mut a = [0u8; 8];
-        a.copy_from_slice(&c[..8]);
-        u.push(f64::from_le_bytes(a));
-        a.copy_from_slice(&c[8..]);
-        y.push(f64::from_le_bytes(a));
+    // Samples: raw little-endian f64 pairs (any bit pattern), or with
+    // option bit 6 pairs of i16 in µm (signals a rig could give).
+    let (mut u, mut y) = (Vec::new(), Vec::new());
+    if opt & 64 == 0 {
+        for c in body.chunks_exact(16) {
+            let mut a = [0u8; 8];
+            a.copy_from_slice(&c[..8]);
+            u.push(f64::from_le_bytes(a));
+            a.copy_from_slice(&c[8..]);
+            y.push(f64::from_le_bytes(a));
+        }
+    } else {
+        for c in body.chunks_exact(4) {
+            u.push(f64::from(i16::from_le_bytes([c[0], c[1]])) * 1e-6);
+            y.push(f64::from(i16::from_le_bytes([c[2], c[3]])) * 1e-6);
+        }
     }
+    let n = u.len();
     // Some inputs as magnitudes users meet (metres): scale by 1e-3 when asked.
     if opt & 16 != 0 {
         u.iter_mut().chain(y.iter_mut()).for_each(|v| *v *= 1e-3);
@@ -92,10 +101,10 @@ fuzz_target!(|data: &[u8]| {
         }
     }
 
-    // Batch: a checked recording (non-finite values replaced).
+    // Batch: a checked recording (values it refuses replaced by 0).
     let clean = |v: &mut Vec<f64>| {
         v.iter_mut()
-            .filter(|x| !x.is_finite())
+            .filter(|x| !feedid::recording::is_usable(**x))
             .for_each(|x| *x = 0.0)
     };
     clean(&mut u);

@@ -88,6 +88,9 @@ enum Expect {
     /// Exit 0 as [`Expect::Succeeds`], or 2 as [`Expect::Fails`] with these
     /// needles: legal but odd data, where refusing with a reason is fine too.
     SucceedsOrFails(&'static [&'static str]),
+    /// Exit 0 as [`Expect::Succeeds`], and standard error reports every
+    /// needle (`stream` skips a bad line and says so: nothing is lost silently).
+    Reports(&'static [&'static str]),
 }
 
 /// One row of the catalogue.
@@ -181,7 +184,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.01,0.001,NaN"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "position_m", "NaN"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "Inf",
@@ -189,7 +192,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.01,-inf,0"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "command_m", "inf"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "number overflowing to Inf",
@@ -197,7 +200,15 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.01,1e999,0"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "command_m", "inf"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
+        },
+        Case {
+            name: "value beyond ±1e100",
+            file: "beyond.csv",
+            bytes: with_bad_row("0.01,1e150,0"),
+            extra: &[],
+            expect: Fails(&["{file}", "line 12", "command_m", "beyond"]),
+            stream: Reports(&["line 12:", "beyond", "skipped lines 1"]),
         },
         Case {
             name: "text in a number column",
@@ -205,7 +216,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.01,abc,0"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "command_m", "abc"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "missing field",
@@ -213,7 +224,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.01,0"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "2 fields, expected 3"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "duplicate time",
@@ -221,7 +232,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.009,0,0"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "time_s", "not strictly increasing"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "decreasing time",
@@ -229,7 +240,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.005,0,0"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "time_s", "not strictly increasing"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "invalid UTF-8",
@@ -242,7 +253,7 @@ fn catalogue() -> Vec<Case> {
             },
             extra: &[],
             expect: Fails(&["{file}", "line 7", "UTF-8"]),
-            stream: Succeeds,
+            stream: Reports(&["line 7:", "skipped lines 1"]),
         },
         Case {
             name: "extremely long number",
@@ -250,7 +261,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row(&format!("0.01,{},0", "1".repeat(1 << 20))),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "command_m", "inf"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "extremely long line of text",
@@ -258,7 +269,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row(&"x".repeat(2 << 20)),
             extra: &[],
             expect: Fails(&["{file}", "line 12"]),
-            stream: Succeeds,
+            stream: Reports(&["line 12:", "skipped lines 1"]),
         },
         Case {
             name: "100 000 columns",
@@ -525,6 +536,16 @@ fn check(o: &Output, expect: Expect, file: &str, dir: &Path) -> Result<(), Strin
                 succeeds()
             } else {
                 fails(needles)
+            }
+        }
+        Expect::Reports(needles) => {
+            succeeds()?;
+            if let Some(l) = err.lines().find(|l| l.len() > 400) {
+                return Err(format!("a report line of {} bytes", l.len()));
+            }
+            match needles.iter().find(|n| !err.contains(*n)) {
+                Some(n) => Err(format!("`{n}` not reported in\n{err}")),
+                None => Ok(()),
             }
         }
     }

@@ -98,9 +98,13 @@ fn run_on<R: BufRead, W: Write, E: Write>(
             Err(FieldError::NotNumeric) if first => continue, // a header line
             Err(_) => {
                 counts.skipped += 1;
+                // quote at most 60 characters of the line (it may be megabytes)
+                let cut = text.char_indices().nth(60).map_or(text.len(), |(i, _)| i);
+                let more = if cut < text.len() { "…" } else { "" };
                 let _ = writeln!(
                     err,
-                    "line {number}: expected {fields} numbers `{layout}`, got `{text}`; skipped"
+                    "line {number}: expected {fields} numbers `{layout}`, got `{}{more}`; skipped",
+                    &text[..cut]
                 );
                 continue;
             }

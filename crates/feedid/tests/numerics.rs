@@ -201,3 +201,53 @@ fn every_estimator_on_degenerate_data_fails_cleanly_or_stays_finite() {
         }
     }
 }
+
+#[test]
+fn windows_outside_the_data_are_errors_not_panics() {
+    let n = 300;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * DT).collect();
+    let u: Vec<f64> = (0..n).map(smooth_move).collect();
+    let s = feedid::ident::Signals::new(&t, &u, &u, DT, 0.0);
+    #[allow(clippy::reversed_empty_ranges)]
+    let bad: [std::ops::Range<usize>; 5] = [
+        0..n + 5,
+        n..n + 20,
+        250..240,
+        100..100,
+        usize::MAX - 3..usize::MAX,
+    ];
+    for (method, spec, _) in methods() {
+        let mut est = spec.build().unwrap();
+        let mut coef = vec![0.0; est.coefficient_names().len()];
+        for w in bad.clone() {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                est.fit(&s, w.clone(), &mut coef).is_err()
+            }));
+            assert_eq!(r.ok(), Some(true), "{method}: fit on {w:?}");
+        }
+        // signals of different lengths (a library caller's slip)
+        let short = feedid::ident::Signals::new(&t, &u[..200], &u, DT, 0.0);
+        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            est.fit(&short, 150..250, &mut coef).is_err()
+        }));
+        assert_eq!(
+            r.ok(),
+            Some(true),
+            "{method}: fit on signals of different lengths"
+        );
+        // a good fit, then horizons outside the data
+        if est.fit(&s, 150..250, &mut coef).is_ok() {
+            for (w, h) in [
+                (150..250, 250..n + 10),
+                (150..250, 260..270),
+                (150..250, 250..250),
+            ] {
+                let mut out = vec![0.0; h.len()];
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    est.predict(&s, w.clone(), h.clone(), &mut out).is_err()
+                }));
+                assert!(r.is_ok(), "{method}: predict {w:?} {h:?} panicked");
+            }
+        }
+    }
+}

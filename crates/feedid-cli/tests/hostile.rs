@@ -880,6 +880,17 @@ fn arg_catalogue() -> Vec<ArgCase> {
             Fails(&["{plain}"]),
         ),
         case(
+            "identify: two inputs of the same name into one --out-dir",
+            &[
+                "identify",
+                "{good}",
+                "{out}/../sub/good.csv",
+                "--out-dir",
+                "{out}/batch",
+            ],
+            Fails(&["would both write", "good.*"]),
+        ),
+        case(
             "simulate: output into a file's subdirectory",
             &[
                 "simulate",

@@ -90,15 +90,25 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
         }
         (None, _) => bail!("several inputs need --out-dir DIR (one set of outputs per input)"),
         (Some(dir), inputs) => {
+            // two inputs with the same name would overwrite each other's outputs
+            let mut seen = std::collections::HashMap::new();
+            for input in inputs {
+                let stem = output_stem(input);
+                if let Some(first) = seen.insert(stem.clone(), input) {
+                    bail!(
+                        "{} and {} would both write {}: give the recordings different names",
+                        first.display(),
+                        input.display(),
+                        dir.join(format!("{stem}.*")).display()
+                    );
+                }
+            }
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("{}: cannot create directory", dir.display()))?;
             let results: Vec<(PathBuf, Result<String>)> = inputs
                 .par_iter()
                 .map(|input| {
-                    let stem = input
-                        .file_stem()
-                        .map(|s| s.to_string_lossy().into_owned())
-                        .unwrap_or_else(|| "recording".to_string());
+                    let stem = output_stem(input);
                     let paths = OutputPaths {
                         predictions: dir.join(format!("{stem}.predictions.csv")),
                         coefficients: Some(dir.join(format!("{stem}.coefficients.csv"))),
@@ -128,6 +138,14 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// The name of a recording's outputs in batch mode (`DIR/STEM.predictions.csv`, …).
+fn output_stem(input: &Path) -> String {
+    input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "recording".to_string())
 }
 
 /// Read, identify and write one recording; returns the human-readable summary.

@@ -880,6 +880,28 @@ fn arg_catalogue() -> Vec<ArgCase> {
             Fails(&["{plain}"]),
         ),
         case(
+            "identify: predictions over the input",
+            &["identify", "{good}", "-o", "{good}"],
+            Fails(&["{good}", "overwrite the input"]),
+        ),
+        case(
+            "identify: predictions over the input by another path",
+            &["identify", "{good}", "-o", "{out}/../good.csv"],
+            Fails(&["overwrite the input"]),
+        ),
+        case(
+            "identify: summary and predictions to one file",
+            &[
+                "identify",
+                "{good}",
+                "-o",
+                "{out}/p.csv",
+                "--summary",
+                "{out}/p.csv",
+            ],
+            Fails(&["{out}/p.csv", "two outputs"]),
+        ),
+        case(
             "identify: two inputs of the same name into one --out-dir",
             &[
                 "identify",

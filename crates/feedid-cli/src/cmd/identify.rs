@@ -13,7 +13,7 @@ use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_ato
 use rayon::prelude::*;
 
 use crate::args::{IdentifyArgs, MethodArgs, WindowArgs};
-use crate::cmd::{load_params, recording, Outputs};
+use crate::cmd::{check_distinct, load_params, recording, Outputs};
 
 /// The method named on the command line with its options.
 pub fn method_spec(m: &MethodArgs) -> Result<MethodSpec> {
@@ -84,6 +84,12 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
                 coefficients: a.coefficients.clone(),
                 summary: a.summary.clone(),
             };
+            let mut ins = vec![input.as_path()];
+            ins.extend(a.params.as_deref());
+            let mut outs = vec![paths.predictions.as_path()];
+            outs.extend(paths.coefficients.as_deref());
+            outs.extend(paths.summary.as_deref());
+            check_distinct(&ins, &outs)?;
             let text = identify_file(input, a, &spec, &cfg, &params, &paths)?;
             print!("{text}");
             Ok(())

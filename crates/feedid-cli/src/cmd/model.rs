@@ -16,6 +16,7 @@ pub fn run(a: &ModelArgs) -> Result<()> {
     let summary =
         ModelSummary::new(&params, variant).map_err(|e| params_error(a.params.as_deref(), e))?;
     if let Some(p) = &a.save_params {
+        // saving over the file read is fine (a template of the same values)
         feedid::io::write_string_atomic(p, &params.to_toml_string())?;
     }
     if a.json {

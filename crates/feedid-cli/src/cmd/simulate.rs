@@ -5,10 +5,17 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
-use crate::cmd::{load_params, params_error};
+use crate::cmd::{check_distinct, load_params, params_error};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
 pub fn run(a: &SimulateArgs) -> Result<()> {
+    let inputs: Vec<&std::path::Path> = a
+        .params
+        .iter()
+        .chain(&a.effects)
+        .map(|p| p.as_path())
+        .collect();
+    check_distinct(&inputs, &[a.output.as_path()])?;
     let scenario: Scenario = a.scenario.parse()?;
     let params = load_params(a.params.as_deref())?;
     let effects = if a.linear {

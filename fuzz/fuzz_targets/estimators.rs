@@ -75,7 +75,7 @@ fuzz_target!(|data: &[u8]| {
     let cap = match kind {
         MethodKind::Oe => 80,
         MethodKind::Paper if spec.paper.solver == Solver::Simplex => 120,
-        _ => 400,
+        _ => 200,
     };
     u.truncate(cap);
     y.truncate(cap);

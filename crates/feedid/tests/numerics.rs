@@ -251,3 +251,60 @@ fn windows_outside_the_data_are_errors_not_panics() {
         }
     }
 }
+
+#[test]
+fn a_prediction_is_only_ever_made_from_a_stable_model() {
+    use feedid::ident::{ArxConfig, ArxOrders, Estimator, OeConfig, Signals};
+    // data from an unstable system (y[k] = 1.02·y[k−1] + u[k−1]) and pure noise
+    let n = 400;
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let noise = Normal::new(0.0, 1e-6).unwrap();
+    let u: Vec<f64> = (0..n).map(|_| noise.sample(&mut rng)).collect();
+    let mut unstable = vec![0.0; n];
+    for k in 1..n {
+        unstable[k] = 1.02 * unstable[k - 1] + u[k - 1];
+    }
+    let pure: Vec<f64> = (0..n).map(|_| noise.sample(&mut rng)).collect();
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * DT).collect();
+    for (name, y) in [("unstable system", &unstable), ("pure noise", &pure)] {
+        let s = Signals::new(&t, &u, y, DT, 0.0);
+        let mut arx = ArxConfig {
+            orders: ArxOrders::new(2, 2, 1),
+            dc_gain_bounds: (f64::NEG_INFINITY, f64::INFINITY),
+            min_excitation: 0.0,
+            ..ArxConfig::default()
+        }
+        .build()
+        .unwrap();
+        let mut oe = OeConfig {
+            poles: 2,
+            zeros: 0,
+            ..OeConfig::default()
+        }
+        .build()
+        .unwrap();
+        let mut out = [0.0; 10];
+        let mut arx_made = 0;
+        for start in (10..n - 110).step_by(20) {
+            let (w, h) = (start..start + 100, start + 100..start + 110);
+            let mut c = vec![0.0; arx.coefficient_names().len()];
+            if arx.fit(&s, w.clone(), &mut c).is_ok()
+                && arx.predict(&s, w.clone(), h.clone(), &mut out).is_ok()
+            {
+                arx_made += 1;
+                let m = arx.model(DT).unwrap().unwrap();
+                assert!(m.is_stable().unwrap(), "{name}: arx window at {start}");
+            }
+            let mut c = vec![0.0; oe.coefficient_names().len()];
+            if oe.fit(&s, w.clone(), &mut c).is_ok() && oe.predict(&s, w, h, &mut out).is_ok() {
+                let m = oe.model().unwrap();
+                assert!(m.is_stable().unwrap(), "{name}: oe window at {start}");
+            }
+            assert!(out.iter().all(|v| v.is_finite()));
+        }
+        // on the unstable system ARX refuses every model (OE fits stable ones)
+        if name == "unstable system" {
+            assert_eq!(arx_made, 0, "{name}");
+        }
+    }
+}

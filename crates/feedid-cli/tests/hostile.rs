@@ -1249,3 +1249,23 @@ fn paper_method_far_from_the_time_origin_warns_and_stays_finite() {
         }
     }
 }
+
+#[test]
+fn stream_skips_an_endless_line_without_holding_it() {
+    // 8 MB of NUL bytes without a newline (`cat /dev/zero | feedid stream`),
+    // then a good recording: the long line is reported and skipped, the rest is used
+    let mut input = vec![0u8; 8 << 20];
+    input.push(b'\n');
+    input.extend_from_slice(&csv(&rows(60, 0.0, 1e-3, 1.0)));
+    let args = Cmd::Stream.args(Path::new(""), Path::new(""));
+    let o = run(&args, Some(&input));
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("line 1: longer than 1048576 bytes; skipped"),
+        "{err}"
+    );
+    assert!(err.contains("samples 60,"), "{err}");
+    assert!(common::stdout(&o).lines().count() > 10);
+    assert!(err.lines().all(|l| l.len() < 400));
+}

@@ -235,6 +235,28 @@ fn windows_outside_the_data_are_errors_not_panics() {
             Some(true),
             "{method}: fit on signals of different lengths"
         );
+        // a nonsensical nominal interval or motion start (a library caller's slip)
+        for (dt, ms) in [
+            (0.0, 0.0),
+            (f64::NAN, 0.0),
+            (-DT, 0.0),
+            (DT, f64::NAN),
+            (DT, 1e300),
+        ] {
+            let odd = feedid::ident::Signals::new(&t, &u, &u, dt, ms);
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let mut out = [0.0; 10];
+                match est.fit(&odd, 150..250, &mut coef) {
+                    Ok(_) => match est.predict(&odd, 150..250, 250..260, &mut out) {
+                        Ok(()) => out.iter().all(|v| v.is_finite()),
+                        Err(_) => true,
+                    },
+                    Err(_) => true,
+                }
+            }));
+            assert_eq!(r.ok(), Some(true), "{method}: dt {dt}, motion start {ms}");
+        }
+        est.reset();
         // a good fit, then horizons outside the data
         if est.fit(&s, 150..250, &mut coef).is_ok() {
             for (w, h) in [

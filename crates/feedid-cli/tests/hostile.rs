@@ -1,16 +1,25 @@
 //! The bad-input catalogue: hostile files and arguments through every command
 //! that reads a file or standard input, as a user would call it.
 //!
-//! Each case is one row of a table: a name, the input bytes, and what every
-//! command that reads such an input must do with it. A failure must be exit
-//! code 2 with exactly one `error:` line naming the place (no panic, which
-//! exits 101), and must leave no output file behind. Inputs that are odd but
-//! legal (huge or tiny magnitudes, constant signals) may succeed; then every
-//! number in the outputs must be finite.
+//! Three tables, each row a name, the input and what must happen:
 //!
-//! To cover a new command: add a [`Cmd`] variant with its arguments in
-//! [`Cmd::args`] and list it in [`RECORDING_COMMANDS`] (or the TOML tables);
-//! every row then runs through it.
+//! - [`catalogue`]: recordings (text and MAT) × every command that reads one
+//!   ([`RECORDING_COMMANDS`]; `stream` gets the bytes on standard input);
+//! - [`toml_catalogue`]: parameter and effects files × every command that
+//!   reads one ([`TomlCmd::ALL`]);
+//! - [`arg_catalogue`]: command lines with unwritable outputs, outputs over
+//!   inputs and numbers a user can type.
+//!
+//! A failure must be exit code 2 with exactly one `error:` line (under 400
+//! bytes) naming the place (no panic, which exits 101), and must leave no
+//! output file behind. Odd but legal inputs succeed with every number in the
+//! outputs finite, with a warning where the user should know (a command that
+//! never moves); `stream` skips a bad line and reports it by number.
+//!
+//! To cover a new command: add a [`Cmd`] (or [`TomlCmd`]) variant with its
+//! arguments and list it in [`RECORDING_COMMANDS`] (or [`TomlCmd::ALL`]);
+//! every row then runs through it, and [`expectation`] takes per-command
+//! exceptions.
 //!
 //! The inputs are small (at most a few hundred samples, a few MB for the long
 //! lines) so that the whole catalogue runs in a few seconds.

@@ -38,7 +38,7 @@ pub enum Error {
 
     // ------------------------------------------------------------ parameters
     /// A numeric parameter or option is outside its valid range.
-    #[error("invalid value for `{name}`: {value} ({reason})")]
+    #[error("invalid value for `{name}`: {} ({reason})", short_number(*value))]
     InvalidParameter {
         /// Parameter name as the user writes it.
         name: &'static str,
@@ -249,6 +249,33 @@ pub enum Error {
         /// What to change.
         hint: &'static str,
     },
+
+    // --- harden
+    /// A finite value too large in magnitude for the numerics (squares and
+    /// sums of squares must stay finite), see [`crate::recording::MAX_MAGNITUDE`].
+    #[error("value {value:e} in {channel} at sample {index} is beyond ±{limit:e}; check the unit or scale")]
+    OutOfRange {
+        /// Channel name (`"time"`, `"command"`, `"position"` or an extra channel).
+        channel: String,
+        /// Zero-based sample index.
+        index: usize,
+        /// The offending value.
+        value: f64,
+        /// The largest magnitude accepted.
+        limit: f64,
+    },
+
+    /// The mean sampling interval of the time stamps is too short for a
+    /// finite rate and finite derivatives, see [`crate::recording::MIN_INTERVAL`].
+    #[error("mean sampling interval {interval:e} s is shorter than {min:e} s (a rate above {max_rate:e} Hz); check the time unit")]
+    SamplingInterval {
+        /// The mean interval \[s\].
+        interval: f64,
+        /// The shortest accepted \[s\].
+        min: f64,
+        /// `1 / min` \[Hz\].
+        max_rate: f64,
+    },
 }
 
 impl Error {
@@ -269,9 +296,43 @@ fn display_in_file(path: &std::path::Path, location: &str, source: &Error) -> St
     }
 }
 
+/// A number for a one-line message: plain when short, else in `e` notation
+/// (`1e300`, not three hundred digits).
+pub(crate) fn short_number(v: f64) -> String {
+    let a = v.abs();
+    if !v.is_finite() || a == 0.0 || (1e-4..1e15).contains(&a) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
+
 fn display_path(path: &Option<PathBuf>) -> String {
     match path {
         Some(p) => p.display().to_string(),
         None => "parameters".to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        assert_eq!(short_number(0.0), "0");
+        assert_eq!(short_number(2.5), "2.5");
+        assert_eq!(short_number(-1e300), "-1e300");
+        assert_eq!(short_number(1e-300), "1e-300");
+        assert_eq!(short_number(f64::NAN), "NaN");
+        let e = Error::InvalidParameter {
+            name: "duration",
+            value: 1e300,
+            reason: "too long",
+        };
+        assert_eq!(
+            e.to_string(),
+            "invalid value for `duration`: 1e300 (too long)"
+        );
     }
 }

@@ -1,7 +1,10 @@
 //! A measured (or simulated) recording: time, command and measured position,
 //! checked on construction.
 //!
-//! Checks: equal lengths, every value finite, time strictly increasing, and
+//! Checks: equal lengths, every value finite and at most [`MAX_MAGNITUDE`]
+//! in magnitude (so that squares and sums of squares over any recording stay
+//! finite), time strictly increasing with a mean interval of at least
+//! [`MIN_INTERVAL`] (so that the rate and finite differences stay finite), and
 //! uniform sampling — every interval within `jitter_tolerance` (relative) of
 //! the mean interval. Nothing is dropped or reordered.
 //!
@@ -19,6 +22,14 @@ use crate::ident::Signals;
 
 /// Default relative tolerance on sampling-interval deviation (1 %).
 pub const DEFAULT_JITTER_TOLERANCE: f64 = 0.01;
+
+/// Largest magnitude of any value of a recording (1e100): its square summed
+/// over 1e9 samples is still finite.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+
+/// Shortest mean sampling interval \[s\] (1e-12 s, a rate of 1 THz): with
+/// values up to [`MAX_MAGNITUDE`] every finite difference stays finite.
+pub const MIN_INTERVAL: f64 = 1e-12;
 
 /// A checked recording of command and measured position.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,6 +102,13 @@ impl Recording {
             }
         }
         let dt = mean_interval(&time);
+        if dt < MIN_INTERVAL {
+            return Err(Error::SamplingInterval {
+                interval: dt,
+                min: MIN_INTERVAL,
+                max_rate: 1.0 / MIN_INTERVAL,
+            });
+        }
         let mut max_jitter = 0.0_f64;
         let mut worst = 0;
         for k in 1..time.len() {
@@ -281,14 +299,25 @@ pub struct MotionSegment {
 pub const MOTION_THRESHOLD: f64 = 1e-9;
 
 fn check_finite(channel: &str, v: &[f64]) -> Result<()> {
-    match v.iter().position(|x| !x.is_finite()) {
-        Some(index) => Err(Error::NonFinite {
+    match v.iter().position(|x| !is_usable(*x)) {
+        Some(index) if !v[index].is_finite() => Err(Error::NonFinite {
             channel: channel.to_string(),
             index,
             value: v[index],
         }),
+        Some(index) => Err(Error::OutOfRange {
+            channel: channel.to_string(),
+            index,
+            value: v[index],
+            limit: MAX_MAGNITUDE,
+        }),
         None => Ok(()),
     }
+}
+
+/// Whether a value is accepted in a recording: finite and at most [`MAX_MAGNITUDE`] in magnitude.
+pub fn is_usable(x: f64) -> bool {
+    x.abs() <= MAX_MAGNITUDE
 }
 
 /// Mean interval `(t_last − t_first)/(n − 1)` of a strictly increasing

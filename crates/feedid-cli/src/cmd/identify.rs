@@ -7,13 +7,13 @@ use anyhow::{bail, Context, Result};
 use feedid::drive::RigParams;
 use feedid::ident::{
     fit_global_model, global_model_for, identify, select_order, ArxOrders, EngineConfig,
-    GlobalModelKind, MethodSpec, OrderSearch, PaperConfig,
+    GlobalModelKind, MethodKind, MethodSpec, OrderSearch, PaperConfig, SHIFT_AMPLIFICATION_WARNING,
 };
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
 use rayon::prelude::*;
 
 use crate::args::{IdentifyArgs, MethodArgs, WindowArgs};
-use crate::cmd::{load_params, recording, Outputs};
+use crate::cmd::{check_distinct, load_params, recording, Outputs};
 
 /// The method named on the command line with its options.
 pub fn method_spec(m: &MethodArgs) -> Result<MethodSpec> {
@@ -91,21 +91,37 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
                 coefficients: a.coefficients.clone(),
                 summary: a.summary.clone(),
             };
+            let mut ins = vec![input.as_path()];
+            ins.extend(a.params.as_deref());
+            let mut outs = vec![paths.predictions.as_path()];
+            outs.extend(paths.coefficients.as_deref());
+            outs.extend(paths.summary.as_deref());
+            check_distinct(&ins, &outs)?;
             let text = identify_file(input, a, &spec, &cfg, &params, &paths)?;
             print!("{text}");
             Ok(())
         }
         (None, _) => bail!("several inputs need --out-dir DIR (one set of outputs per input)"),
         (Some(dir), inputs) => {
+            // two inputs with the same name would overwrite each other's outputs
+            let mut seen = std::collections::HashMap::new();
+            for input in inputs {
+                let stem = output_stem(input);
+                if let Some(first) = seen.insert(stem.clone(), input) {
+                    bail!(
+                        "{} and {} would both write {}: give the recordings different names",
+                        first.display(),
+                        input.display(),
+                        dir.join(format!("{stem}.*")).display()
+                    );
+                }
+            }
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("{}: cannot create directory", dir.display()))?;
             let results: Vec<(PathBuf, Result<String>)> = inputs
                 .par_iter()
                 .map(|input| {
-                    let stem = input
-                        .file_stem()
-                        .map(|s| s.to_string_lossy().into_owned())
-                        .unwrap_or_else(|| "recording".to_string());
+                    let stem = output_stem(input);
                     let paths = OutputPaths {
                         predictions: dir.join(format!("{stem}.predictions.csv")),
                         coefficients: Some(dir.join(format!("{stem}.coefficients.csv"))),
@@ -135,6 +151,14 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// The name of a recording's outputs in batch mode (`DIR/STEM.predictions.csv`, …).
+fn output_stem(input: &Path) -> String {
+    input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "recording".to_string())
 }
 
 /// Read, identify and write one recording; returns the human-readable summary.
@@ -175,6 +199,18 @@ fn identify_file(
         spec.rls.orders = sel.chosen;
         spec.auto.long.orders = sel.chosen;
         chosen_order = Some((sel.chosen, sel.criterion));
+    }
+    if spec.kind == MethodKind::Paper {
+        let g = spec.paper.worst_shift_amplification(&rec.signals(), cfg);
+        if g > SHIFT_AMPLIFICATION_WARNING {
+            eprintln!(
+                "warning: {}: paper method: windows lie far from the time origin; the \
+                 coefficients N, D lose about {:.0} of their 16 digits (amplification {g:.1e}); \
+                 predictions are not affected (--time-origin window keeps the coefficients accurate)",
+                input.display(),
+                g.log10().min(16.0)
+            );
+        }
     }
     let mut est = spec.build()?;
     let mut run = identify(&rec, est.as_mut(), cfg, Some(params))?;

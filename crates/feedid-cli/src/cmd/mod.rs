@@ -44,6 +44,53 @@ pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigPara
     })
 }
 
+/// A library error caused by the values of a parameter file, prefixed by the
+/// file (`rig.toml: these parameters give no usable model: …`).
+pub fn params_error(path: Option<&Path>, e: feedid::Error) -> anyhow::Error {
+    match path {
+        Some(p) => anyhow::anyhow!(
+            "{}: these parameters give no usable model: {e}",
+            p.display()
+        ),
+        None => e.into(),
+    }
+}
+
+/// Refuse a command line whose outputs would overwrite one of its inputs or
+/// each other (`identify rec.csv -o rec.csv` would destroy the recording).
+pub fn check_distinct(inputs: &[&Path], outputs: &[&Path]) -> anyhow::Result<()> {
+    // an output may not exist yet: compare its canonical directory and name
+    let key = |p: &Path| -> Option<PathBuf> {
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some(std::fs::canonicalize(dir).ok()?.join(p.file_name()?))
+    };
+    for (i, out) in outputs.iter().enumerate() {
+        let Some(k) = key(out) else { continue };
+        for input in inputs {
+            if key(input).as_ref() == Some(&k) {
+                anyhow::bail!(
+                    "{}: the output would overwrite the input {}",
+                    out.display(),
+                    input.display()
+                );
+            }
+        }
+        for other in &outputs[..i] {
+            if key(other).as_ref() == Some(&k) {
+                anyhow::bail!(
+                    "{}: given for two outputs ({} too)",
+                    out.display(),
+                    other.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Output files of one command: each is written atomically; if a later one
 /// fails, the ones already written are removed, so a failed command leaves
 /// no output behind.

@@ -4,7 +4,7 @@ use anyhow::Result;
 use feedid::drive::{D1Variant, ModelSummary};
 
 use crate::args::{D1Arg, ModelArgs};
-use crate::cmd::load_params;
+use crate::cmd::{load_params, params_error};
 
 /// Print the model summary as text or JSON.
 pub fn run(a: &ModelArgs) -> Result<()> {
@@ -13,8 +13,10 @@ pub fn run(a: &ModelArgs) -> Result<()> {
         D1Arg::Corrected => D1Variant::Corrected,
         D1Arg::Paper => D1Variant::PaperPrinted,
     };
-    let summary = ModelSummary::new(&params, variant)?;
+    let summary =
+        ModelSummary::new(&params, variant).map_err(|e| params_error(a.params.as_deref(), e))?;
     if let Some(p) = &a.save_params {
+        // saving over the file read is fine (a template of the same values)
         feedid::io::write_string_atomic(p, &params.to_toml_string())?;
     }
     if a.json {

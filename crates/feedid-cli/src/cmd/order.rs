@@ -37,7 +37,8 @@ pub fn run(a: &OrderArgs) -> Result<()> {
         validation_fraction: a.validation,
         ..OrderSearch::default()
     };
-    let sel = select_order(rec.command(), rec.position(), rec.dt(), &search)?;
+    let sel = select_order(rec.command(), rec.position(), rec.dt(), &search)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&sel)?);
         return Ok(());

@@ -5,10 +5,17 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
-use crate::cmd::load_params;
+use crate::cmd::{check_distinct, load_params, params_error};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
 pub fn run(a: &SimulateArgs) -> Result<()> {
+    let inputs: Vec<&std::path::Path> = a
+        .params
+        .iter()
+        .chain(&a.effects)
+        .map(|p| p.as_path())
+        .collect();
+    check_distinct(&inputs, &[a.output.as_path()])?;
     let scenario: Scenario = a.scenario.parse()?;
     let params = load_params(a.params.as_deref())?;
     let effects = if a.linear {
@@ -29,7 +36,9 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let rig = VirtualRig::new(params)
         .with_effects(effects)
         .with_seed(a.seed);
-    let out = rig.simulate(&command, a.rate)?;
+    let out = rig
+        .simulate(&command, a.rate)
+        .map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
     feedid::io::write_atomic(&a.output, |w| {
         writeln!(
             w,

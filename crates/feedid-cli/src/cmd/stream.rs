@@ -15,7 +15,7 @@
 //! skipped; the stream goes on. At the end of input the last windows are
 //! processed and a summary goes to standard error.
 
-use std::io::{BufRead, ErrorKind, Write};
+use std::io::{BufRead, ErrorKind, Read, Write};
 
 use anyhow::{bail, Result};
 use feedid::ident::{Prediction, Streamer};
@@ -70,24 +70,32 @@ fn run_on<R: BufRead, W: Write, E: Write>(
     let mut sink = write_rows(&mut out, None, &mut counts, true);
     let mut seen_data_line = false;
     let mut values = [0.0; 3];
-    let mut line = String::new();
+    let mut line: Vec<u8> = Vec::new();
     let mut input = input;
     let mut number = 0usize;
     while matches!(sink, Sink::Open) {
         line.clear();
-        match input.read_line(&mut line) {
+        // at most MAX_LINE bytes per line: a stream without newlines
+        // (`cat /dev/zero | feedid stream`) must not exhaust memory
+        match (&mut input).take(MAX_LINE).read_until(b'\n', &mut line) {
             Ok(0) => break,
             Ok(_) => {}
-            Err(e) if e.kind() == ErrorKind::InvalidData => {
-                number += 1;
-                counts.skipped += 1;
-                let _ = writeln!(err, "line {number}: not UTF-8 text; skipped");
-                continue;
-            }
+            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
             Err(e) => return Err(e.into()),
         }
         number += 1;
-        let text = line.trim();
+        if line.len() as u64 >= MAX_LINE && line.last() != Some(&b'\n') {
+            skip_rest_of_line(&mut input)?;
+            counts.skipped += 1;
+            let _ = writeln!(err, "line {number}: longer than {MAX_LINE} bytes; skipped");
+            continue;
+        }
+        let Ok(text) = std::str::from_utf8(&line) else {
+            counts.skipped += 1;
+            let _ = writeln!(err, "line {number}: not UTF-8 text; skipped");
+            continue;
+        };
+        let text = text.trim();
         if text.is_empty() || text.starts_with('#') {
             continue;
         }
@@ -98,9 +106,13 @@ fn run_on<R: BufRead, W: Write, E: Write>(
             Err(FieldError::NotNumeric) if first => continue, // a header line
             Err(_) => {
                 counts.skipped += 1;
+                // quote at most 60 characters of the line (it may be megabytes)
+                let cut = text.char_indices().nth(60).map_or(text.len(), |(i, _)| i);
+                let more = if cut < text.len() { "…" } else { "" };
                 let _ = writeln!(
                     err,
-                    "line {number}: expected {fields} numbers `{layout}`, got `{text}`; skipped"
+                    "line {number}: expected {fields} numbers `{layout}`, got `{}{more}`; skipped",
+                    &text[..cut]
                 );
                 continue;
             }
@@ -142,6 +154,33 @@ fn run_on<R: BufRead, W: Write, E: Write>(
         s.scored.max_abs,
     );
     Ok(())
+}
+
+/// Longest input line \[bytes\]; longer ones are reported and skipped.
+const MAX_LINE: u64 = 1 << 20;
+
+/// Discard input up to and including the next newline (or to the end).
+fn skip_rest_of_line<R: BufRead>(input: &mut R) -> std::io::Result<()> {
+    loop {
+        let buf = match input.fill_buf() {
+            Ok(b) => b,
+            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if buf.is_empty() {
+            return Ok(());
+        }
+        match buf.iter().position(|&b| b == b'\n') {
+            Some(i) => {
+                input.consume(i + 1);
+                return Ok(());
+            }
+            None => {
+                let n = buf.len();
+                input.consume(n);
+            }
+        }
+    }
 }
 
 /// Write the header (`header`) or a prediction's rows, and flush.

@@ -370,7 +370,10 @@ impl RigParams {
                 Some(p),
             ) => Error::ParamsFile {
                 path: Some(p.to_path_buf()),
-                message: format!("invalid value for `{name}`: {value} ({reason})"),
+                message: format!(
+                    "invalid value for `{name}`: {} ({reason})",
+                    crate::error::short_number(value)
+                ),
             },
             (e, _) => e,
         })?;

@@ -58,8 +58,9 @@ pub struct ModelSummary {
     pub poles: Vec<[f64; 2]>,
     /// Poles with frequency and damping, sorted by frequency.
     pub pole_details: Vec<PoleInfo>,
-    /// −3 dB bandwidth of Xa/Xs \[Hz\].
-    pub bandwidth_hz: f64,
+    /// −3 dB bandwidth of Xa/Xs \[Hz\]; `None` (JSON `null`) when outside the
+    /// scanned 0.01 Hz … 100 kHz (see [`bandwidth_hz`]).
+    pub bandwidth_hz: Option<f64>,
     /// DC gain (1 for the corrected coefficients).
     pub dc_gain: f64,
     /// Steady ramp following error per command velocity `(D1 − N1)/D0` \[s\] (= 1/Kv).
@@ -97,8 +98,9 @@ impl ModelSummary {
 }
 
 /// −3 dB bandwidth \[Hz\]: first frequency where |G| falls below |G(0)|/√2
-/// (log scan 0.01 Hz … 100 kHz, refined by bisection); `f64::INFINITY` if none.
-pub fn bandwidth_hz(tf: &TransferFunction) -> f64 {
+/// (log scan 0.01 Hz … 100 kHz, refined by bisection); `None` if the gain
+/// is already below at 0.01 Hz, does not fall below up to 100 kHz, or is not finite.
+pub fn bandwidth_hz(tf: &TransferFunction) -> Option<f64> {
     let g0 = tf.dc_gain().abs();
     let target = g0 / std::f64::consts::SQRT_2;
     let mag = |f: f64| {
@@ -106,8 +108,9 @@ pub fn bandwidth_hz(tf: &TransferFunction) -> f64 {
             .norm()
     };
     let mut lo = 0.01;
-    if !(g0.is_finite()) || mag(lo) < target {
-        return f64::INFINITY;
+    let m0 = mag(lo);
+    if !g0.is_finite() || g0 == 0.0 || m0.is_nan() || m0 < target {
+        return None;
     }
     let steps = 700;
     for k in 1..=steps {
@@ -122,11 +125,12 @@ pub fn bandwidth_hz(tf: &TransferFunction) -> f64 {
                     lo = mid;
                 }
             }
-            return (lo * hi).sqrt();
+            let bw = (lo * hi).sqrt();
+            return bw.is_finite().then_some(bw);
         }
         lo = f;
     }
-    f64::INFINITY
+    None
 }
 
 impl fmt::Display for ModelSummary {
@@ -167,7 +171,10 @@ impl fmt::Display for ModelSummary {
                 p.re, p.im, p.freq_hz, p.damping
             )?;
         }
-        writeln!(f, "Bandwidth (−3 dB)         {:.1} Hz", self.bandwidth_hz)?;
+        match self.bandwidth_hz {
+            Some(bw) => writeln!(f, "Bandwidth (−3 dB)         {bw:.1} Hz")?,
+            None => writeln!(f, "Bandwidth (−3 dB)         outside 0.01 Hz … 100 kHz")?,
+        }
         writeln!(f, "DC gain                   {:.9}", self.dc_gain)?;
         write!(
             f,
@@ -175,5 +182,42 @@ impl fmt::Display for ModelSummary {
             1e3 * self.following_error_s,
             0.05 * self.following_error_s * 1e6
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn first_order(corner_hz: f64) -> TransferFunction {
+        let w = 2.0 * std::f64::consts::PI * corner_hz;
+        TransferFunction::new(vec![1.0], vec![1.0 / w, 1.0]).unwrap()
+    }
+
+    #[test]
+    fn bandwidth_of_first_order_is_its_corner_frequency() {
+        let bw = bandwidth_hz(&first_order(120.0)).unwrap();
+        assert!((bw / 120.0 - 1.0).abs() < 1e-6, "{bw}");
+    }
+
+    #[test]
+    fn bandwidth_outside_the_scan_is_none_not_infinite() {
+        assert_eq!(bandwidth_hz(&first_order(1e-4)), None);
+        assert_eq!(bandwidth_hz(&first_order(1e7)), None);
+    }
+
+    #[test]
+    fn extreme_gains_give_a_finite_summary_or_an_error() {
+        // kv = 1e-300 used to print "inf Hz": the bandwidth is far below 0.01 Hz
+        let mut p = RigParams::default();
+        p.control.kv = 1e-300;
+        if let Ok(s) = ModelSummary::new(&p, D1Variant::Corrected) {
+            assert_eq!(s.bandwidth_hz, None);
+            let json = serde_json::to_string(&s).unwrap();
+            assert!(
+                !json.replace("\"bandwidth_hz\":null", "").contains("null"),
+                "{json}"
+            );
+        }
     }
 }

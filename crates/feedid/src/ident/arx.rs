@@ -42,10 +42,12 @@
 //! orthogonal-hyperbolic scheme: solve `Rᵀa = x`, `α = √(1 − ‖a‖²)`, then
 //! Givens rotations built from `a` and `α`), `O(n²)` per row. The factor is
 //! recomputed from scratch every [`ArxConfig::refactor_every`] windows (to
-//! bound drift), when a downdate fails (`‖a‖ ≥ 1`: the window lost rank),
+//! bound drift), when a downdate fails or would lose more than 4 digits
+//! (`α² < 1e-4`: the window (nearly) lost rank),
 //! and when the reference moved far from the frame `r₀` (`|r − r₀|·√W` more
-//! than 16 times the norm of the deviation output column), so the frame
-//! shift never cancels more than about one digit. The result equals a fresh
+//! than the norm of the deviation output column), so the frame shift cancels
+//! no digit (a bound of 16 let coefficients drift by up to 1e-6 relative on
+//! slowly excited windows). The result equals a fresh
 //! fit to rounding (tested to 1e-9).
 //!
 //! # Per-window checks and fallback
@@ -114,6 +116,10 @@ use crate::solve::{lstsq_in_place, LstsqOptions, QrWorkspace, Termination};
 
 /// Largest accepted `na` and `nb` (guards against absurd allocations).
 pub const MAX_ARX_ORDER: usize = 64;
+
+/// Smallest `α² = 1 − ‖a‖²` of a sliding downdate; below it the factor is
+/// recomputed from scratch.
+const MIN_DOWNDATE_ALPHA2: f64 = 1e-4;
 
 /// ARX structure: `na` poles, `nb` input coefficients, input delay `nk` \[samples\].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -531,7 +537,10 @@ impl SlidingFactor {
             self.a[j] = s / d;
         }
         let norm2: f64 = self.a.iter().map(|v| v * v).sum();
-        if !(norm2 < 1.0 - 64.0 * f64::EPSILON) {
+        // The downdate loses about log10(1/α²) digits (α² = 1 − ‖a‖², small
+        // when the removed row carried most of the window's energy in some
+        // direction): refactor instead when that would exceed 4 digits.
+        if !(norm2 < 1.0 - MIN_DOWNDATE_ALPHA2) {
             return false;
         }
         let mut alpha = (1.0 - norm2).sqrt();
@@ -735,14 +744,15 @@ impl ArxEstimator {
             && rows.end - rows.start == old.end - old.start
             && f.age + 1 < self.config.refactor_every;
         if can_slide && f.slide(&orders, y, u, base, rows.clone()) {
-            // frame check: the shift to the reference must not dominate the data
+            // frame check: the shift to the reference must not exceed the data
+            // (every digit it cancels is lost in the coefficients)
             let n = f.p - 2;
             let d = (reference - f.r0).abs() * (rows.len() as f64).sqrt();
             let out_norm = (0..f.p)
                 .map(|i| (f.rs(i, n + 1) - (reference - f.r0) * f.rs(i, 0)).powi(2))
                 .sum::<f64>()
                 .sqrt();
-            if d <= 16.0 * out_norm {
+            if d <= 1.0 * out_norm {
                 return true;
             }
         }

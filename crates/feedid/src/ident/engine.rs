@@ -87,7 +87,12 @@ impl EngineConfig {
                 });
             }
         }
-        let needed = self.warm_up + estimator_warm_up + self.window + self.horizon;
+        // saturating: lengths come from the user (`--window 18446744073709551615`)
+        let needed = self
+            .warm_up
+            .saturating_add(estimator_warm_up)
+            .saturating_add(self.window)
+            .saturating_add(self.horizon);
         if n < needed {
             return Err(Error::TooFewSamples {
                 what: "warm-up + window + horizon",
@@ -101,7 +106,7 @@ impl EngineConfig {
     /// The window and horizon ranges visited over `n` samples.
     pub fn windows(&self, n: usize, estimator_warm_up: usize) -> WindowIter {
         WindowIter {
-            next: self.warm_up + estimator_warm_up,
+            next: self.warm_up.saturating_add(estimator_warm_up),
             window: self.window,
             horizon: self.horizon,
             hop: self.hop().max(1),
@@ -129,8 +134,8 @@ impl Iterator for WindowIter {
         if we >= self.n {
             return None;
         }
-        let he = (we + self.horizon).min(self.n);
-        self.next = s + self.hop;
+        let he = we.saturating_add(self.horizon).min(self.n);
+        self.next = s.saturating_add(self.hop);
         Some((s..we, we..he))
     }
 }
@@ -489,5 +494,40 @@ mod tests {
             ..EngineConfig::default()
         };
         assert!(cfg.validate(100, 0).is_err());
+    }
+
+    #[test]
+    fn huge_window_horizon_or_hop_is_too_few_samples_not_an_overflow() {
+        let (t, y) = ramp(100);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        for (window, horizon) in [(usize::MAX, 10), (20, usize::MAX), (usize::MAX, usize::MAX)] {
+            let cfg = EngineConfig {
+                window,
+                horizon,
+                warm_up: 3,
+                ..EngineConfig::default()
+            };
+            let e = run(&mut Linear { calls: 0 }, &s, &cfg).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    Error::TooFewSamples {
+                        needed: usize::MAX,
+                        actual: 100,
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+        }
+        // a hop beyond the data visits one window
+        let cfg = EngineConfig {
+            hop: Some(usize::MAX),
+            warm_up: 3,
+            ..EngineConfig::default()
+        };
+        assert_eq!(cfg.windows(100, 2).count(), 1);
+        let r = run(&mut Linear { calls: 0 }, &s, &cfg).unwrap();
+        assert_eq!(r.windows.len(), 1);
     }
 }

@@ -87,7 +87,10 @@ pub fn identify<E: Estimator + ?Sized>(
     })
 }
 
-/// The machine-readable summary of a run (`summary.json`).
+/// The machine-readable summary of a run (`summary.json`). Optional values
+/// that do not apply (no nominal model, no global model, too few predictions
+/// for the residual analysis) are left out of the JSON, so a `null` never
+/// stands for a number.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IdentifySummary {
     /// Method name.
@@ -123,14 +126,19 @@ pub struct IdentifySummary {
     /// NRMSE fit of the free-run simulation of the method's global model
     /// over the whole recording \[%\] (`None` without one, e.g. `paper`;
     /// `null` in JSON also when the model is unstable).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sim_fit_percent: Option<f64>,
     /// Structure of the global model (e.g. `"arx na=8 nb=8 nk=1"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub global_model: Option<String>,
     /// RMS error of the nominal simulation model over the predicted samples \[m\].
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sim_rms_error_m: Option<f64>,
     /// Largest absolute error of the nominal simulation model \[m\].
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sim_max_abs_error_m: Option<f64>,
     /// NRMSE fit of the nominal simulation model \[%\].
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal_fit_percent: Option<f64>,
     /// Wall time of identification and prediction only (no I/O) \[s\].
     pub identification_seconds: f64,
@@ -141,6 +149,7 @@ pub struct IdentifySummary {
     /// (`None` when fewer than 52 samples were predicted). The k-step errors of one horizon share the
     /// state they were predicted from, so `r_ee` is expected to be
     /// positive for lags below the horizon.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub residuals: Option<ResidualAnalysis>,
 }
 

@@ -38,7 +38,7 @@ pub use order::{
 };
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
-    PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin,
+    PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin, SHIFT_AMPLIFICATION_WARNING,
 };
 pub use residuals::{ResidualAnalysis, Z_99};
 pub use rls::{RlsConfig, RlsEstimator};

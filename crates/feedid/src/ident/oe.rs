@@ -78,6 +78,7 @@ use std::ops::Range;
 
 use nalgebra::{Complex, DMatrix};
 
+use super::arx::check_window;
 use super::companion::{is_hurwitz, output, reflect_unstable, Companion, MAX_ORDER};
 use super::srivc::srivc;
 use crate::error::{Error, Result};
@@ -771,13 +772,8 @@ impl Estimator for OeEstimator {
                 actual: coef.len(),
             });
         }
-        if window.start < signals.offset || window.end > signals.end() {
-            return Err(Error::TooFewSamples {
-                what: "oe window inside the available data",
-                needed: window.end,
-                actual: signals.end(),
-            });
-        }
+        // lengths of the signals, and the window inside them (not reversed)
+        check_window(signals, &window, 0)?;
         let u = signals.command(window.clone());
         let y = signals.position(window.clone());
         let w = u.len();
@@ -899,7 +895,8 @@ impl Estimator for OeEstimator {
                 actual: out.len(),
             });
         }
-        if horizon.start != window.end || horizon.end > signals.end() {
+        if horizon.start != window.end || horizon.start > horizon.end || horizon.end > signals.end()
+        {
             return Err(Error::TooFewSamples {
                 what: "oe horizon after the window",
                 needed: horizon.end,

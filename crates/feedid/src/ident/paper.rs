@@ -282,7 +282,53 @@ pub struct PaperConfig {
     pub simplex: SimplexSettings,
 }
 
+/// Growth factor `(1 + |τ_c|/h)⁷` of the change of basis to monomial
+/// coefficients for a window spanning `τ_first … τ_last` (see
+/// [`PaperDiagnostics::shift_amplification`]); infinite for an empty span.
+fn shift_amplification(tau_first: f64, tau_last: f64) -> f64 {
+    let centre = 0.5 * (tau_first + tau_last);
+    let half = 0.5 * (tau_last - tau_first);
+    let g = (1.0 + centre.abs() / half).powi(7);
+    if g.is_nan() {
+        f64::INFINITY
+    } else {
+        g
+    }
+}
+
+/// [`PaperConfig::worst_shift_amplification`] above which the coefficients
+/// `N`, `D` keep fewer than about 8 significant digits (1e8 × 1e-16).
+pub const SHIFT_AMPLIFICATION_WARNING: f64 = 1e8;
+
 impl PaperConfig {
+    /// The largest [`PaperDiagnostics::shift_amplification`] over the windows
+    /// that `config` visits on `signals` (offset 0): how far from the time
+    /// origin the windows lie. Above [`SHIFT_AMPLIFICATION_WARNING`] the
+    /// identified `N`, `D` lose accuracy (predictions in
+    /// [`PredictionMode::Polynomial`] do not). `1.0` when no window fits.
+    pub fn worst_shift_amplification(
+        &self,
+        signals: &Signals<'_>,
+        config: &crate::ident::EngineConfig,
+    ) -> f64 {
+        let n = signals.time.len();
+        let mut worst = 1.0f64;
+        for (w, _) in config.windows(n, 0) {
+            let (Some(&first), Some(&last)) = (
+                signals.time.get(w.start),
+                w.end.checked_sub(1).and_then(|e| signals.time.get(e)),
+            ) else {
+                continue;
+            };
+            let origin = match self.time_origin {
+                TimeOrigin::Motion => signals.motion_start,
+                TimeOrigin::Window => first,
+            };
+            worst = worst.max(shift_amplification(first - origin, last - origin));
+        }
+        worst
+    }
+
     /// Validate and build the estimator.
     ///
     /// ```
@@ -882,7 +928,7 @@ impl Estimator for PaperMethod {
         self.diagnostics = Some(PaperDiagnostics {
             output_qr: out_info,
             input_qr: in_info,
-            shift_amplification: (1.0 + centre.abs() / half).powi(7),
+            shift_amplification: shift_amplification(t_first, t_last),
             tf_fallback: false,
             input_residual_rel: if in_norm > 0.0 {
                 in_sse.max(0.0).sqrt() / in_norm
@@ -1454,6 +1500,35 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn worst_shift_amplification_matches_the_fit_diagnostics() {
+        // windows 25 s after the motion start (the EMPS file's span)
+        let n = 100;
+        let t: Vec<f64> = (0..n).map(|k| 25.0 + k as f64 * DT).collect();
+        let u: Vec<f64> = t.iter().map(|&t| 0.05 * t).collect();
+        let s = Signals::new(&t, &u, &u, DT, 0.0);
+        let cfg = crate::ident::EngineConfig {
+            window: W,
+            horizon: H,
+            ..Default::default()
+        };
+        let mut m = method(Solver::Qr, TimeOrigin::Motion);
+        let mut coef = [0.0; NAMES.len()];
+        // the last window is the farthest from the origin
+        let (last, _) = cfg.windows(n, 0).last().unwrap();
+        m.fit(&s, last, &mut coef).unwrap();
+        let fitted = m.diagnostics().unwrap().shift_amplification;
+        let worst = m.config.worst_shift_amplification(&s, &cfg);
+        assert!((worst / fitted - 1.0).abs() < 1e-12, "{worst} vs {fitted}");
+        assert!(worst > SHIFT_AMPLIFICATION_WARNING);
+        // each window's own origin: (1 + 1)⁷
+        let w = PaperConfig {
+            time_origin: TimeOrigin::Window,
+            ..PaperConfig::default()
+        };
+        assert!((w.worst_shift_amplification(&s, &cfg) - 128.0).abs() < 1e-9);
     }
 
     #[test]

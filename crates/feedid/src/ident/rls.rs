@@ -50,7 +50,10 @@
 //! `window.end` (the window range only tells where the data ends; hop and
 //! window length only decide when predictions are made); `reset` rewinds.
 //! Prediction is the k-step-ahead prediction of the ARX model from the
-//! measured past, in deviations from the last measured position.
+//! measured past, in deviations from the last measured position. A model
+//! with a pole on or outside the unit circle (Schur–Cohn test) is never used
+//! for a prediction: the window gives none (`predict` fails with
+//! [`Error::InvalidModel`]) until the estimate is stable again.
 //!
 //! References: L. Ljung, *System Identification*, 2nd ed., §11.2; S. Haykin,
 //! *Adaptive Filter Theory*, ch. 10; design notes §3.
@@ -79,7 +82,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::arx::{check_window, predict_horizon};
+use crate::ident::arx::{check_window, poles_inside, predict_horizon};
 use crate::ident::{ArxOrders, Estimator, Signals, WindowFit};
 use crate::solve::Termination;
 
@@ -188,6 +191,8 @@ pub struct RlsEstimator {
     psi: Vec<f64>,
     g: Vec<f64>,
     past: Vec<f64>,
+    /// Scratch of the stability test (`na + 1`).
+    schur: Vec<f64>,
     r0: f64,
     framed: bool,
     cursor: Option<usize>,
@@ -210,6 +215,7 @@ impl RlsEstimator {
             psi: vec![0.0; n],
             g: vec![0.0; n],
             past: Vec::new(),
+            schur: vec![0.0; n + 1],
             r0: 0.0,
             framed: false,
             cursor: None,
@@ -620,6 +626,11 @@ impl Estimator for RlsEstimator {
                 context: "rls prediction (no model)",
             });
         }
+        if !poles_inside(&self.theta[..orders.na], 1.0, &mut self.schur) {
+            return Err(Error::InvalidModel {
+                reason: "RLS estimate has unstable poles",
+            });
+        }
         predict_horizon(
             &orders,
             &self.theta,
@@ -719,6 +730,43 @@ mod tests {
             .map(|(x, y)| (x - y).abs())
             .fold(0.0, f64::max)
             / s
+    }
+
+    #[test]
+    fn unstable_estimate_is_never_used_for_a_prediction() {
+        // data from an unstable system: y[k] = 1.05 y[k-1] + u[k-1]
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let n = 100;
+        let u: Vec<f64> = (0..n).map(|_| rng.random_range(-1e-3..1e-3)).collect();
+        let y = simulate_arx(&[-1.05], &[1.0], 1, &u, &vec![0.0; n]);
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
+        let mut rls = RlsConfig {
+            orders: ArxOrders::new(1, 1, 1),
+            lambda: 1.0,
+            p0: 1e10,
+            min_excitation: 0.0,
+            ..RlsConfig::default()
+        }
+        .build()
+        .unwrap();
+        let mut coef = [0.0; 2];
+        rls.fit(&s, 2..60, &mut coef).unwrap();
+        assert!(coef[0] < -1.0, "a pole outside the unit circle: {coef:?}");
+        let mut out = [0.0; 5];
+        let e = rls.predict(&s, 2..60, 60..65, &mut out).unwrap_err();
+        assert!(matches!(e, Error::InvalidModel { .. }), "{e}");
+        // window by window: a prediction exactly when the estimate is stable
+        let mut rls = rls.config().build().unwrap();
+        let mut unstable = 0;
+        for end in (25..95).step_by(5) {
+            rls.fit(&s, end - 20..end, &mut coef).unwrap();
+            let stable = poles_inside(&rls.theta()[..1], 1.0, &mut [0.0; 2]);
+            let r = rls.predict(&s, end - 20..end, end..end + 5, &mut out);
+            assert_eq!(r.is_ok(), stable, "window ending at {end}: {coef:?}");
+            unstable += usize::from(!stable);
+        }
+        assert!(unstable > 0);
     }
 
     #[test]

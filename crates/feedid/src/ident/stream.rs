@@ -488,13 +488,7 @@ impl<E: Estimator> Streamer<E> {
             });
         }
         for (channel, v) in [("time", t), ("command", command)] {
-            if !v.is_finite() {
-                return Err(Error::NonFinite {
-                    channel: channel.to_string(),
-                    index: self.nc,
-                    value: v,
-                });
-            }
+            check_value(channel, self.nc, v)?;
         }
         if self.nc > 0 && t <= self.t_last {
             return Err(Error::NonMonotoneTime {
@@ -514,14 +508,7 @@ impl<E: Estimator> Streamer<E> {
     }
 
     fn check_position(&self, position: f64) -> Result<()> {
-        if !position.is_finite() {
-            return Err(Error::NonFinite {
-                channel: "position".to_string(),
-                index: self.np,
-                value: position,
-            });
-        }
-        Ok(())
+        check_value("position", self.np, position)
     }
 
     fn store_command(&mut self, t: f64, command: f64) -> Result<()> {
@@ -595,6 +582,27 @@ impl<E: Estimator> Streamer<E> {
             })
         }
     }
+}
+
+/// A sample value is accepted as in a [`crate::Recording`]: finite and at
+/// most [`crate::recording::MAX_MAGNITUDE`] in magnitude.
+fn check_value(channel: &str, index: usize, v: f64) -> Result<()> {
+    if !v.is_finite() {
+        return Err(Error::NonFinite {
+            channel: channel.to_string(),
+            index,
+            value: v,
+        });
+    }
+    if !crate::recording::is_usable(v) {
+        return Err(Error::OutOfRange {
+            channel: channel.to_string(),
+            index,
+            value: v,
+            limit: crate::recording::MAX_MAGNITUDE,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -1017,6 +1025,18 @@ mod tests {
         }
         assert_eq!(got, want);
         assert_eq!(s.stats(), clean.stats());
+    }
+
+    #[test]
+    fn values_a_recording_refuses_are_refused_per_sample() {
+        let mut s = Streamer::new(Linear, EngineConfig::default()).unwrap();
+        s.push(0.0, 0.0, 0.0).unwrap();
+        for (t, u, y) in [(1e-3, 1e101, 0.0), (1e-3, 0.0, -1e300), (1e200, 0.0, 0.0)] {
+            let e = s.push(t, u, y).unwrap_err();
+            assert!(matches!(e, Error::OutOfRange { index: 1, .. }), "{e}");
+        }
+        assert_eq!(s.stats().samples, 1);
+        s.push(1e-3, 1e100, 0.0).unwrap();
     }
 
     #[test]

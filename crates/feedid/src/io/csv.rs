@@ -46,7 +46,9 @@ use crate::error::{Error, Result};
 use crate::io::options::{
     ChannelRef, ReadOptions, DEFAULT_COMMAND_COLUMN, DEFAULT_POSITION_COLUMN, DEFAULT_TIME_COLUMN,
 };
-use crate::io::read::{build_recording, failing_sample, in_file, read_file, Role};
+use crate::io::read::{
+    build_recording, failing_sample, in_file, read_file, short_list, short_text, Role,
+};
 use crate::recording::Recording;
 
 /// Hint appended to [`Error::BadNumber`] when a cell looks like a decimal comma.
@@ -187,7 +189,7 @@ pub fn read_csv_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
                 path: path.to_path_buf(),
                 line: line.no,
                 column: col_name(c),
-                text: text.to_string(),
+                text: short_text(text),
                 hint: decimal_comma_hint(text, delim),
             })
         };
@@ -199,7 +201,7 @@ pub fn read_csv_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
         for (c, slot) in extras.iter_mut().enumerate() {
             if let Some(v) = slot {
                 match fields.get(c).and_then(|s| parse_number(s)) {
-                    Some(x) if x.is_finite() => v.push(x),
+                    Some(x) if crate::recording::is_usable(x) => v.push(x),
                     _ => *slot = None,
                 }
             }
@@ -428,7 +430,7 @@ fn resolve_column(
                 Ok(i - 1)
             } else {
                 Err(missing(match header {
-                    Some(h) => format!("{} (columns 1 to {ncols})", h.join(", ")),
+                    Some(h) => format!("{} (columns 1 to {ncols})", short_list(h)),
                     None => by_index(),
                 }))
             }
@@ -446,7 +448,7 @@ fn resolve_column(
                     _ => None,
                 }
             })
-            .ok_or_else(|| missing(h.join(", "))),
+            .ok_or_else(|| missing(short_list(h))),
         (ChannelRef::Name(_), None) => Err(missing(by_index())),
     }
 }

@@ -62,7 +62,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::io::options::{ChannelRef, ReadOptions};
-use crate::io::read::{build_recording, failing_sample, in_file, read_file, Role};
+use crate::io::read::{build_recording, failing_sample, in_file, read_file, short_list, Role};
 use crate::recording::Recording;
 
 const HEADER_LEN: usize = 128;
@@ -71,6 +71,9 @@ const MI_MATRIX: u32 = 14;
 const MI_COMPRESSED: u32 = 15;
 /// Upper bound of the deflate expansion ratio (1032:1) plus slack.
 const MAX_INFLATE_RATIO: usize = 1040;
+/// Largest inflated element (2 GiB, 268 M doubles): a small compressed
+/// "bomb" must not exhaust memory.
+const MAX_INFLATED: usize = 1 << 31;
 const V73_ADVICE: &str =
     "is a MATLAB v7.3 (HDF5) file, which is not supported; save it with -v7 or -v6 (save(f, '-v7'))";
 
@@ -152,10 +155,7 @@ pub fn read_mat_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
         if vars.is_empty() {
             "none".to_string()
         } else {
-            vars.iter()
-                .map(|v| v.info.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
+            short_list(vars.iter().map(|v| v.info.to_string()))
         }
     };
     let mat_err = |reason: String| Error::MatFile {
@@ -231,7 +231,7 @@ pub fn read_mat_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
             continue;
         }
         if let Ok(values) = vector_of(v) {
-            if values.len() == n && values.iter().all(|x| x.is_finite()) {
+            if values.len() == n && values.iter().all(|&x| crate::recording::is_usable(x)) {
                 rec = rec.with_channel(name, values)?;
             }
         }
@@ -362,6 +362,11 @@ fn inflate(data: &[u8]) -> std::result::Result<Vec<u8>, String> {
     let le = u32::from_le_bytes([tag[4], tag[5], tag[6], tag[7]]) as usize;
     let be = u32::from_be_bytes([tag[4], tag[5], tag[6], tag[7]]) as usize;
     let declared = le.min(be);
+    if declared > MAX_INFLATED {
+        return Err(format!(
+            "compressed element declares {declared} bytes, more than the {MAX_INFLATED} supported"
+        ));
+    }
     let limit = data
         .len()
         .saturating_mul(MAX_INFLATE_RATIO)
@@ -594,15 +599,25 @@ mod tests {
         let e = list_mat_variables_from_bytes(&b, Path::new("h.mat")).unwrap_err();
         assert!(e.to_string().contains("declares 4294967280 bytes"), "{e}");
 
-        // A tiny zlib stream whose inner tag claims 4 GB.
-        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
-        std::io::Write::write_all(&mut z, &tag(MI_MATRIX, 0xFFFF_FFF0)).unwrap();
-        let z = z.finish().unwrap();
-        let mut b = le_header();
-        b.extend(tag(MI_COMPRESSED, z.len() as u32));
-        b.extend(&z);
-        let e = list_mat_variables_from_bytes(&b, Path::new("h.mat")).unwrap_err();
+        // A tiny zlib stream whose inner tag claims 1 GB: more than deflate can give.
+        let bomb = |claim: u32| {
+            let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+            std::io::Write::write_all(&mut z, &tag(MI_MATRIX, claim)).unwrap();
+            let z = z.finish().unwrap();
+            let mut b = le_header();
+            b.extend(tag(MI_COMPRESSED, z.len() as u32));
+            b.extend(&z);
+            list_mat_variables_from_bytes(&b, Path::new("h.mat")).unwrap_err()
+        };
+        let e = bomb(0x4000_0040); // the same read in either byte order
         assert!(e.to_string().contains("impossible"), "{e}");
+        // Beyond 2 GiB whatever the compressed size (a real bomb of 3 MB could
+        // otherwise inflate to 3 GB).
+        let e = bomb(0xFFFF_FFF0);
+        assert!(
+            e.to_string().contains("more than the 2147483648 supported"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -102,7 +102,7 @@ pub(crate) fn build_recording(
 /// The zero-based sample and the signal a [`Recording`] check error points at.
 pub(crate) fn failing_sample(err: &Error) -> Option<(usize, Option<Role>)> {
     match err {
-        Error::NonFinite { channel, index, .. } => {
+        Error::NonFinite { channel, index, .. } | Error::OutOfRange { channel, index, .. } => {
             let role = match channel.as_str() {
                 "time" => Some(Role::Time),
                 "command" => Some(Role::Command),
@@ -113,8 +113,47 @@ pub(crate) fn failing_sample(err: &Error) -> Option<(usize, Option<Role>)> {
         }
         Error::NonMonotoneTime { index, .. } => Some((*index, Some(Role::Time))),
         Error::SamplingJitter { index, .. } => Some((*index, Some(Role::Time))),
+        Error::SamplingInterval { .. } => Some((1, Some(Role::Time))),
         _ => None,
     }
+}
+
+/// Longest text of one item quoted in an error message \[chars\].
+const MAX_QUOTED_CHARS: usize = 60;
+/// Most items listed in an error message.
+const MAX_LISTED: usize = 24;
+
+/// `text` cut to a length fit for a one-line message (`…` marks the cut).
+pub(crate) fn short_text(text: &str) -> String {
+    match text.char_indices().nth(MAX_QUOTED_CHARS) {
+        Some((cut, _)) => format!("{}… ({} bytes)", &text[..cut], text.len()),
+        None => text.to_string(),
+    }
+}
+
+/// `items` joined by `, `, each cut by [`short_text`], at most [`MAX_LISTED`]
+/// of them (then `… and N more`).
+pub(crate) fn short_list<I, S>(items: I) -> String
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<str>,
+{
+    let mut out = String::new();
+    let mut more = 0usize;
+    for (i, item) in items.into_iter().enumerate() {
+        if i >= MAX_LISTED {
+            more += 1;
+            continue;
+        }
+        if i > 0 {
+            out.push_str(", ");
+        }
+        out.push_str(&short_text(item.as_ref()));
+    }
+    if more > 0 {
+        out.push_str(&format!(", … and {more} more"));
+    }
+    out
 }
 
 /// Wrap `err` into [`Error::InFile`].
@@ -158,6 +197,21 @@ mod tests {
         };
         let r = build_recording(None, vec![0.0; 4], vec![0.0; 4], &opts).unwrap();
         assert_eq!(r.time(), &[0.0, 0.002, 0.004, 0.006]);
+    }
+
+    #[test]
+    fn messages_quote_and_list_at_most_a_line() {
+        let long = "é".repeat(5000);
+        let t = short_text(&long);
+        assert_eq!(t, format!("{}… (10000 bytes)", "é".repeat(60)));
+        assert_eq!(short_text("abc"), "abc");
+        let names: Vec<String> = (0..100).map(|i| format!("c{i}")).collect();
+        let l = short_list(&names);
+        assert!(
+            l.starts_with("c0, c1, ") && l.ends_with("c23, … and 76 more"),
+            "{l}"
+        );
+        assert_eq!(short_list(["a", "b"]), "a, b");
     }
 
     #[test]

@@ -70,6 +70,13 @@ fn norm1(m: &DMatrix<f64>) -> f64 {
 fn expm_pade13(m: &DMatrix<f64>) -> Result<DMatrix<f64>> {
     let n = m.nrows();
     let norm = norm1(m);
+    // finite entries can still sum to an infinite norm: that would ask for
+    // i32::MAX squarings (a hang), and the exponential overflows anyway
+    if !norm.is_finite() {
+        return Err(Error::InvalidModel {
+            reason: "matrix exponential overflowed",
+        });
+    }
     let s = if norm > THETA13 {
         (norm / THETA13).log2().ceil().max(0.0) as i32
     } else {
@@ -111,6 +118,17 @@ fn expm_pade13(m: &DMatrix<f64>) -> Result<DMatrix<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn expm_of_a_matrix_whose_norm_overflows_is_an_error_not_a_hang() {
+        let m = DMatrix::from_element(3, 3, -1e308);
+        assert!(matches!(expm(&m), Err(Error::InvalidModel { .. })));
+        // large but finite norm: at most ~1000 squarings, then a clean result or error
+        let m = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![-1e300, -1.0]));
+        if let Ok(e) = expm(&m) {
+            assert!(e.iter().all(|v| v.is_finite()));
+        }
+    }
 
     #[test]
     fn expm_of_diagonal_matrix_is_elementwise_exp() {

@@ -57,17 +57,21 @@ pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<()> {
     Ok(())
 }
 
+/// Most samples of a command: 1e8 (5.5 h at 5 kHz). A simulation keeps about
+/// ten signals of this length in memory (8 GB at the limit).
+pub const MAX_SAMPLES: usize = 100_000_000;
+
 /// Number of samples `n = round(duration·rate)` of a command (times `k/rate`,
-/// `k = 0 … n−1`); at least 2.
+/// `k = 0 … n−1`); at least 2, at most [`MAX_SAMPLES`].
 pub fn sample_count(rate_hz: f64, duration: f64) -> Result<usize> {
     check_rate(rate_hz)?;
     check_positive("duration", duration)?;
     let n = (duration * rate_hz).round();
-    if n > 1.0e9 {
+    if n > MAX_SAMPLES as f64 {
         return Err(Error::InvalidParameter {
             name: "duration",
             value: duration,
-            reason: "gives more than 1e9 samples",
+            reason: "gives more than 1e8 samples at this rate",
         });
     }
     let n = n as usize;

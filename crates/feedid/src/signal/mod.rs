@@ -27,7 +27,7 @@ mod scurve;
 mod step;
 
 pub use chirp::{chirp, Chirp, Sweep};
-pub use common::{sample_count, DEFAULT_RATE_HZ, DEFAULT_REST};
+pub use common::{sample_count, DEFAULT_RATE_HZ, DEFAULT_REST, MAX_SAMPLES};
 pub use multisine::{multisine, Multisine};
 pub use prbs::{prbs, Lfsr, Prbs};
 pub use ramp::{ramp, Ramp};

@@ -17,6 +17,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::common::{check_non_negative, check_positive, check_rate, sample_count, taper};
+
+/// Most evaluations of a line when searching the peak over one period.
+const MAX_PEAK_EVALUATIONS: f64 = 1e9;
 use crate::error::{Error, Result};
 
 /// Schroeder-phase multisine of position.
@@ -104,7 +107,18 @@ impl Multisine {
     pub fn fill(&self, rate_hz: f64, out: &mut [f64]) -> Result<()> {
         check_rate(rate_hz)?;
         self.validate()?;
-        let period_samples = ((rate_hz / self.resolution).ceil() as usize).max(1);
+        // the peak is searched over one period: bound its cost (samples × lines)
+        let (k0, k1) = self.harmonics();
+        let period = (rate_hz / self.resolution).ceil().max(1.0);
+        if period * (k1 - k0 + 1) as f64 > MAX_PEAK_EVALUATIONS {
+            return Err(Error::InvalidParameter {
+                name: "rate",
+                value: rate_hz,
+                reason: "too high for this multisine: one period (rate / resolution samples) \
+                         times the lines exceeds 1e9 evaluations",
+            });
+        }
+        let period_samples = period as usize;
         let mut peak = 0.0f64;
         for k in 0..period_samples {
             peak = peak.max(self.raw(k as f64 / rate_hz).abs());

@@ -40,10 +40,21 @@ enum Cmd {
     Order,
     /// `stream`, with the file on standard input.
     Stream,
+    Report,
+    Sweep,
+    Greybox,
 }
 
 /// Every command that reads a recording.
-const RECORDING_COMMANDS: [Cmd; 4] = [Cmd::Info, Cmd::Identify, Cmd::Order, Cmd::Stream];
+const RECORDING_COMMANDS: [Cmd; 7] = [
+    Cmd::Info,
+    Cmd::Identify,
+    Cmd::Order,
+    Cmd::Stream,
+    Cmd::Report,
+    Cmd::Sweep,
+    Cmd::Greybox,
+];
 
 impl Cmd {
     /// Arguments for reading `input`, writing outputs (if any) under `out`.
@@ -81,6 +92,40 @@ impl Cmd {
                 "20".into(),
                 "--horizon".into(),
                 "5".into(),
+            ],
+            Cmd::Report => vec![
+                "report".into(),
+                i,
+                "--methods".into(),
+                "paper,arx,auto".into(),
+                "--window".into(),
+                "20".into(),
+                "--horizon".into(),
+                "5".into(),
+                "-o".into(),
+                s(out.join("report.html")),
+            ],
+            Cmd::Sweep => vec![
+                "sweep".into(),
+                i,
+                "--windows".into(),
+                "10,20".into(),
+                "--horizons".into(),
+                "5".into(),
+                "-o".into(),
+                s(out.join("sweep.csv")),
+                "--plot".into(),
+                s(out.join("sweep.svg")),
+            ],
+            Cmd::Greybox => vec![
+                "greybox".into(),
+                i,
+                "--estimate".into(),
+                "Kv".into(),
+                "--max-iterations".into(),
+                "5".into(),
+                "--summary".into(),
+                s(out.join("gb.json")),
             ],
         }
     }
@@ -424,6 +469,11 @@ fn expectation(case: &Case, cmd: Cmd) -> Expect {
             Fails(&["too few samples", "need at least", "got 12"])
         }
         ("window longer than the data", Cmd::Order) => Fails(&["too few samples", "got 12"]),
+        ("window longer than the data", Cmd::Report | Cmd::Sweep) => {
+            Fails(&["too few samples", "got 12"])
+        }
+        // nothing moves: Kv cannot be told from the data, and the tool says so
+        ("constant signals", Cmd::Greybox) => Fails(&["{file}", "not identifiable", "Kv"]),
         // nothing moves: the warning, then no regression to solve
         ("constant signals", Cmd::Order) => Fails(&["{file}", "singular"]),
         _ => case.expect,
@@ -614,6 +664,8 @@ enum TomlCmd {
     SimulateParams,
     SimulateEffects,
     IdentifyParams,
+    GreyboxParams,
+    ReportParams,
     /// Only for files that fail: a reproduce run takes seconds.
     ReproduceParams,
 }
@@ -626,12 +678,14 @@ enum TomlKind {
 }
 
 impl TomlCmd {
-    const ALL: [TomlCmd; 6] = [
+    const ALL: [TomlCmd; 8] = [
         TomlCmd::Model,
         TomlCmd::ModelJson,
         TomlCmd::SimulateParams,
         TomlCmd::SimulateEffects,
         TomlCmd::IdentifyParams,
+        TomlCmd::GreyboxParams,
+        TomlCmd::ReportParams,
         TomlCmd::ReproduceParams,
     ];
 
@@ -661,6 +715,26 @@ impl TomlCmd {
                 let mut a = v(&["identify", &input, "--window", "8", "--horizon", "2"]);
                 a.extend(["--params".into(), t, "-o".into(), o("pred.csv")]);
                 a.extend(["--summary".into(), o("summary.json")]);
+                a
+            }
+            TomlCmd::GreyboxParams => {
+                let input = common::data("comma_header.csv").display().to_string();
+                let mut a = v(&[
+                    "greybox",
+                    &input,
+                    "--estimate",
+                    "Kv",
+                    "--max-iterations",
+                    "3",
+                ]);
+                a.extend(["--params".into(), t, "--summary".into(), o("gb.json")]);
+                a
+            }
+            TomlCmd::ReportParams => {
+                let input = common::data("comma_header.csv").display().to_string();
+                let mut a = v(&["report", &input, "--methods", "paper", "--window", "8"]);
+                a.extend(["--horizon".into(), "2".into(), "--params".into(), t]);
+                a.extend(["-o".into(), o("report.html")]);
                 a
             }
             TomlCmd::ReproduceParams => v(&["reproduce", "--params", &t, "--out", &o("repro")]),
@@ -823,7 +897,15 @@ fn every_bad_parameter_file_fails_cleanly_in_every_command() {
             let out = tmp.path().join("out");
             std::fs::create_dir_all(&out).unwrap();
             let o = run(&cmd.args(&toml, &out), None);
-            if let Err(e) = check(&o, case.expect, &file, &out) {
+            // extreme but valid parameters: greybox may find that the data
+            // cannot identify Kv under them, and says so naming the recording
+            let expect = match (cmd, case.expect) {
+                (TomlCmd::GreyboxParams, Expect::SucceedsOrFails(_)) => {
+                    Expect::SucceedsOrFails(&["not identifiable", "Kv"])
+                }
+                (_, e) => e,
+            };
+            if let Err(e) = check(&o, expect, &file, &out) {
                 failures.push(format!("{} / {cmd:?}: {e}", case.name));
             }
             std::fs::remove_dir_all(&out).unwrap();

@@ -127,7 +127,9 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                 (if a.friction { "nonlinear" } else { "linear" }).into(),
             );
             context.insert("position_loop".into(), position_loop.name().into());
-            context.insert("current".into(), a.current.clone().into());
+            if let Some(c) = &a.current {
+                context.insert("current".into(), c.clone().into());
+            }
             let track = match a.track_window {
                 Some(w) => {
                     let samples = |s: f64, what: &str| -> Result<usize> {

@@ -7,7 +7,7 @@ use feedid::report::{recording_report, RecordingAnalysis, ReportOptions};
 
 use crate::args::{MethodArgs, MethodListArgs, ReportArgs};
 use crate::cmd::identify::{engine_config, method_spec};
-use crate::cmd::{load_params, recording, Outputs};
+use crate::cmd::{load_params, params_error, recording, Outputs};
 
 /// The methods of `--methods` (or `default`), each with the shared per-method options.
 pub fn method_specs(m: &MethodListArgs, default: &str) -> Result<Vec<MethodSpec>> {
@@ -60,7 +60,14 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         || a.input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let analysis = RecordingAnalysis::run(&name, rec, &opts)?;
+    let analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| {
+        // extreme but valid parameters can give no usable nominal model: say which file
+        if matches!(e.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() {
+            params_error(a.params.as_deref(), e)
+        } else {
+            e.into()
+        }
+    })?;
     let page = recording_report(&analysis)?;
     let html = page.to_html();
     let mut outputs = Outputs::default();

@@ -102,8 +102,10 @@ pub struct ParameterEstimate {
     /// Starting (nominal) value.
     pub start: f64,
     /// Standard error (`None` when the parameter is not determined).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub std_error: Option<f64>,
     /// Standard error relative to the estimate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub relative_std_error: Option<f64>,
     /// How well the data determine it.
     pub verdict: Verdict,
@@ -131,8 +133,10 @@ pub struct GreyboxFit {
     /// RMS of the position residuals at the estimate (m, or relative for coefficients).
     pub residual_rms: f64,
     /// RMS of the current residuals \[A\] when a current was measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub current_residual_rms: Option<f64>,
     /// NRMSE fit \[%\] of the simulated position (recordings only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub fit_percent: Option<f64>,
     /// Number of residuals (samples or coefficients).
     pub residuals: usize,

@@ -816,6 +816,12 @@ fn toml_catalogue() -> Vec<TomlCase> {
             "[geometry]\nroot_diameter = 1.0\n",
             Fails(&["{file}", "geometry.root_diameter"]),
         ),
+        case(
+            "values that overflow together (found by fuzzing)",
+            Params,
+            "[geometry]\nscrew_diameter = 2.2e104\n",
+            Fails(&["{file}", "inertia J", "inf"]),
+        ),
         TomlCase {
             name: "invalid UTF-8",
             kind: Params,

@@ -349,6 +349,26 @@ impl RigParams {
                 reason: "must not exceed geometry.screw_length",
             });
         }
+        // Values fine one by one can still overflow or underflow together
+        // (J grows as the fourth power of the screw diameter).
+        let derived: [(&'static str, f64); 4] = [
+            ("r = lead/2π", self.r()),
+            ("stiffness K", self.stiffness_k()),
+            (
+                "stiffness K at the screw end",
+                self.stiffness_at(self.geometry.screw_length),
+            ),
+            ("inertia J", self.inertia_j()),
+        ];
+        for (name, value) in derived {
+            if !value.is_finite() || value <= 0.0 {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    reason: "derived from the values given; must be finite and > 0",
+                });
+            }
+        }
         Ok(())
     }
 
@@ -427,6 +447,28 @@ fn one_line(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_that_overflow_together_are_rejected() {
+        // found by the params_toml fuzz target: every value finite and > 0,
+        // the screw inertia ρ·π·d⁴·L/32 infinite
+        let e = RigParams::from_toml_str(
+            "[geometry]\nscrew_diameter = 2.2e104\n",
+            Some("rig.toml".as_ref()),
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("inertia J") && e.to_string().contains("inf"),
+            "{e}"
+        );
+        // and underflow: a stiffness of 0
+        let e = RigParams::from_toml_str(
+            "[material]\nyoungs_modulus = 1e-320\n[stiffness]\nbearing = 1e-320\nnut = 1e-320\n",
+            None,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("stiffness K"), "{e}");
+    }
 
     #[test]
     fn default_rig_has_notes_stiffness_and_inertia() {

@@ -12,9 +12,10 @@
 //! windowed linear models reach about 4 µm rms / 9 µm max; that is asserted
 //! as it stands.
 
+mod common;
+
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::{engine, ArxConfig, EngineConfig, Estimator, RlsConfig, Signals};
-use feedid::io::{read_recording, ChannelRef, ReadOptions};
 use feedid::signal::Scenario;
 use feedid::stats::ErrorStats;
 
@@ -79,30 +80,9 @@ fn arx_and_rls_reach_the_prediction_targets_on_the_virtual_rig() {
 
 #[test]
 fn rls_reaches_one_micrometre_on_emps() {
-    let path = std::env::var("FEEDID_EMPS_MAT").unwrap_or_else(|_| {
-        format!(
-            "{}/../../../shared/data/emps/DATA_EMPS.mat",
-            env!("CARGO_MANIFEST_DIR")
-        )
-    });
-    let path = std::path::Path::new(&path);
-    if !path.exists() {
-        eprintln!(
-            "skipped: EMPS data not found at {} (set FEEDID_EMPS_MAT)",
-            path.display()
-        );
+    let Some(rec) = common::emps_recording() else {
         return;
-    }
-    let rec = read_recording(
-        path,
-        &ReadOptions {
-            time: Some(ChannelRef::Name("t".into())),
-            command: Some(ChannelRef::Name("qg".into())),
-            position: Some(ChannelRef::Name("qm".into())),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    };
     let (a, r) = both(&rec.signals());
     println!(
         "EMPS arx rms {:.3} max {:.3} | rls rms {:.3} max {:.3} µm",

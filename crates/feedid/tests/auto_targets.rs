@@ -10,9 +10,10 @@
 //! linear model predicts them within 10 µm) and coverage is ≈ 25 % of the
 //! 50 ms recording.
 
+mod common;
+
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::{engine, AutoConfig, EngineConfig, Signals};
-use feedid::io::{read_recording, ChannelRef, ReadOptions};
 use feedid::signal::Scenario;
 use feedid::stats::ErrorStats;
 
@@ -67,30 +68,9 @@ fn auto_reaches_the_prediction_targets_on_every_rig_scenario() {
 
 #[test]
 fn auto_reaches_one_micrometre_on_emps() {
-    let path = std::env::var("FEEDID_EMPS_MAT").unwrap_or_else(|_| {
-        format!(
-            "{}/../../../shared/data/emps/DATA_EMPS.mat",
-            env!("CARGO_MANIFEST_DIR")
-        )
-    });
-    let path = std::path::Path::new(&path);
-    if !path.exists() {
-        eprintln!(
-            "skipped: EMPS data not found at {} (set FEEDID_EMPS_MAT)",
-            path.display()
-        );
+    let Some(rec) = common::emps_recording() else {
         return;
-    }
-    let rec = read_recording(
-        path,
-        &ReadOptions {
-            time: Some(ChannelRef::Name("t".into())),
-            command: Some(ChannelRef::Name("qg".into())),
-            position: Some(ChannelRef::Name("qm".into())),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    };
     let (st, cov) = run_auto(&rec.signals());
     println!(
         "EMPS auto rms {:.3} max {:.3} µm coverage {:.1} %",

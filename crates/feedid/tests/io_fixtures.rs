@@ -1,6 +1,8 @@
 //! Reading the fixture files under `tests/data/` (repository root) and the
 //! EMPS benchmark file, through the public `feedid::io` API.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use feedid::io::{
@@ -370,15 +372,9 @@ fn truncated_and_v73_mat_files_are_refused() {
 
 #[test]
 fn emps_benchmark_reads_with_plausible_ranges() {
-    // `FEEDID_EMPS_MAT` overrides the location (e.g. from a git worktree).
-    let path = std::env::var_os("FEEDID_EMPS_MAT").map_or_else(
-        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat"),
-        PathBuf::from,
-    );
-    if !path.exists() {
-        println!("skipped: EMPS data not found at {}", path.display());
+    let Some(path) = common::emps_path() else {
         return;
-    }
+    };
     let vars = list_mat_variables(&path).unwrap();
     let names: Vec<&str> = vars.iter().map(|v| v.name.as_str()).collect();
     for n in ["t", "qg", "qm", "vir", "kp", "kv", "gtau"] {

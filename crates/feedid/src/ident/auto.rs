@@ -279,6 +279,18 @@ impl AutoEstimator {
     }
 }
 
+/// The window must be non-empty and inside the available data.
+fn check_window(signals: &Signals<'_>, window: &Range<usize>) -> Result<()> {
+    if window.is_empty() || window.end > signals.end() || window.start < signals.offset {
+        return Err(Error::TooFewSamples {
+            what: "auto window",
+            needed: window.end.max(signals.offset + 1),
+            actual: signals.end(),
+        });
+    }
+    Ok(())
+}
+
 impl Estimator for AutoEstimator {
     fn name(&self) -> &'static str {
         "auto"
@@ -320,13 +332,7 @@ impl Estimator for AutoEstimator {
         window: Range<usize>,
         coef: &mut [f64],
     ) -> Result<WindowFit> {
-        if window.is_empty() || window.end > signals.end() || window.start < signals.offset {
-            return Err(Error::TooFewSamples {
-                what: "auto window",
-                needed: window.end.max(signals.offset + 1),
-                actual: signals.end(),
-            });
-        }
+        check_window(signals, &window)?;
         self.score_pending(signals, window.end);
         let mut residual = [0.0; 3];
         for (i, slot) in self.slots.iter_mut().enumerate() {
@@ -398,13 +404,7 @@ impl Estimator for AutoEstimator {
         horizon: Range<usize>,
         out: &mut [f64],
     ) -> Result<()> {
-        if window.is_empty() || window.end > signals.end() || window.start < signals.offset {
-            return Err(Error::TooFewSamples {
-                what: "auto window",
-                needed: window.end.max(signals.offset + 1),
-                actual: signals.end(),
-            });
-        }
+        check_window(signals, &window)?;
         let h = out.len();
         let last = signals.position(window.end - 1..window.end)[0];
         for slot in &mut self.slots {

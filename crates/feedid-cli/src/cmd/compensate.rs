@@ -12,14 +12,23 @@ use feedid::compensate::{
 use feedid::drive::{RigEffects, VirtualRig};
 use feedid::greybox::LoopModel;
 use feedid::ident::ModelFile;
-use feedid::io::{read_recording, write_atomic, write_string_atomic, ChannelRef, ReadOptions};
+use feedid::io::{cell, read_recording, ChannelRef, ReadOptions};
 
 use crate::args::CompensateArgs;
 use crate::cmd::greybox::load_effects;
-use crate::cmd::{load_params, Outputs};
+use crate::cmd::{check_distinct, load_params, Outputs};
 
 /// Compute, write, verify, print.
 pub fn run(a: &CompensateArgs) -> Result<()> {
+    let mut ins = vec![a.desired.as_path()];
+    ins.extend(a.model.as_deref());
+    ins.extend(a.params.as_deref());
+    ins.extend(a.rig.as_deref());
+    ins.extend(a.effects.as_deref());
+    let mut outs = vec![a.output.as_path()];
+    outs.extend(a.verify_out.as_deref());
+    outs.extend(a.summary.as_deref());
+    check_distinct(&ins, &outs)?;
     let smoothing = match a.smooth.trim() {
         "auto" => Smoothing::Auto,
         s => Smoothing::Fixed(s.parse::<f64>().map_err(|_| {
@@ -107,39 +116,49 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     }
 
     let mut outputs = Outputs::default();
-    outputs.write(&a.output, |p| {
-        write_atomic(p, |w| {
-            writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
-            for (((t, u), d), y) in rec
-                .time()
-                .iter()
-                .zip(&comp.command)
-                .zip(desired)
-                .zip(&comp.predicted)
-            {
-                writeln!(w, "{t},{u},{d},{y}")?;
-            }
-            Ok(())
-        })
+    outputs.add(&a.output, |w| {
+        writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
+        for (((t, u), d), y) in rec
+            .time()
+            .iter()
+            .zip(&comp.command)
+            .zip(desired)
+            .zip(&comp.predicted)
+        {
+            writeln!(
+                w,
+                "{},{},{},{}",
+                cell(Some(*t)),
+                cell(Some(*u)),
+                cell(Some(*d)),
+                cell(Some(*y))
+            )?;
+        }
+        Ok(())
     })?;
     if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
-        outputs.write(p, |p| {
-            write_atomic(p, |w| {
+        outputs.add(p, |w| {
+            writeln!(
+                w,
+                "time_s,desired_m,position_uncompensated_m,position_compensated_m"
+            )?;
+            for (((t, d), a), b) in rec
+                .time()
+                .iter()
+                .zip(desired)
+                .zip(&v.position_uncompensated)
+                .zip(&v.position_compensated)
+            {
                 writeln!(
                     w,
-                    "time_s,desired_m,position_uncompensated_m,position_compensated_m"
+                    "{},{},{},{}",
+                    cell(Some(*t)),
+                    cell(Some(*d)),
+                    cell(Some(*a)),
+                    cell(Some(*b))
                 )?;
-                for (((t, d), a), b) in rec
-                    .time()
-                    .iter()
-                    .zip(desired)
-                    .zip(&v.position_uncompensated)
-                    .zip(&v.position_compensated)
-                {
-                    writeln!(w, "{t},{d},{a},{b}")?;
-                }
-                Ok(())
-            })
+            }
+            Ok(())
         })?;
     }
     if let Some(p) = &a.summary {
@@ -163,9 +182,9 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             }
         }
         let json = serde_json::to_string_pretty(&v)?;
-        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+        outputs.add_text(p, format!("{json}\n"))?;
     }
-    outputs.commit();
+    outputs.commit()?;
     print!("{text}");
     if !comp.exact_inverse {
         eprintln!(

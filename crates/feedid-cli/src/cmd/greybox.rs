@@ -13,10 +13,10 @@ use feedid::greybox::{
     Measurements, PhysicalParameter, TrackConfig, TrackWindow,
 };
 use feedid::ident::{LinearModel, ModelFile};
-use feedid::io::{cell, write_atomic, write_string_atomic};
+use feedid::io::cell;
 
 use crate::args::GreyboxArgs;
-use crate::cmd::{load_params, recording, Outputs};
+use crate::cmd::{check_distinct, load_params, recording, Outputs};
 
 /// Rig effects from a TOML file (as `feedid simulate --effects`).
 pub fn load_effects(path: &Path) -> Result<RigEffects> {
@@ -31,6 +31,14 @@ pub fn load_effects(path: &Path) -> Result<RigEffects> {
 
 /// Run the fit(s), write the outputs, print the report.
 pub fn run(a: &GreyboxArgs) -> Result<()> {
+    let mut ins: Vec<&Path> = a.input.iter().map(|p| p.as_path()).collect();
+    ins.extend(a.from_model.as_deref());
+    ins.extend(a.params.as_deref());
+    ins.extend(a.effects.as_deref());
+    let mut outs: Vec<&Path> = a.summary.iter().map(|p| p.as_path()).collect();
+    outs.extend(a.params_out.as_deref());
+    outs.extend(a.track_out.as_deref());
+    check_distinct(&ins, &outs)?;
     let estimate = PhysicalParameter::parse_list(&a.estimate)?;
     let start = load_params(a.params.as_deref())?;
     let position_loop: LoopModel = a.position_loop.parse()?;
@@ -175,6 +183,12 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     }
 
     let mut outputs = Outputs::default();
+    if let Some(p) = &a.params_out {
+        outputs.add_text(p, fit.params.to_toml_string())?;
+    }
+    if let (Some(p), Some(rows)) = (&a.track_out, &track) {
+        outputs.add(p, |w| write_track_csv(w, &estimate, rows))?;
+    }
     if let Some(p) = &a.summary {
         let mut v = serde_json::to_value(&fit)?;
         if let Some(obj) = v.as_object_mut() {
@@ -186,15 +200,9 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             }
         }
         let json = serde_json::to_string_pretty(&v)?;
-        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+        outputs.add_text(p, format!("{json}\n"))?;
     }
-    if let Some(p) = &a.params_out {
-        outputs.write(p, |p| write_string_atomic(p, &fit.params.to_toml_string()))?;
-    }
-    if let (Some(p), Some(rows)) = (&a.track_out, &track) {
-        outputs.write(p, |p| write_track_csv(p, &estimate, rows))?;
-    }
-    outputs.commit();
+    outputs.commit()?;
     print!("{text}");
     for w in fit.warnings() {
         eprintln!("warning: {w}");
@@ -289,23 +297,32 @@ fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWin
 }
 
 fn write_track_csv(
-    path: &Path,
+    w: &mut dyn std::io::Write,
     estimate: &[PhysicalParameter],
     rows: &[TrackWindow],
-) -> feedid::Result<()> {
-    write_atomic(path, |w| {
-        write!(w, "time_s,nut_position_m,mean_position_m")?;
-        for p in estimate {
-            write!(w, ",{},{}_std_error", p.name(), p.name())?;
+) -> std::io::Result<()> {
+    write!(w, "time_s,nut_position_m,mean_position_m")?;
+    for p in estimate {
+        write!(w, ",{},{}_std_error", p.name(), p.name())?;
+    }
+    writeln!(w, ",residual_rms_m,termination")?;
+    for r in rows {
+        write!(
+            w,
+            "{},{},{}",
+            cell(Some(r.time_s)),
+            cell(Some(r.nut_position_m)),
+            cell(Some(r.mean_position_m))
+        )?;
+        for (v, s) in r.values.iter().zip(&r.std_errors) {
+            write!(w, ",{},{}", cell(Some(*v)), cell(*s))?;
         }
-        writeln!(w, ",residual_rms_m,termination")?;
-        for r in rows {
-            write!(w, "{},{},{}", r.time_s, r.nut_position_m, r.mean_position_m)?;
-            for (v, s) in r.values.iter().zip(&r.std_errors) {
-                write!(w, ",{},{}", v, cell(*s))?;
-            }
-            writeln!(w, ",{},{}", r.residual_rms_m, r.termination.label())?;
-        }
-        Ok(())
-    })
+        writeln!(
+            w,
+            ",{},{}",
+            cell(Some(r.residual_rms_m)),
+            r.termination.label()
+        )?;
+    }
+    Ok(())
 }

@@ -7,9 +7,10 @@ use anyhow::{bail, Context, Result};
 use feedid::drive::RigParams;
 use feedid::ident::{
     fit_global_model, global_model_for, identify, select_order, ArxOrders, EngineConfig,
-    GlobalModelKind, MethodKind, MethodSpec, OrderSearch, PaperConfig, SHIFT_AMPLIFICATION_WARNING,
+    GlobalModelKind, MethodKind, MethodSpec, OrderSearch, PaperConfig, SlidingResult,
+    SHIFT_AMPLIFICATION_WARNING,
 };
-use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
+use feedid::io::{write_coefficients_csv, write_predictions_csv, CoefficientRow};
 use rayon::prelude::*;
 
 use crate::args::{IdentifyArgs, MethodArgs, WindowArgs};
@@ -69,6 +70,24 @@ pub fn engine_config(w: &WindowArgs, spec: &MethodSpec) -> EngineConfig {
     }
 }
 
+/// The coefficients table's rows of a sliding run.
+fn coefficient_rows<'a>(
+    time: &'a [f64],
+    s: &'a SlidingResult,
+) -> impl Iterator<Item = CoefficientRow<'a>> + 'a {
+    s.windows
+        .iter()
+        .enumerate()
+        .map(move |(i, rec)| CoefficientRow {
+            start_s: time.get(rec.window.start).copied(),
+            end_s: time.get(rec.window.end.saturating_sub(1)).copied(),
+            residual_rms_m: rec.fit.residual_rms,
+            iterations: rec.fit.iterations,
+            termination: rec.fit.termination.label(),
+            coefficients: s.window_coefficients(i),
+        })
+}
+
 /// Output paths of one recording.
 struct OutputPaths {
     predictions: PathBuf,
@@ -96,6 +115,7 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             let mut outs = vec![paths.predictions.as_path()];
             outs.extend(paths.coefficients.as_deref());
             outs.extend(paths.summary.as_deref());
+            outs.extend(a.model_out.as_deref());
             check_distinct(&ins, &outs)?;
             let text = identify_file(input, a, &spec, &cfg, &params, &paths)?;
             print!("{text}");
@@ -118,6 +138,20 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             }
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+            // no output may overwrite an input (`--out-dir .` beside a recording
+            // named like another's output)
+            let batch_outputs: Vec<PathBuf> = inputs
+                .iter()
+                .flat_map(|input| {
+                    let stem = output_stem(input);
+                    ["predictions.csv", "coefficients.csv", "summary.json"]
+                        .map(|ext| dir.join(format!("{stem}.{ext}")))
+                })
+                .collect();
+            let mut ins: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+            ins.extend(a.params.as_deref());
+            let outs: Vec<&Path> = batch_outputs.iter().map(PathBuf::as_path).collect();
+            check_distinct(&ins, &outs)?;
             let results: Vec<(PathBuf, Result<String>)> = inputs
                 .par_iter()
                 .map(|input| {
@@ -221,25 +255,8 @@ fn identify_file(
     }
     let summary = run.summary();
 
-    let mut outputs = Outputs::default();
-    outputs.write(&paths.predictions, |p| {
-        write_predictions_csv(
-            p,
-            rec.time(),
-            rec.command(),
-            rec.position(),
-            &run.sliding,
-            run.simulated.as_deref(),
-        )
-    })?;
-    if let Some(p) = &paths.coefficients {
-        outputs.write(p, |p| write_coefficients_csv(p, rec.time(), &run.sliding))?;
-    }
-    if let Some(p) = &paths.summary {
-        let json = serde_json::to_string_pretty(&summary)?;
-        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
-    }
     let mut global_line = None;
+    let mut model_json = None;
     if let (Some(p), Some(kind)) = (&a.model_out, &global_kind) {
         let mut file = fit_global_model(&rec, kind)
             .map_err(|e| anyhow::anyhow!("{}: global model: {e}", input.display()))?;
@@ -254,11 +271,36 @@ fn identify_file(
                 p.display()
             ));
         }
-        outputs.write(p, |p| {
-            write_string_atomic(p, &format!("{}\n", file.to_json()))
+        model_json = Some((p, format!("{}\n", file.to_json())));
+    }
+
+    // every output written together or not at all, the summary last
+    let mut outputs = Outputs::default();
+    let s = &run.sliding;
+    outputs.add(&paths.predictions, |w| {
+        write_predictions_csv(
+            w,
+            rec.time(),
+            rec.command(),
+            rec.position(),
+            &s.predicted,
+            &s.has_prediction,
+            run.simulated.as_deref(),
+        )
+    })?;
+    if let Some(p) = &paths.coefficients {
+        outputs.add(p, |w| {
+            write_coefficients_csv(w, &s.coefficient_names, coefficient_rows(rec.time(), s))
         })?;
     }
-    outputs.commit();
+    if let Some((p, json)) = model_json {
+        outputs.add_text(p, json)?;
+    }
+    if let Some(p) = &paths.summary {
+        let json = serde_json::to_string_pretty(&summary)?;
+        outputs.add_text(p, format!("{json}\n"))?;
+    }
+    outputs.commit()?;
 
     let mut t = String::new();
     let _ = writeln!(

@@ -2,12 +2,11 @@
 
 use anyhow::{bail, Result};
 use feedid::ident::MethodSpec;
-use feedid::io::write_string_atomic;
 use feedid::report::{recording_report, RecordingAnalysis, ReportOptions};
 
 use crate::args::{MethodArgs, MethodListArgs, ReportArgs};
 use crate::cmd::identify::{engine_config, method_spec};
-use crate::cmd::{load_params, params_error, recording, Outputs};
+use crate::cmd::{check_distinct, load_params, params_error, recording, Outputs};
 
 /// The methods of `--methods` (or `default`), each with the shared per-method options.
 pub fn method_specs(m: &MethodListArgs, default: &str) -> Result<Vec<MethodSpec>> {
@@ -40,6 +39,9 @@ pub fn run(a: &ReportArgs) -> Result<()> {
             a.zoom
         );
     }
+    let mut ins = vec![a.input.as_path()];
+    ins.extend(a.params.as_deref());
+    check_distinct(&ins, &[a.output.as_path()])?;
     let params = load_params(a.params.as_deref())?;
     let rec = recording::load(&a.input, &a.recording)?;
     let methods = specs
@@ -71,8 +73,8 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     let page = recording_report(&analysis)?;
     let html = page.to_html();
     let mut outputs = Outputs::default();
-    outputs.write(&a.output, |p| write_string_atomic(p, &html))?;
-    outputs.commit();
+    outputs.add(&a.output, |w| w.write_all(html.as_bytes()))?;
+    outputs.commit()?;
 
     println!(
         "{}: {} samples at {:.2} Hz",

@@ -1,14 +1,15 @@
 //! `feedid reproduce`: the paper's experiments on the virtual rig.
 
+use std::path::PathBuf;
+
 use anyhow::{Context, Result};
 use feedid::experiment::{run_experiment, summary_markdown, PaperExperimentConfig};
 use feedid::ident::{MethodKind, MethodSpec};
-use feedid::io::write_string_atomic;
 use feedid::report::paper_report;
 use feedid::signal::Scenario;
 
 use crate::args::ReproduceArgs;
-use crate::cmd::{load_params, Outputs};
+use crate::cmd::{check_distinct, load_params, Outputs};
 
 /// Run ramp and step, write figures, summary.md and report.html, print the table.
 pub fn run(a: &ReproduceArgs) -> Result<()> {
@@ -44,11 +45,17 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
 
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("{}: cannot create directory", a.out.display()))?;
+    let paths: Vec<PathBuf> = files.iter().map(|(name, _)| a.out.join(name)).collect();
+    check_distinct(
+        &a.params.iter().map(|p| p.as_path()).collect::<Vec<_>>(),
+        &paths.iter().map(|p| p.as_path()).collect::<Vec<_>>(),
+    )?;
     let mut outputs = Outputs::default();
-    for (name, text) in &files {
-        outputs.write(&a.out.join(name), |p| write_string_atomic(p, text))?;
+    // summary.md and report.html are the last two
+    for (path, (_, text)) in paths.iter().zip(files) {
+        outputs.add_text(path, text)?;
     }
-    outputs.commit();
+    outputs.commit()?;
     println!("{md}");
     println!("written to {}", a.out.display());
     Ok(())

@@ -5,7 +5,7 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
-use crate::cmd::{check_distinct, load_params, params_error};
+use crate::cmd::{check_distinct, load_params, params_error, Outputs};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
 pub fn run(a: &SimulateArgs) -> Result<()> {
@@ -39,7 +39,8 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let out = rig
         .simulate(&command, a.rate)
         .map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
-    feedid::io::write_atomic(&a.output, |w| {
+    let mut outputs = Outputs::default();
+    outputs.add(&a.output, |w| {
         writeln!(
             w,
             "time_s,command_m,position_m,true_position_m,current_a,velocity_m_per_s"
@@ -58,6 +59,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         }
         Ok(())
     })?;
+    outputs.commit()?;
     let peak = command.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
     println!(
         "{}: {} samples at {} Hz ({:.3} s), {} command, peak {:.4} mm, effects {}",

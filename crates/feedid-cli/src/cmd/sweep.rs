@@ -6,12 +6,11 @@ use std::io::IsTerminal;
 
 use anyhow::{bail, Result};
 use feedid::ident::{sweep, ArxOrders, SweepConfig, SweepResult};
-use feedid::io::write_string_atomic;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::SweepArgs;
 use crate::cmd::report::method_specs;
-use crate::cmd::{recording, Outputs};
+use crate::cmd::{check_distinct, recording, Outputs};
 
 /// A comma-separated list of sample counts ≥ 1 (duplicates dropped, order kept).
 fn parse_counts(flag: &str, s: &str) -> Result<Vec<usize>> {
@@ -108,6 +107,9 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     if a.hop == Some(0) {
         bail!("invalid --hop 0: must be at least 1 sample");
     }
+    let mut outs = vec![a.output.as_path()];
+    outs.extend(a.plot.as_deref());
+    check_distinct(&[a.input.as_path()], &outs)?;
     let rec = recording::load(&a.input, &a.recording)?;
     let cfg = SweepConfig {
         methods,
@@ -137,11 +139,11 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         None => None,
     };
     let mut outputs = Outputs::default();
-    outputs.write(&a.output, |p| write_string_atomic(p, &csv))?;
-    if let (Some(p), Some(svg)) = (&a.plot, &svg) {
-        outputs.write(p, |p| write_string_atomic(p, svg))?;
+    if let (Some(p), Some(svg)) = (&a.plot, svg) {
+        outputs.add_text(p, svg)?;
     }
-    outputs.commit();
+    outputs.add_text(&a.output, csv)?;
+    outputs.commit()?;
 
     println!(
         "{}: {} samples at {:.2} Hz, {} combinations on {} threads",

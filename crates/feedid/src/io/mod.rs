@@ -1,7 +1,8 @@
 //! Reading recordings from CSV/text and MATLAB v5 files ([`read_recording`]
 //! dispatches), the options that pick columns and units ([`ReadOptions`]),
 //! the summary a user checks before identifying ([`recording_info`]), and
-//! writing results without leaving partial files ([`write_atomic`]).
+//! writing results without destroying anything or leaving partial files
+//! ([`OutputSet`], [`write_atomic`]), and the CSV tables of results.
 
 mod csv;
 mod info;
@@ -9,6 +10,7 @@ mod mat;
 mod options;
 mod output;
 mod read;
+mod table;
 
 pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
 pub use self::info::{recording_info, ChannelStats, RecordingInfo};
@@ -21,6 +23,8 @@ pub use self::options::{
     DEFAULT_TIME_COLUMN,
 };
 pub use self::output::{
-    cell, write_atomic, write_coefficients_csv, write_predictions_csv, write_string_atomic,
+    abandon_pending_outputs, destination, pending_output_count, write_atomic, write_string_atomic,
+    Destination, OutputSet,
 };
 pub use self::read::{read_recording, read_recording_from_bytes};
+pub use self::table::{cell, write_coefficients_csv, write_predictions_csv, CoefficientRow};

@@ -265,6 +265,15 @@ pub enum Error {
         limit: f64,
     },
 
+    /// A stream (FIFO, device, pipe) delivered more than a recording may hold.
+    #[error("{}: more than {limit} bytes from a pipe or device; feedid reads a recording whole: save it to a file first, or use `feedid stream` for live data", path.display())]
+    InputTooLarge {
+        /// The input.
+        path: PathBuf,
+        /// The most bytes read \[bytes\].
+        limit: u64,
+    },
+
     /// The mean sampling interval of the time stamps is too short for a
     /// finite rate and finite derivatives, see [`crate::recording::MIN_INTERVAL`].
     #[error("mean sampling interval {interval:e} s is shorter than {min:e} s (a rate above {max_rate:e} Hz); check the time unit")]

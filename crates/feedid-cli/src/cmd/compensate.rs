@@ -15,8 +15,7 @@ use feedid::ident::ModelFile;
 use feedid::io::{cell, read_recording, ChannelRef, ReadOptions};
 
 use crate::args::CompensateArgs;
-use crate::cmd::greybox::load_effects;
-use crate::cmd::{check_distinct, load_params, Outputs};
+use crate::cmd::{check_distinct, load_effects, load_params, Outputs};
 
 /// Compute, write, verify, print.
 pub fn run(a: &CompensateArgs) -> Result<()> {

@@ -16,18 +16,7 @@ use feedid::ident::{LinearModel, ModelFile};
 use feedid::io::cell;
 
 use crate::args::GreyboxArgs;
-use crate::cmd::{check_distinct, load_params, recording, Outputs};
-
-/// Rig effects from a TOML file (as `feedid simulate --effects`).
-pub fn load_effects(path: &Path) -> Result<RigEffects> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let fx: RigEffects = toml::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " ")))?;
-    fx.validate()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    Ok(fx)
-}
+use crate::cmd::{check_distinct, load_effects, load_params, recording, Outputs};
 
 /// Run the fit(s), write the outputs, print the report.
 pub fn run(a: &GreyboxArgs) -> Result<()> {

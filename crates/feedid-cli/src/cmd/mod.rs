@@ -45,6 +45,16 @@ pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigPara
     })
 }
 
+/// Rig effects from a TOML file (`--effects`): friction law, limits, noise.
+pub fn load_effects(path: &Path) -> anyhow::Result<feedid::drive::RigEffects> {
+    let text = feedid::io::read_small_text(path)?;
+    let fx: feedid::drive::RigEffects = toml::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " ")))?;
+    fx.validate()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(fx)
+}
+
 /// A library error caused by the values of a parameter file, prefixed by the
 /// file (`rig.toml: these parameters give no usable model: …`).
 pub fn params_error(path: Option<&Path>, e: feedid::Error) -> anyhow::Error {

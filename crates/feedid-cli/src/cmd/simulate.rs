@@ -5,7 +5,7 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
-use crate::cmd::{check_distinct, load_params, params_error, Outputs};
+use crate::cmd::{check_distinct, load_effects, load_params, params_error, Outputs};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
 pub fn run(a: &SimulateArgs) -> Result<()> {
@@ -21,13 +21,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let effects = if a.linear {
         RigEffects::linear()
     } else if let Some(p) = &a.effects {
-        let text =
-            std::fs::read_to_string(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
-        let fx: RigEffects = toml::from_str(&text).map_err(|e| {
-            anyhow::anyhow!("{}: {}", p.display(), e.to_string().replace('\n', " "))
-        })?;
-        fx.validate()?;
-        fx
+        load_effects(p)?
     } else {
         RigEffects::default()
     };

@@ -402,10 +402,7 @@ impl RigParams {
 
     /// Read and validate a TOML parameter file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::io::read_small_text(path)?;
         Self::from_toml_str(&text, Some(path))
     }
 

@@ -212,10 +212,7 @@ impl ModelFile {
 
     /// Read a model file; errors name the file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::io::read_small_text(path)?;
         Self::from_json(&text).map_err(|e| match e {
             Error::ParamsFile { message, .. } => Error::ParamsFile {
                 path: Some(path.to_path_buf()),

@@ -10,6 +10,7 @@ mod mat;
 mod options;
 mod output;
 mod read;
+mod source;
 mod table;
 
 pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
@@ -27,4 +28,5 @@ pub use self::output::{
     Destination, OutputSet,
 };
 pub use self::read::{read_recording, read_recording_from_bytes};
+pub use self::source::{read_small_text, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES};
 pub use self::table::{cell, write_coefficients_csv, write_predictions_csv, CoefficientRow};

@@ -24,6 +24,7 @@ pub mod greybox;
 pub mod ident;
 pub mod io;
 pub mod lti;
+pub mod plausibility;
 pub mod plot;
 pub mod recording;
 pub mod report;

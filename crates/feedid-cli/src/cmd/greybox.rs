@@ -77,7 +77,8 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             (fit, None)
         }
         (None, Some(input)) => {
-            let rec = recording::load(input, &a.recording)?;
+            let (rec, warnings) = recording::load_checked(input, &a.recording)?;
+            context.insert("warnings".into(), warnings.into());
             let current = match &a.current {
                 Some(name) => Some(
                     rec.extra()

@@ -214,7 +214,7 @@ fn identify_file(
             kind.as_deref().unwrap_or("auto"),
         )?),
     };
-    let rec = recording::load(input, &a.recording)?;
+    let (rec, warnings) = recording::load_checked(input, &a.recording)?;
     let mut spec = spec.clone();
     let mut chosen_order = None;
     if a.method
@@ -297,7 +297,11 @@ fn identify_file(
         outputs.add_text(p, json)?;
     }
     if let Some(p) = &paths.summary {
-        let json = serde_json::to_string_pretty(&summary)?;
+        let mut v = serde_json::to_value(&summary)?;
+        if let Some(obj) = v.as_object_mut() {
+            obj.insert("warnings".into(), warnings.clone().into());
+        }
+        let json = serde_json::to_string_pretty(&v)?;
         outputs.add_text(p, format!("{json}\n"))?;
     }
     outputs.commit()?;
@@ -334,13 +338,26 @@ fn identify_file(
         summary.samples_predicted,
         summary.coverage_percent
     );
-    let _ = writeln!(
-        t,
-        "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %",
-        1e6 * summary.rms_error_m,
-        1e6 * summary.max_abs_error_m,
-        summary.fit_percent
-    );
+    if summary.samples_predicted == 0 {
+        // no figure over nothing
+        let _ = writeln!(
+            t,
+            "  prediction error: none (no sample was predicted; see --tolerance, --window and the warnings)"
+        );
+    } else {
+        let _ = writeln!(
+            t,
+            "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %{}",
+            1e6 * summary.rms_error_m,
+            1e6 * summary.max_abs_error_m,
+            summary.fit_percent,
+            if warnings.is_empty() {
+                ""
+            } else {
+                " (the recording has warnings: see above)"
+            }
+        );
+    }
     if let Some(p) = run.global.as_ref().and_then(|g| g.identified_by.as_ref()) {
         let _ = writeln!(
             t,

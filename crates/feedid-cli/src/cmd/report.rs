@@ -43,7 +43,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     ins.extend(a.params.as_deref());
     check_distinct(&ins, &[a.output.as_path()])?;
     let params = load_params(a.params.as_deref())?;
-    let rec = recording::load(&a.input, &a.recording)?;
+    let (rec, warnings) = recording::load_checked(&a.input, &a.recording)?;
     let methods = specs
         .into_iter()
         .map(|s| {
@@ -62,7 +62,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         || a.input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| {
+    let mut analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| {
         // extreme but valid parameters can give no usable nominal model: say which file
         if matches!(e.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() {
             params_error(a.params.as_deref(), e)
@@ -70,6 +70,9 @@ pub fn run(a: &ReportArgs) -> Result<()> {
             e.into()
         }
     })?;
+    analysis
+        .notes
+        .extend(warnings.iter().map(|w| format!("warning: {w}")));
     let page = recording_report(&analysis)?;
     let html = page.to_html();
     let mut outputs = Outputs::default();

@@ -182,6 +182,13 @@ pub enum Error {
         reason: &'static str,
     },
 
+    /// A physical model has poles with a non-negative real part.
+    #[error("the physical model is unstable: poles with a positive real part at {poles}; its simulation diverges (check the gains and the mechanics)")]
+    UnstableModel {
+        /// The unstable poles, e.g. `1.3913e3 ± 3.9766e3j rad/s (6.7051e2 Hz)`.
+        poles: String,
+    },
+
     /// An iterative algorithm did not converge.
     #[error("{algorithm} did not converge after {iterations} iterations")]
     NotConverged {

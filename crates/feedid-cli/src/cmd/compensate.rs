@@ -15,7 +15,7 @@ use feedid::ident::ModelFile;
 use feedid::io::{cell, read_recording, ChannelRef, ReadOptions};
 
 use crate::args::CompensateArgs;
-use crate::cmd::{check_distinct, load_effects, load_params, Outputs};
+use crate::cmd::{check_distinct, load_effects, load_model_params, Outputs};
 
 /// Compute, write, verify, print.
 pub fn run(a: &CompensateArgs) -> Result<()> {
@@ -45,7 +45,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     cfg.validate()?;
     let position_loop: LoopModel = a.position_loop.parse()?;
     let verify_rig = if a.verify {
-        let params = load_params(a.rig.as_deref())?;
+        let params = load_model_params(a.rig.as_deref(), a.allow_unstable)?;
         let effects = match &a.effects {
             Some(p) => load_effects(p)?,
             None => RigEffects::default(),
@@ -83,7 +83,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             (format!("{} [{how}]", path.display()), comp)
         }
         (None, Some(path)) => {
-            let params = load_params(Some(path))?;
+            let params = load_model_params(Some(path), a.allow_unstable)?;
             let comp = compensate_params(&params, position_loop, desired, dt, &cfg)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             (
@@ -97,6 +97,20 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         }
         (None, None) => anyhow::bail!("give --model model.json or --params rig.toml"),
     };
+    // an unstable model (allowed by --allow-unstable) can give a command that runs away
+    for (name, v) in [
+        ("command", &comp.command),
+        ("predicted position", &comp.predicted),
+    ] {
+        if let Some(k) = v.iter().position(|x| !feedid::recording::is_usable(*x)) {
+            anyhow::bail!(
+                "{}: the {name} runs away ({:e} at t = {} s): the model cannot be inverted here; nothing written",
+                a.output.display(),
+                v[k],
+                rec.time()[k]
+            );
+        }
+    }
     let _ = writeln!(
         text,
         "{}: {} samples at {:.2} Hz; model {source}",

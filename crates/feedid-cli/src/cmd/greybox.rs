@@ -16,7 +16,7 @@ use feedid::ident::{LinearModel, ModelFile};
 use feedid::io::cell;
 
 use crate::args::GreyboxArgs;
-use crate::cmd::{check_distinct, load_effects, load_params, recording, Outputs};
+use crate::cmd::{check_distinct, load_effects, load_model_params, recording, Outputs};
 
 /// Run the fit(s), write the outputs, print the report.
 pub fn run(a: &GreyboxArgs) -> Result<()> {
@@ -29,7 +29,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     outs.extend(a.track_out.as_deref());
     check_distinct(&ins, &outs)?;
     let estimate = PhysicalParameter::parse_list(&a.estimate)?;
-    let start = load_params(a.params.as_deref())?;
+    let start = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let position_loop: LoopModel = a.position_loop.parse()?;
     let effects = match &a.effects {
         Some(p) => load_effects(p)?,

@@ -14,7 +14,7 @@ use feedid::io::{write_coefficients_csv, write_predictions_csv, CoefficientRow};
 use rayon::prelude::*;
 
 use crate::args::{IdentifyArgs, MethodArgs, WindowArgs};
-use crate::cmd::{check_distinct, load_params, recording, Outputs};
+use crate::cmd::{check_distinct, load_model_params, recording, Outputs};
 
 /// The method named on the command line with its options.
 pub fn method_spec(m: &MethodArgs) -> Result<MethodSpec> {
@@ -99,7 +99,7 @@ struct OutputPaths {
 pub fn run(a: &IdentifyArgs) -> Result<()> {
     let spec = method_spec(&a.method)?;
     let cfg = engine_config(&a.windows, &spec);
-    let params = load_params(a.params.as_deref())?;
+    let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     match (&a.out_dir, a.inputs.as_slice()) {
         (None, [input]) => {
             let paths = OutputPaths {
@@ -368,13 +368,19 @@ fn identify_file(
     if let Some(n) = global_note {
         let _ = writeln!(t, "{n}");
     }
-    if let (Some(r), Some(m)) = (summary.sim_rms_error_m, summary.sim_max_abs_error_m) {
-        let _ = writeln!(
-            t,
-            "  simulation model:  rms {:.3} µm, max {:.3} µm",
-            1e6 * r,
-            1e6 * m
-        );
+    match (summary.sim_rms_error_m, summary.sim_max_abs_error_m) {
+        (Some(r), Some(m)) if r.is_finite() && m.is_finite() => {
+            let _ = writeln!(
+                t,
+                "  simulation model:  rms {:.3} µm, max {:.3} µm",
+                1e6 * r,
+                1e6 * m
+            );
+        }
+        (Some(_), _) => {
+            let _ = writeln!(t, "  simulation model:  diverged (unstable parameters)");
+        }
+        _ => {}
     }
     let _ = writeln!(
         t,

@@ -37,12 +37,42 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
-/// The rig parameters from a TOML file, or the built-in default rig.
+/// The rig parameters from a TOML file, or the built-in default rig, with
+/// the one validation every command makes (`feedid::drive::check_model`:
+/// each value in range, the closed loop finite — `kv = 1e300` is refused
+/// everywhere, not only by `feedid model`).
 pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigParams> {
-    Ok(match path {
+    let params = match path {
         Some(p) => feedid::drive::RigParams::load(p)?,
         None => feedid::drive::RigParams::default(),
-    })
+    };
+    feedid::drive::check_model(&params).map_err(|e| params_error(path, e))?;
+    Ok(params)
+}
+
+/// [`load_params`] for a model that is simulated or inverted: an unstable
+/// one is refused (exit 2, its unstable poles named) unless `allow_unstable`,
+/// then only warned about.
+pub fn load_model_params(
+    path: Option<&Path>,
+    allow_unstable: bool,
+) -> anyhow::Result<feedid::drive::RigParams> {
+    let params = load_params(path)?;
+    let check = feedid::drive::check_model(&params)?;
+    if !check.stable {
+        let name = path.map_or_else(
+            || "the built-in rig".to_string(),
+            |p| p.display().to_string(),
+        );
+        let e = feedid::Error::UnstableModel {
+            poles: check.describe_unstable(),
+        };
+        if !allow_unstable {
+            anyhow::bail!("{name}: {e}; give --allow-unstable to use it anyway");
+        }
+        eprintln!("warning: {name}: {e}");
+    }
+    Ok(params)
 }
 
 /// Rig effects from a TOML file (`--effects`): friction law, limits, noise.

@@ -6,7 +6,7 @@ use feedid::report::{recording_report, RecordingAnalysis, ReportOptions};
 
 use crate::args::{MethodArgs, MethodListArgs, ReportArgs};
 use crate::cmd::identify::{engine_config, method_spec};
-use crate::cmd::{check_distinct, load_params, params_error, recording, Outputs};
+use crate::cmd::{check_distinct, load_model_params, params_error, recording, Outputs};
 
 /// The methods of `--methods` (or `default`), each with the shared per-method options.
 pub fn method_specs(m: &MethodListArgs, default: &str) -> Result<Vec<MethodSpec>> {
@@ -42,7 +42,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     let mut ins = vec![a.input.as_path()];
     ins.extend(a.params.as_deref());
     check_distinct(&ins, &[a.output.as_path()])?;
-    let params = load_params(a.params.as_deref())?;
+    let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let (rec, warnings) = recording::load_checked(&a.input, &a.recording)?;
     let methods = specs
         .into_iter()

@@ -9,12 +9,12 @@ use feedid::report::paper_report;
 use feedid::signal::Scenario;
 
 use crate::args::ReproduceArgs;
-use crate::cmd::{check_distinct, load_params, Outputs};
+use crate::cmd::{check_distinct, load_model_params, Outputs};
 
 /// Run ramp and step, write figures, summary.md and report.html, print the table.
 pub fn run(a: &ReproduceArgs) -> Result<()> {
     let cfg = PaperExperimentConfig {
-        params: load_params(a.params.as_deref())?,
+        params: load_model_params(a.params.as_deref(), a.allow_unstable)?,
         seed: a.seed,
         solver: a.solver.parse()?,
         ..PaperExperimentConfig::default()

@@ -5,7 +5,7 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
-use crate::cmd::{check_distinct, load_effects, load_params, params_error, Outputs};
+use crate::cmd::{check_distinct, load_effects, load_model_params, params_error, Outputs};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
 pub fn run(a: &SimulateArgs) -> Result<()> {
@@ -17,7 +17,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         .collect();
     check_distinct(&inputs, &[a.output.as_path()])?;
     let scenario: Scenario = a.scenario.parse()?;
-    let params = load_params(a.params.as_deref())?;
+    let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let effects = if a.linear {
         RigEffects::linear()
     } else if let Some(p) = &a.effects {
@@ -33,6 +33,24 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let out = rig
         .simulate(&command, a.rate)
         .map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
+    // an unstable rig (allowed by --allow-unstable) may run away: never write
+    // what cannot be read back as a recording
+    let channels = [
+        ("position_m", &out.position),
+        ("true_position_m", &out.true_position),
+        ("current_a", &out.motor_current),
+        ("velocity_m_per_s", &out.velocity),
+    ];
+    for (name, v) in channels {
+        if let Some(k) = v.iter().position(|x| !feedid::recording::is_usable(*x)) {
+            anyhow::bail!(
+                "{}: the simulation diverged: {name} reaches {:e} at t = {} s (beyond ±1e100 or not finite); nothing written",
+                a.output.display(),
+                v[k],
+                out.time[k]
+            );
+        }
+    }
     let mut outputs = Outputs::default();
     outputs.add(&a.output, |w| {
         writeln!(

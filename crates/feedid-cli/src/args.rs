@@ -431,6 +431,9 @@ pub struct GreyboxArgs {
     /// Levenberg–Marquardt iteration cap.
     #[arg(long, default_value_t = 100, value_name = "N")]
     pub max_iterations: usize,
+    /// Fits restarted from the estimate moved ±22 % to check that the data pin it (0: no check).
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    pub restarts: usize,
     /// Summary JSON.
     #[arg(long, value_name = "gb.json")]
     pub summary: Option<PathBuf>,

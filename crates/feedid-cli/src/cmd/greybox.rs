@@ -14,6 +14,7 @@ use feedid::greybox::{
 };
 use feedid::ident::{LinearModel, ModelFile};
 use feedid::io::cell;
+use feedid::solve::Termination;
 
 use crate::args::GreyboxArgs;
 use crate::cmd::{check_distinct, load_effects, load_model_params, recording, Outputs};
@@ -45,6 +46,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
         effects,
         max_iterations: a.max_iterations,
         refuse_unidentifiable: !a.allow_unidentifiable,
+        restarts: a.restarts,
         ..GreyboxConfig::default()
     };
     if a.track_window.is_some() && a.track_out.is_none() {
@@ -259,10 +261,40 @@ fn report(t: &mut String, fit: &GreyboxFit) {
         "  condition number of the log-parameter Jacobian: {:.3e}",
         fit.condition_number
     );
+    if !fit.residual_structure.is_empty() {
+        let parts: Vec<String> = fit
+            .residual_structure
+            .iter()
+            .map(|s| {
+                format!(
+                    "{} {:.1} % predictable from its past ({})",
+                    s.output,
+                    100.0 * s.predictable_share,
+                    if s.structured { "structured" } else { "white" }
+                )
+            })
+            .collect();
+        let _ = writeln!(t, "  residuals: {}", parts.join(", "));
+    }
+    if fit.restarts > 0 {
+        let _ = writeln!(
+            t,
+            "  restarts: {} fits started ±22 % from the estimate",
+            fit.restarts
+        );
+    }
 }
 
 fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWindow]) {
-    let _ = writeln!(t, "  tracking: {} windows", rows.len());
+    let skipped = rows
+        .iter()
+        .filter(|r| r.termination == Termination::Fallback)
+        .count();
+    let _ = writeln!(
+        t,
+        "  tracking: {} windows ({skipped} without excitation of a parameter: no estimate, the previous one kept)",
+        rows.len()
+    );
     let _ = write!(t, "  {:>9} {:>10}", "time s", "nut m");
     for p in estimate {
         let _ = write!(t, " {:>12} {:>10}", p.name(), "std");
@@ -275,12 +307,20 @@ fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWin
         }
         let _ = write!(t, "  {:>9.4} {:>10.5}", r.time_s, r.nut_position_m);
         for (v, s) in r.values.iter().zip(&r.std_errors) {
+            let v = if r.termination == Termination::Fallback {
+                "-".to_string()
+            } else {
+                format!("{v:.5e}")
+            };
             let _ = write!(
                 t,
-                " {:>12.5e} {:>10}",
+                " {:>12} {:>10}",
                 v,
                 s.map_or("-".to_string(), |s| format!("{s:.2e}"))
             );
+        }
+        if r.termination == Termination::Fallback {
+            let _ = write!(t, "  not excited");
         }
         let _ = writeln!(t);
     }
@@ -293,7 +333,7 @@ fn write_track_csv(
 ) -> std::io::Result<()> {
     write!(w, "time_s,nut_position_m,mean_position_m")?;
     for p in estimate {
-        write!(w, ",{},{}_std_error", p.name(), p.name())?;
+        write!(w, ",{0},{0}_std_error,{0}_verdict", p.name())?;
     }
     writeln!(w, ",residual_rms_m,termination")?;
     for r in rows {
@@ -304,8 +344,10 @@ fn write_track_csv(
             cell(Some(r.nut_position_m)),
             cell(Some(r.mean_position_m))
         )?;
-        for (v, s) in r.values.iter().zip(&r.std_errors) {
-            write!(w, ",{},{}", cell(Some(*v)), cell(*s))?;
+        for ((v, s), verdict) in r.values.iter().zip(&r.std_errors).zip(&r.verdicts) {
+            // a window that does not determine the parameter has no estimate of it
+            let v = (r.termination != Termination::Fallback).then_some(*v);
+            write!(w, ",{},{},{}", cell(v), cell(*s), verdict.label())?;
         }
         writeln!(
             w,

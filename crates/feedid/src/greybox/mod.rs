@@ -22,6 +22,7 @@ pub mod identifiability;
 mod model;
 mod names;
 mod track;
+pub mod whiteness;
 
 pub use coefficients::fit_coefficients;
 pub use fit::{fit_greybox, GreyboxConfig, GreyboxFit, Measurements, ParameterEstimate};

@@ -11,7 +11,10 @@
 //! advanced to the next window's `b` with this window's estimate. Each window
 //! is fitted by Levenberg–Marquardt on the log-parameters, warm-started from
 //! the previous window's estimate, with standard errors from the window's
-//! Jacobian and residuals as in [`super::fit_greybox`].
+//! Jacobian and residuals as in [`super::fit_greybox`]. A window that leaves
+//! a parameter *not identifiable* (it does not excite it: a plain ramp for
+//! the stiffness) keeps the previous window's estimates, reported with
+//! termination `fallback` and no standard errors.
 //!
 //! The nut position of a window is `geometry.nut_position` plus the mean
 //! measured position over the window (the virtual rig's convention: position
@@ -34,7 +37,7 @@
 use serde::Serialize;
 
 use super::fit::{apply, central_jacobian, check_set, check_signals, GreyboxConfig};
-use super::identifiability::analyse;
+use super::identifiability::{analyse, Verdict};
 use super::model::{linear_discrete, Dynamics};
 use super::names::PhysicalParameter;
 use crate::drive::RigParams;
@@ -82,6 +85,10 @@ pub struct TrackWindow {
     pub values: Vec<f64>,
     /// Their standard errors (`None` when not determined in this window).
     pub std_errors: Vec<Option<f64>>,
+    /// How well this window determines each parameter; a window that leaves
+    /// one *not identifiable* (no excitation of it) keeps the previous
+    /// window's estimates (`termination` [`Termination::Fallback`]).
+    pub verdicts: Vec<Verdict>,
     /// RMS of the window's residuals \[m\].
     pub residual_rms_m: f64,
     /// LM termination.
@@ -186,11 +193,24 @@ pub fn track_greybox(
                 out.iter_mut().for_each(|v| *v = penalty);
             }
         };
+        let before = theta.clone();
         let report = lm.minimize(&mut residual, &mut theta, &lm_cfg)?;
         central_jacobian(&mut residual, &theta, w, &mut r, &mut jac);
         residual(&theta, &mut r);
         let ss: f64 = r.iter().map(|v| v * v).sum();
         let a = analyse(&jac, w, estimate, ss, &cfg.thresholds)?;
+        // a window that does not excite a parameter cannot move it: keep the
+        // previous estimate (on a plain ramp the stiffness would otherwise
+        // run off to 1e16 N/m, "converged")
+        let excited = a.verdicts.iter().all(|v| *v != Verdict::NotIdentifiable);
+        let mut termination = report.termination;
+        let mut residual_ss = ss;
+        if !excited {
+            theta.copy_from_slice(&before);
+            residual(&theta, &mut r);
+            residual_ss = r.iter().map(|v| v * v).sum();
+            termination = Termination::Fallback;
+        }
         let values: Vec<f64> = base.iter().zip(&theta).map(|(b, t)| b * t.exp()).collect();
         let mean = position[s..s + w].iter().sum::<f64>() / w as f64;
         rows.push(TrackWindow {
@@ -202,11 +222,12 @@ pub fn track_greybox(
             std_errors: values
                 .iter()
                 .zip(&a.relative_std_errors)
-                .map(|(v, e)| e.map(|e| e * v))
+                .map(|(v, e)| e.filter(|_| excited).map(|e| e * v))
                 .collect(),
             values,
-            residual_rms_m: (ss / w as f64).sqrt(),
-            termination: report.termination,
+            verdicts: a.verdicts.clone(),
+            residual_rms_m: (residual_ss / w as f64).sqrt(),
+            termination,
             iterations: report.iterations,
         });
         apply(estimate, &base, &theta, &mut ref_params, &mut ref_effects);
@@ -286,6 +307,45 @@ mod tests {
             moved |= want < 0.9 * truth.stiffness_k();
         }
         assert!(moved, "the move should soften the screw by more than 10 %");
+    }
+
+    #[test]
+    fn a_window_without_excitation_keeps_the_last_estimate() {
+        // issue 15: K tracked on a plain ramp ran off to 1.18e16 N/m, "converged"
+        let rate = 5000.0;
+        let u = Ramp::default().generate(rate, 0.8).unwrap();
+        let out = VirtualRig::new(RigParams::default())
+            .simulate(&u, rate)
+            .unwrap();
+        let cfg = TrackConfig {
+            window: 500,
+            hop: 250,
+            ..TrackConfig::default()
+        };
+        let rows = track_greybox(
+            &u,
+            &out.position,
+            1.0 / rate,
+            &RigParams::default(),
+            &[PhysicalParameter::K],
+            &GreyboxConfig::default(),
+            &cfg,
+        )
+        .unwrap();
+        let k0 = RigParams::default().stiffness_k();
+        let mut fallbacks = 0;
+        for r in &rows {
+            // never far from a plausible stiffness
+            assert!(r.values[0] < 10.0 * k0 && r.values[0] > 0.1 * k0, "{r:?}");
+            if r.termination == Termination::Fallback {
+                fallbacks += 1;
+                assert_eq!(r.verdicts[0], Verdict::NotIdentifiable);
+                assert_eq!(r.std_errors[0], None);
+            } else {
+                assert_ne!(r.verdicts[0], Verdict::NotIdentifiable, "{r:?}");
+            }
+        }
+        assert!(fallbacks > rows.len() / 2, "{fallbacks} of {}", rows.len());
     }
 
     #[test]

@@ -81,6 +81,7 @@ pub fn identify<E: Estimator + ?Sized>(
             recording.command(),
             recording.position(),
             RESIDUAL_LAGS,
+            config.horizon,
         ),
         sliding,
         global: None,
@@ -145,10 +146,12 @@ pub struct IdentifySummary {
     /// Mean wall time per window \[µs\].
     pub per_window_us: f64,
     /// Residual analysis of the prediction errors `y − ŷ` over the predicted
-    /// samples (at most the last 200 000) against the command, lags 0 … 25
-    /// (`None` when fewer than 52 samples were predicted). The k-step errors of one horizon share the
-    /// state they were predicted from, so `r_ee` is expected to be
-    /// positive for lags below the horizon.
+    /// samples (at most the last 200 000) against the command, lags 0 … max(25, 2H)
+    /// (`None` when fewer than 52 samples were predicted). The k-step errors
+    /// of one horizon share the state they were predicted from, so `r_ee` is
+    /// positive for lags below the horizon H even for a perfect model: its
+    /// verdict `ee_inside` tests the lags H … max(25, 2H) only
+    /// ([`ResidualAnalysis::for_horizon`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residuals: Option<ResidualAnalysis>,
 }
@@ -166,6 +169,7 @@ fn prediction_residuals(
     command: &[f64],
     position: &[f64],
     max_lag: usize,
+    horizon: usize,
 ) -> Option<ResidualAnalysis> {
     let (mut u, mut e) = (Vec::new(), Vec::new());
     for k in (0..s.predicted.len()).rev() {
@@ -182,7 +186,7 @@ fn prediction_residuals(
     }
     u.reverse();
     e.reverse();
-    ResidualAnalysis::new(&u, &e, max_lag).ok()
+    ResidualAnalysis::for_horizon(&u, &e, max_lag, horizon).ok()
 }
 
 impl Identification {

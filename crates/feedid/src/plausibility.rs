@@ -119,7 +119,7 @@ pub fn check_recording(rec: &Recording) -> Vec<Warning> {
     if !moves {
         out.push(warn(
             WarningKind::CommandStill,
-            "the command never moves (range <= 1 nm): there is nothing to identify".to_string(),
+            "command never moves (range <= 1 nm): there is nothing to identify".to_string(),
         ));
     }
     // the first of these that applies: each makes the later ones meaningless

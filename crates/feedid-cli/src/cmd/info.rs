@@ -1,15 +1,14 @@
 //! `feedid info`: what a user checks before identifying.
 
 use anyhow::Result;
-use feedid::io::{read_recording, recording_info};
+use feedid::io::recording_info;
 
 use crate::args::InfoArgs;
 use crate::cmd::recording;
 
 /// Print samples, duration, rate and jitter, channel ranges and motion segments.
 pub fn run(a: &InfoArgs) -> Result<()> {
-    // the warnings are part of what info prints
-    let rec = read_recording(&a.input, &recording::read_options(&a.recording)?)?;
+    let rec = recording::load(&a.input, &a.recording)?;
     let info = recording_info(&rec);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&info)?);

@@ -99,6 +99,10 @@ impl Default for GreyboxConfig {
 /// Distance of a restart from the estimate in each log-parameter (0.2: ±22 %).
 pub const RESTART_STEP: f64 = 0.2;
 
+/// Residual rms, relative to the signal's, below which a fit counts as
+/// exact and its residuals are not tested for structure (1e-5).
+pub const EXACT_FIT: f64 = 1e-5;
+
 /// How far (in standard errors) a restarted fit may end from the estimate
 /// before the parameter is not identifiable.
 pub const RESTART_TOLERANCE_SE: f64 = 3.0;
@@ -635,13 +639,15 @@ pub fn fit_greybox(
     let mut analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
     let (rms_y, rms_i) = prob.channel_rms();
 
-    // structure left in the residuals (not measured on an exact fit)
+    // structure left in the residuals; not measured when the fit is exact to
+    // within EXACT_FIT of the signal (integration or rounding differences,
+    // which cannot bias an estimate by more than about that share)
     let mut structure = Vec::new();
-    if rms_y > 1e-9 * y_scale {
+    if rms_y > EXACT_FIT * y_scale {
         structure.extend(residual_structure("position", &r[..len]));
     }
     if let (Some(ri), true) = (rms_i, data.current.is_some()) {
-        if ri > 1e-9 * i_scale {
+        if ri > EXACT_FIT * i_scale {
             structure.extend(residual_structure("current", &r[len..]));
         }
     }

@@ -904,10 +904,13 @@ fn every_bad_parameter_file_fails_cleanly_in_every_command() {
             let out = tmp.path().join("out");
             std::fs::create_dir_all(&out).unwrap();
             let o = run(&cmd.args(&toml, &out), None);
-            // extreme but valid parameters: greybox may find that the data
-            // cannot identify Kv under them, and says so naming the recording
+            // extreme but valid parameters: those whose model is usable reach
+            // greybox's fit, which finds that the data cannot identify Kv
+            // under a vanishing gain, and says so naming the recording
             let expect = match (cmd, case.expect) {
-                (TomlCmd::GreyboxParams, Expect::SucceedsOrFails(_)) => {
+                (TomlCmd::GreyboxParams, Expect::SucceedsOrFails(_))
+                    if case.name.starts_with("tiny gain") =>
+                {
                     Expect::SucceedsOrFails(&["not identifiable", "Kv"])
                 }
                 (_, e) => e,

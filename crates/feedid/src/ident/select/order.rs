@@ -81,7 +81,7 @@ use std::str::FromStr;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::ident::arx::{fit_arx_rows, regressor};
+use crate::ident::methods::{fit_arx_rows, regressor};
 use crate::ident::{ArxConfig, ArxOrders};
 use crate::stats::InformationCriteria;
 

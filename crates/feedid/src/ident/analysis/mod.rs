@@ -1,0 +1,5 @@
+//! Analysis of the prediction errors: residual auto- and cross-correlation.
+
+mod residuals;
+
+pub use residuals::{ResidualAnalysis, Z_99};

@@ -1,0 +1,13 @@
+//! The estimator trait and what drives it: the sliding-window engine over a
+//! whole recording, the streaming engine fed one sample at a time, and
+//! batches of recordings on all cores.
+
+pub mod batch;
+mod estimator;
+mod sliding;
+pub mod stream;
+
+pub use estimator::{Estimator, Signals, WindowFit};
+pub(crate) use sliding::fit_and_predict;
+pub use sliding::{run, EngineConfig, SlidingResult, WindowIter, WindowRecord};
+pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};

@@ -198,14 +198,6 @@ pub enum Error {
         reason: &'static str,
     },
 
-    // --- plot
-    /// A figure could not be rendered.
-    #[error("cannot render figure: {reason}")]
-    Plot {
-        /// Renderer message.
-        reason: String,
-    },
-
     // --- io
     /// An error found in a recording file, with the place it was found: the
     /// wrapped error (e.g. [`Error::NonFinite`], [`Error::NonMonotoneTime`])

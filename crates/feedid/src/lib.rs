@@ -8,6 +8,9 @@
 //! file input ([`io`]); physical parameters from data ([`greybox`]) and
 //! model-based compensation of the command ([`compensate`]).
 //!
+//! Figures and HTML reports are in the separate crate `feedid-report`, so
+//! this numerical core builds without a plotting library.
+//!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
 //! Identification of Feed Drive Systems using Nonlinear Least Squares Method".
 #![cfg_attr(
@@ -24,9 +27,7 @@ pub mod greybox;
 pub mod ident;
 pub mod io;
 pub mod lti;
-pub mod plot;
 pub mod recording;
-pub mod report;
 pub mod signal;
 pub mod solve;
 pub mod stats;

@@ -3,7 +3,7 @@
 use anyhow::{bail, Result};
 use feedid::ident::MethodSpec;
 use feedid::io::write_string_atomic;
-use feedid::report::{recording_report, RecordingAnalysis, ReportOptions};
+use feedid_report::{recording_report, RecordingAnalysis, ReportOptions};
 
 use crate::args::{MethodArgs, MethodListArgs, ReportArgs};
 use crate::cmd::identify::{engine_config, method_spec};
@@ -60,13 +60,14 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         || a.input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| {
+    let analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| match e {
         // extreme but valid parameters can give no usable nominal model: say which file
-        if matches!(e.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() {
-            params_error(a.params.as_deref(), e)
-        } else {
-            e.into()
+        feedid_report::Error::Core(core)
+            if matches!(core.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() =>
+        {
+            params_error(a.params.as_deref(), core)
         }
+        other => other.into(),
     })?;
     let page = recording_report(&analysis)?;
     let html = page.to_html();

@@ -133,7 +133,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     }
     let csv = res.to_csv();
     let svg = match &a.plot {
-        Some(_) => Some(res.heat_map().to_svg()?),
+        Some(_) => Some(feedid_report::sweep_heat_map(&res).to_svg()?),
         None => None,
     };
     let mut outputs = Outputs::default();

@@ -50,8 +50,8 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::ident::engine::{run as run_engine, EngineConfig};
 use crate::ident::{ArxOrders, MethodKind, MethodSpec};
-use crate::plot::{sig3, HeatMap};
 use crate::recording::Recording;
+use crate::stats::sig3;
 use crate::stats::ErrorAccumulator;
 
 /// The paper's window \[samples\] (4 ms at 5 kHz), highlighted in comparisons.
@@ -318,7 +318,7 @@ impl SweepResult {
     }
 
     /// Distinct `(model label, horizon)` groups in row order.
-    fn groups(&self) -> Vec<(String, usize)> {
+    pub fn groups(&self) -> Vec<(String, usize)> {
         let mut g: Vec<(String, usize)> = Vec::new();
         for r in &self.rows {
             let key = (r.model_label(), r.horizon);
@@ -330,14 +330,15 @@ impl SweepResult {
     }
 
     /// Distinct windows, ascending.
-    fn window_list(&self) -> Vec<usize> {
+    pub fn window_list(&self) -> Vec<usize> {
         let mut w: Vec<usize> = self.rows.iter().map(|r| r.window).collect();
         w.sort_unstable();
         w.dedup();
         w
     }
 
-    fn horizon_list(&self) -> Vec<usize> {
+    /// Distinct horizons, ascending.
+    pub fn horizon_list(&self) -> Vec<usize> {
         let mut h: Vec<usize> = self.rows.iter().map(|r| r.horizon).collect();
         h.sort_unstable();
         h.dedup();
@@ -376,75 +377,6 @@ impl SweepResult {
             );
         }
         s
-    }
-
-    /// Heat map: one row per method/order (and horizon when several), one
-    /// column per window, colour and number = common-sample rms in µm (log
-    /// scale); the best cell of each horizon outlined.
-    pub fn heat_map(&self) -> HeatMap {
-        let windows = self.window_list();
-        let groups = self.groups();
-        let several_h = self.horizon_list().len() > 1;
-        let dt_ms = if self.rate_hz > 0.0 {
-            1e3 / self.rate_hz
-        } else {
-            0.0
-        };
-        let mut h = HeatMap::new(
-            &format!(
-                "Prediction rms error over the common samples (from {:.1} ms on)",
-                self.common_start as f64 * dt_ms
-            ),
-            "window W [samples]",
-            "method",
-            "rms error [µm] (log colour scale)",
-        );
-        h.columns = windows
-            .iter()
-            .map(|&w| {
-                if w == PAPER_WINDOW {
-                    format!("{w} (paper)")
-                } else {
-                    format!("{w}")
-                }
-            })
-            .collect();
-        h.rows = groups
-            .iter()
-            .map(|(m, hz)| {
-                if several_h {
-                    format!("{m}, H={hz}")
-                } else {
-                    m.clone()
-                }
-            })
-            .collect();
-        h.values = vec![f64::NAN; groups.len() * windows.len()];
-        for r in &self.rows {
-            let (Some(i), Some(j)) = (
-                groups
-                    .iter()
-                    .position(|g| g.0 == r.model_label() && g.1 == r.horizon),
-                windows.iter().position(|&w| w == r.window),
-            ) else {
-                continue;
-            };
-            if r.ok() {
-                h.values[i * windows.len() + j] = 1e6 * r.rms_common_m;
-            }
-        }
-        for hz in self.horizon_list() {
-            if let Some(b) = self.best_for_horizon(hz) {
-                let i = groups
-                    .iter()
-                    .position(|g| g.0 == b.model_label() && g.1 == b.horizon);
-                let j = windows.iter().position(|&w| w == b.window);
-                if let (Some(i), Some(j)) = (i, j) {
-                    h.marked.push((i, j));
-                }
-            }
-        }
-        h
     }
 
     /// Human-readable conclusion: the best combination (per horizon) and, for
@@ -623,19 +555,6 @@ mod tests {
             .iter()
             .filter(|r| r.ok())
             .all(|r| r.rms_common_m >= best.rms_common_m));
-    }
-
-    #[test]
-    fn heat_map_has_one_cell_per_combination() {
-        let res = sweep(&ramp(), &cfg(), &|_, _| {}).unwrap();
-        let h = res.heat_map();
-        // rows: paper×2 horizons + arx 2 orders × 2 horizons = 6; columns 3
-        assert_eq!(h.rows.len(), 6);
-        assert_eq!(h.columns, vec!["20 (paper)", "40", "80"]);
-        assert_eq!(h.values.len(), res.rows.len());
-        let svg = h.to_svg().unwrap();
-        assert_eq!(svg.matches("class=\"cell\"").count(), res.rows.len());
-        assert_eq!(h.marked.len(), 2, "best of each horizon");
     }
 
     #[test]

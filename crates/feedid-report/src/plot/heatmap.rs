@@ -16,7 +16,7 @@
 //! Reference: S. van der Walt, N. Smith, "mpl colormaps" (viridis), 2015.
 //!
 //! ```
-//! use feedid::plot::HeatMap;
+//! use feedid_report::plot::HeatMap;
 //! let mut h = HeatMap::new("rms error", "window W [samples]", "method", "rms [µm]");
 //! h.columns = vec!["10".into(), "20".into()];
 //! h.rows = vec!["paper".into(), "arx".into()];
@@ -29,6 +29,7 @@
 use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
+use feedid::stats::sig3;
 
 /// A heat map of `rows × columns` values.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,26 +88,6 @@ fn xml(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
-}
-
-/// A value with three significant digits (no exponent below 1e6).
-pub(crate) fn sig3(v: f64) -> String {
-    let a = v.abs();
-    if !v.is_finite() {
-        "–".to_string()
-    } else if a >= 1e6 {
-        format!("{v:.2e}")
-    } else if a >= 100.0 {
-        format!("{v:.0}")
-    } else if a >= 10.0 {
-        format!("{v:.1}")
-    } else if a >= 1.0 {
-        format!("{v:.2}")
-    } else if a >= 0.01 || a == 0.0 {
-        format!("{v:.3}")
-    } else {
-        format!("{v:.2e}")
-    }
 }
 
 /// `3.00` → `3`, `30.0` → `30`, `0.250` → `0.25` (tick labels).
@@ -170,11 +151,11 @@ impl HeatMap {
     pub fn to_svg(&self) -> Result<String> {
         let (nr, nc) = (self.rows.len(), self.columns.len());
         if self.values.len() != nr * nc {
-            return Err(Error::LengthMismatch {
+            return Err(Error::Core(feedid::Error::LengthMismatch {
                 what: "heat map values",
                 expected: nr * nc,
                 actual: self.values.len(),
-            });
+            }));
         }
         let label_w = self
             .rows

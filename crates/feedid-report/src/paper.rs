@@ -6,7 +6,7 @@
 //! ```no_run
 //! use feedid::experiment::{run_experiment, PaperExperimentConfig};
 //! use feedid::ident::{MethodKind, MethodSpec};
-//! use feedid::report::paper_report;
+//! use feedid_report::paper_report;
 //! use feedid::signal::Scenario;
 //! let cfg = PaperExperimentConfig::default();
 //! let runs = vec![run_experiment(Scenario::Ramp, &cfg).unwrap()];
@@ -14,12 +14,12 @@
 //! std::fs::write("report.html", page.to_html()).unwrap();
 //! ```
 
-use crate::drive::RigEffects;
 use crate::error::Result;
-use crate::experiment::{ExperimentResult, PaperExperimentConfig};
-use crate::ident::{EngineConfig, MethodSpec, PaperConfig};
-use crate::report::html::{Block, HtmlReport, Section, Table};
-use crate::report::recording::{RecordingAnalysis, ReportOptions};
+use crate::html::{Block, HtmlReport, Section, Table};
+use crate::recording::{RecordingAnalysis, ReportOptions};
+use feedid::drive::RigEffects;
+use feedid::experiment::{ExperimentResult, PaperExperimentConfig};
+use feedid::ident::{EngineConfig, MethodSpec, PaperConfig};
 
 /// Title of an experiment's section.
 fn experiment_title(name: &str) -> String {
@@ -44,7 +44,7 @@ pub fn paper_report(
                 solver: cfg.solver,
                 ..PaperConfig::default()
             },
-            ..MethodSpec::new(crate::ident::MethodKind::Paper)
+            ..MethodSpec::new(feedid::ident::MethodKind::Paper)
         },
         cfg.engine,
     )];
@@ -185,9 +185,9 @@ pub fn paper_report(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::run_experiment;
-    use crate::ident::{MethodKind, Solver};
-    use crate::signal::Scenario;
+    use feedid::experiment::run_experiment;
+    use feedid::ident::{MethodKind, Solver};
+    use feedid::signal::Scenario;
 
     #[test]
     fn reproduce_report_has_both_experiments_and_the_paper_table() {

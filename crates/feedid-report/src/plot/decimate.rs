@@ -20,7 +20,7 @@
 //! S. Steinarsson, *Downsampling Time Series for Visual Representation*, 2013, §3).
 //!
 //! ```
-//! use feedid::plot::decimate_minmax;
+//! use feedid_report::plot::decimate_minmax;
 //! let x: Vec<f64> = (0..10_000).map(|k| k as f64).collect();
 //! let mut y = vec![0.0; 10_000];
 //! y[4321] = 5.0; // a one-sample spike

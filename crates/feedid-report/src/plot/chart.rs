@@ -5,7 +5,7 @@
 //! plot (upper right), below it (never covering data) or none.
 //!
 //! ```
-//! use feedid::plot::{LineChart, Series};
+//! use feedid_report::plot::{LineChart, Series};
 //! let mut c = LineChart::new("Ramp", "time [ms]", "position [µm]");
 //! c.push(Series::new("measured", vec![0.0, 1.0, 2.0], vec![0.0, 1.0, 4.0]));
 //! let svg = c.to_svg().unwrap();

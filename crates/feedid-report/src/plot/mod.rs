@@ -7,5 +7,4 @@ mod heatmap;
 
 pub use chart::{palette_hex, Band, LegendPosition, LineChart, Series};
 pub use decimate::decimate_minmax;
-pub(crate) use heatmap::sig3;
 pub use heatmap::HeatMap;

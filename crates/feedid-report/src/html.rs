@@ -9,7 +9,7 @@
 //! namespace by itself) and its size made responsive.
 //!
 //! ```
-//! use feedid::report::{Block, Figure, HtmlReport, Section};
+//! use feedid_report::{Block, Figure, HtmlReport, Section};
 //! let mut page = HtmlReport::new("Report <1>");
 //! page.facts.push(("file".into(), "a&b.csv".into()));
 //! page.sections.push(Section::new("s1", "First").with(Block::Figure(Figure::new(

@@ -21,7 +21,7 @@
 //!
 //! ```
 //! use feedid::ident::{EngineConfig, MethodKind, MethodSpec};
-//! use feedid::report::{recording_report, RecordingAnalysis, ReportOptions};
+//! use feedid_report::{recording_report, RecordingAnalysis, ReportOptions};
 //! use feedid::Recording;
 //! let t: Vec<f64> = (0..400).map(|k| k as f64 * 2e-4).collect();
 //! let u: Vec<f64> = t.iter().map(|&t| if t > 0.01 { 0.05 * (t - 0.01) } else { 0.0 }).collect();
@@ -38,18 +38,18 @@
 
 use rayon::prelude::*;
 
-use crate::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
 use crate::error::Result;
-use crate::ident::{
+use crate::html::{Block, Figure, HtmlReport, Section, Table};
+use crate::plot::{decimate_minmax, Band, LegendPosition, LineChart, Series};
+use feedid::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
+use feedid::ident::{
     fit_arx, fit_oe, identify, ArxConfig, ArxOrders, EngineConfig, Identification, LinearModel,
     MethodKind, MethodSpec, OeConfig, ResidualAnalysis,
 };
-use crate::lti::{Complex, TransferFunction};
-use crate::plot::{decimate_minmax, Band, LegendPosition, LineChart, Series};
-use crate::recording::Recording;
-use crate::report::html::{Block, Figure, HtmlReport, Section, Table};
-use crate::solve::Termination;
-use crate::stats::ErrorStats;
+use feedid::lti::{Complex, TransferFunction};
+use feedid::solve::Termination;
+use feedid::stats::ErrorStats;
+use feedid::Recording;
 
 /// Palette colours of the methods (0 = measurement, 5 = simulation model, 8 = command).
 const METHOD_COLORS: [usize; 6] = [1, 2, 3, 4, 6, 7];
@@ -1215,8 +1215,8 @@ pub fn recording_report(a: &RecordingAnalysis) -> Result<HtmlReport> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::drive::VirtualRig;
-    use crate::signal::Scenario;
+    use feedid::drive::VirtualRig;
+    use feedid::signal::Scenario;
 
     fn ramp() -> Recording {
         let cmd = Scenario::Ramp.command(5000.0, 0.2, 1).unwrap();

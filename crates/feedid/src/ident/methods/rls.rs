@@ -82,7 +82,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::methods::arx::{check_window, poles_inside, predict_horizon};
+use crate::ident::methods::regressor::{check_window, poles_inside, predict_horizon};
 use crate::ident::{ArxOrders, Estimator, Signals, WindowFit};
 use crate::solve::Termination;
 
@@ -648,7 +648,7 @@ impl Estimator for RlsEstimator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ident::methods::arx::regressor;
+    use crate::ident::methods::regressor::regressor;
     use nalgebra::{DMatrix, DVector};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;

@@ -81,7 +81,7 @@ use nalgebra::{Complex, DMatrix};
 use super::companion::{is_hurwitz, output, reflect_unstable, Companion, MAX_ORDER};
 use super::srivc::srivc;
 use crate::error::{Error, Result};
-use crate::ident::methods::arx::check_window;
+use crate::ident::methods::regressor::check_window;
 use crate::ident::{Estimator, LinearModel, Signals, WindowFit};
 use crate::lti::TransferFunction;
 use crate::solve::{

@@ -31,7 +31,7 @@ fn row(name: &str, s: &Signals<'_>) -> feedid::Result<String> {
             warm_up: 0,
         };
         let r = engine::run(&mut est, s, &cfg)?;
-        let cov = 100.0 * r.stats.samples as f64 / s.time.len() as f64;
+        let cov = 100.0 * r.stats.samples as f64 / s.len() as f64;
         line += &format!(
             " {:.3} / {:.2} ({:.0} %) |",
             r.stats.rms * 1e6,

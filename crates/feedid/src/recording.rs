@@ -18,7 +18,6 @@
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::ident::Signals;
 
 /// Default relative tolerance on sampling-interval deviation (1 %).
 pub const DEFAULT_JITTER_TOLERANCE: f64 = 0.01;
@@ -266,17 +265,6 @@ impl Recording {
                 }
             })
             .collect()
-    }
-
-    /// The whole recording as an estimator view.
-    pub fn signals(&self) -> Signals<'_> {
-        Signals::new(
-            &self.time,
-            &self.command,
-            &self.position,
-            self.dt,
-            self.motion_start_time(),
-        )
     }
 }
 

@@ -4,70 +4,8 @@
 use std::ops::Range;
 
 use crate::error::Result;
+use crate::ident::Signals;
 use crate::solve::Termination;
-
-/// Read-only view of the signals an estimator may use.
-///
-/// Indices passed to estimators are *absolute* sample indices of the whole
-/// recording; element 0 of the slices here is sample `offset`. Batch
-/// processing uses `offset = 0`; the streaming path passes a moving buffer with
-/// a growing offset. Always go through [`Signals::time`],
-/// [`Signals::command`] and [`Signals::position`].
-#[derive(Debug, Clone, Copy)]
-pub struct Signals<'a> {
-    /// Absolute index of element 0 of the slices.
-    pub offset: usize,
-    /// Time stamps \[s\].
-    pub time: &'a [f64],
-    /// Command (set-point) position \[m\].
-    pub command: &'a [f64],
-    /// Measured position \[m\].
-    pub position: &'a [f64],
-    /// Nominal sample interval \[s\].
-    pub dt: f64,
-    /// Time at which motion starts \[s\] (the paper's time origin).
-    pub motion_start: f64,
-}
-
-impl<'a> Signals<'a> {
-    /// A view of whole arrays (offset 0).
-    pub fn new(
-        time: &'a [f64],
-        command: &'a [f64],
-        position: &'a [f64],
-        dt: f64,
-        motion_start: f64,
-    ) -> Self {
-        Self {
-            offset: 0,
-            time,
-            command,
-            position,
-            dt,
-            motion_start,
-        }
-    }
-
-    /// First absolute index past the available data.
-    pub fn end(&self) -> usize {
-        self.offset + self.time.len()
-    }
-
-    /// Time stamps for absolute indices `r`.
-    pub fn time(&self, r: Range<usize>) -> &'a [f64] {
-        &self.time[r.start - self.offset..r.end - self.offset]
-    }
-
-    /// Command for absolute indices `r`.
-    pub fn command(&self, r: Range<usize>) -> &'a [f64] {
-        &self.command[r.start - self.offset..r.end - self.offset]
-    }
-
-    /// Measured position for absolute indices `r`.
-    pub fn position(&self, r: Range<usize>) -> &'a [f64] {
-        &self.position[r.start - self.offset..r.end - self.offset]
-    }
-}
 
 /// Outcome of fitting one window.
 #[derive(Debug, Clone, Copy, PartialEq)]

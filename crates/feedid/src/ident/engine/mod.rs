@@ -4,10 +4,12 @@
 
 pub mod batch;
 mod estimator;
+mod signals;
 mod sliding;
 pub mod stream;
 
-pub use estimator::{Estimator, Signals, WindowFit};
+pub use estimator::{Estimator, WindowFit};
+pub use signals::{Samples, Signals};
 pub(crate) use sliding::fit_and_predict;
 pub use sliding::{run, EngineConfig, SlidingResult, WindowIter, WindowRecord};
 pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};

@@ -23,7 +23,7 @@
 //!         Ok(WindowFit { residual_rms: 0.0, iterations: 0, termination: Termination::Exact })
 //!     }
 //!     fn predict(&mut self, s: &Signals<'_>, w: std::ops::Range<usize>, _: std::ops::Range<usize>, out: &mut [f64]) -> feedid::Result<()> {
-//!         out.fill(s.position(w.end - 1..w.end)[0]);
+//!         out.fill(s.window(w.end - 1..w.end, 0, "hold")?.position[0]);
 //!         Ok(())
 //!     }
 //! }
@@ -219,14 +219,8 @@ pub fn run<E: Estimator + ?Sized>(
     signals: &Signals<'_>,
     config: &EngineConfig,
 ) -> Result<SlidingResult> {
-    let n = signals.time.len();
-    if signals.command.len() != n || signals.position.len() != n {
-        return Err(Error::LengthMismatch {
-            what: "signals",
-            expected: n,
-            actual: signals.command.len().min(signals.position.len()),
-        });
-    }
+    signals.check_lengths()?;
+    let n = signals.len();
     let est_warm = estimator.warm_up();
     config.validate(n, est_warm)?;
     let names = estimator.coefficient_names();
@@ -258,9 +252,10 @@ pub fn run<E: Estimator + ?Sized>(
     let elapsed = start.elapsed();
 
     let mut acc = ErrorAccumulator::default();
+    let y = signals.all().position;
     for k in 0..n {
         if has_prediction[k] {
-            acc.push(signals.position[k], predicted[k]);
+            acc.push(y[k], predicted[k]);
         }
     }
     Ok(SlidingResult {
@@ -337,7 +332,7 @@ mod tests {
         }
         fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, coef: &mut [f64]) -> Result<WindowFit> {
             self.calls += 1;
-            let y = s.position(w.end - 2..w.end);
+            let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             coef[0] = y[1];
             coef[1] = y[1] - y[0];
             Ok(WindowFit {
@@ -353,7 +348,7 @@ mod tests {
             h: Range<usize>,
             out: &mut [f64],
         ) -> Result<()> {
-            let y = s.position(w.end - 2..w.end);
+            let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             assert_eq!(h.start, w.end);
             for (j, o) in out.iter_mut().enumerate() {
                 *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);

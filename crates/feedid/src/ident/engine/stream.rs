@@ -442,14 +442,14 @@ impl<E: Estimator> Streamer<E> {
         }
         u[nc - off..end - off].fill(f64::NAN);
         y[np - off..end - off].fill(f64::NAN);
-        let signals = Signals {
-            offset: off,
-            time: &t[..end - off],
-            command: &u[..end - off],
-            position: &y[..end - off],
+        let signals = Signals::with_offset(
+            off,
+            &t[..end - off],
+            &u[..end - off],
+            &y[..end - off],
             dt,
-            motion_start: *motion_start,
-        };
+            *motion_start,
+        );
         let out = &mut pred[..he - we];
         coef.fill(0.0);
         let fit = fit_and_predict(est, &signals, &(s..we), &(we..he), coef, out);
@@ -628,7 +628,7 @@ mod tests {
             false
         }
         fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, c: &mut [f64]) -> Result<WindowFit> {
-            let y = s.position(w.end - 2..w.end);
+            let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             c[0] = y[1];
             c[1] = y[1] - y[0];
             Ok(WindowFit {
@@ -644,7 +644,7 @@ mod tests {
             _: Range<usize>,
             out: &mut [f64],
         ) -> Result<()> {
-            let y = s.position(w.end - 2..w.end);
+            let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             for (j, o) in out.iter_mut().enumerate() {
                 *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);
             }
@@ -676,8 +676,8 @@ mod tests {
             if self.k % 7 == 0 {
                 return Err(Error::Singular { context: "test" });
             }
-            let u = s.command(w.start - 1..w.end);
-            let y = s.position(w.start - 1..w.end);
+            let u = s.window(w.start - 1..w.end, 0, "test").unwrap().command;
+            let y = s.window(w.start - 1..w.end, 0, "test").unwrap().position;
             let du = u[u.len() - 1] - u[0];
             c[0] = if du != 0.0 {
                 (y[y.len() - 1] - y[0]) / du
@@ -697,9 +697,9 @@ mod tests {
             h: Range<usize>,
             out: &mut [f64],
         ) -> Result<()> {
-            let y0 = s.position(w.end - 1..w.end)[0];
-            let u0 = s.command(w.end - 1..w.end)[0];
-            for (o, &u) in out.iter_mut().zip(s.command(h)) {
+            let y0 = s.window(w.end - 1..w.end, 0, "test").unwrap().position[0];
+            let u0 = s.window(w.end - 1..w.end, 0, "test").unwrap().command[0];
+            for (o, &u) in out.iter_mut().zip(s.window(h, 0, "test").unwrap().command) {
                 *o = y0 + (u - u0);
             }
             Ok(())

@@ -65,7 +65,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::{ArxOrders, Estimator, RlsConfig, RlsEstimator, Signals, WindowFit};
+use crate::ident::{ArxOrders, Estimator, RlsConfig, RlsEstimator, Samples, Signals, WindowFit};
 use crate::solve::Termination;
 
 /// Settings of the `auto` method.
@@ -253,10 +253,10 @@ impl AutoEstimator {
             if slot.pending_len == 0 {
                 continue;
             }
-            let from = slot.pending_start.max(signals.offset);
+            let from = slot.pending_start.max(signals.offset());
             let to = (slot.pending_start + slot.pending_len).min(end);
-            if to > from {
-                let y = signals.position(from..to);
+            if let (true, Ok(w)) = (to > from, signals.window(from..to, 0, "auto scoring")) {
+                let y = w.position;
                 let p = &slot.pending[from - slot.pending_start..to - slot.pending_start];
                 let mse = y.iter().zip(p).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()
                     / (to - from) as f64;
@@ -279,16 +279,16 @@ impl AutoEstimator {
     }
 }
 
-/// The window must be non-empty and inside the available data.
-fn check_window(signals: &Signals<'_>, window: &Range<usize>) -> Result<()> {
-    if window.is_empty() || window.end > signals.end() || window.start < signals.offset {
+/// The window's samples: non-empty and inside the available data.
+fn window_samples<'a>(signals: &Signals<'a>, window: &Range<usize>) -> Result<Samples<'a>> {
+    if window.is_empty() {
         return Err(Error::TooFewSamples {
             what: "auto window",
-            needed: window.end.max(signals.offset + 1),
+            needed: window.end.max(signals.offset() + 1),
             actual: signals.end(),
         });
     }
-    Ok(())
+    signals.window(window.clone(), 0, "auto window")
 }
 
 impl Estimator for AutoEstimator {
@@ -332,7 +332,7 @@ impl Estimator for AutoEstimator {
         window: Range<usize>,
         coef: &mut [f64],
     ) -> Result<WindowFit> {
-        check_window(signals, &window)?;
+        window_samples(signals, &window)?;
         self.score_pending(signals, window.end);
         let mut residual = [0.0; 3];
         for (i, slot) in self.slots.iter_mut().enumerate() {
@@ -404,9 +404,12 @@ impl Estimator for AutoEstimator {
         horizon: Range<usize>,
         out: &mut [f64],
     ) -> Result<()> {
-        check_window(signals, &window)?;
+        let w = window_samples(signals, &window)?;
         let h = out.len();
-        let last = signals.position(window.end - 1..window.end)[0];
+        let (last, u_last) = (
+            w.position[w.position.len() - 1],
+            w.command[w.command.len() - 1],
+        );
         for slot in &mut self.slots {
             slot.pending_len = 0;
             if !slot.ok {
@@ -431,16 +434,14 @@ impl Estimator for AutoEstimator {
             }
         }
         // command excursion over the horizon
-        let u_last = signals.command(window.end - 1..window.end)[0];
         let hu = horizon.end.min(signals.end());
-        let excursion = if hu > horizon.start {
-            signals
-                .command(horizon.start..hu)
+        let excursion = match signals.window(horizon.start..hu, 0, "auto horizon") {
+            Ok(hz) => hz
+                .command
                 .iter()
                 .map(|u| (u - u_last).abs())
-                .fold(0.0, f64::max)
-        } else {
-            0.0
+                .fold(0.0, f64::max),
+            Err(_) => 0.0,
         };
         self.pending_excursion = if excursion.is_finite() {
             excursion

@@ -214,26 +214,6 @@ pub(crate) fn dc_gain(orders: &ArxOrders, theta: &[f64]) -> f64 {
     sb / sa
 }
 
-/// Check the signals cover `r` (absolute indices) with `lag` samples before it.
-pub(crate) fn check_window(signals: &Signals<'_>, r: &Range<usize>, lag: usize) -> Result<()> {
-    let n = signals.time.len();
-    if signals.command.len() != n || signals.position.len() != n {
-        return Err(Error::LengthMismatch {
-            what: "signals",
-            expected: n,
-            actual: signals.command.len().min(signals.position.len()),
-        });
-    }
-    if r.start > r.end || r.end > signals.end() || r.start < signals.offset + lag {
-        return Err(Error::TooFewSamples {
-            what: "ARX window (past samples + window)",
-            needed: r.end.max(signals.offset + lag + r.len()),
-            actual: signals.end(),
-        });
-    }
-    Ok(())
-}
-
 /// k-step-ahead prediction of an ARX model over `horizon` (which starts at
 /// `window.end`): the past from the measurements, the future command known,
 /// predicted outputs fed back. Shared by [`ArxEstimator`] and the RLS estimator.
@@ -257,10 +237,14 @@ pub(crate) fn predict_horizon(
         });
     }
     let lag = orders.lag().max(1);
-    check_window(signals, &(window.end..horizon.end), lag)?;
-    let base = window.end - lag;
-    let y = signals.position(base..window.end);
-    let u = signals.command(base..horizon.end);
+    let w = signals.window(
+        window.end..horizon.end,
+        lag,
+        "ARX window (past samples + window)",
+    )?;
+    let base = w.start;
+    let y = &w.position[..window.end - base];
+    let u = w.command;
     let need = orders.na + out.len();
     if past.len() < need {
         past.resize(need, 0.0);

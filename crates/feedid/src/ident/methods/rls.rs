@@ -82,7 +82,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::methods::regressor::{check_window, poles_inside, predict_horizon};
+use crate::ident::methods::regressor::{poles_inside, predict_horizon};
 use crate::ident::{ArxOrders, Estimator, Signals, WindowFit};
 use crate::solve::Termination;
 
@@ -523,8 +523,8 @@ impl Estimator for RlsEstimator {
         coef: &mut [f64],
     ) -> Result<WindowFit> {
         let lag = self.config.orders.lag().max(1);
-        check_window(signals, &window, lag)?;
-        let first = signals.offset + lag;
+        signals.window(window.clone(), lag, "ARX window (past samples + window)")?;
+        let first = signals.offset() + lag;
         let mut cursor = self.cursor.unwrap_or(window.start.max(first));
         if cursor > window.end || cursor < first {
             self.reset();
@@ -532,9 +532,9 @@ impl Estimator for RlsEstimator {
         }
         // the finite window needs the samples it removes: reach back W samples
         let reach = self.config.window.unwrap_or(0);
-        let base = cursor.saturating_sub(reach + lag).max(signals.offset);
-        let y = signals.position(base..window.end);
-        let u = signals.command(base..window.end);
+        let base = cursor.saturating_sub(reach + lag).max(signals.offset());
+        let w = signals.window(base..window.end, 0, "ARX window (past samples + window)")?;
+        let (y, u) = (w.position, w.command);
         if let Some(i) = y.iter().chain(u).position(|v| !v.is_finite()) {
             let ch = if i < y.len() { "position" } else { "command" };
             return Err(Error::NonFinite {

@@ -17,9 +17,7 @@ use serde::Serialize;
 use super::config::ArxConfig;
 use super::factor::SlidingFactor;
 use crate::error::{Error, Result};
-use crate::ident::methods::regressor::{
-    check_window, dc_gain, poles_inside, predict_horizon, MAX_ARX_ORDER,
-};
+use crate::ident::methods::regressor::{dc_gain, poles_inside, predict_horizon, MAX_ARX_ORDER};
 use crate::ident::{Estimator, LinearModel, Signals, WindowFit};
 use crate::solve::{lstsq_in_place, LstsqOptions, QrWorkspace, Termination};
 
@@ -170,7 +168,7 @@ impl Estimator for ArxEstimator {
         let orders = self.config.orders;
         let n = orders.n_params();
         let lag = orders.lag();
-        check_window(signals, &window, lag)?;
+        signals.window(window.clone(), lag, "ARX window (past samples + window)")?;
         if window.is_empty() {
             return Err(Error::TooFewSamples {
                 what: "ARX window",
@@ -183,14 +181,14 @@ impl Estimator for ArxEstimator {
         let mut base = window.start - lag;
         if self.factor.valid {
             let old = self.factor.rows.start;
-            if old < window.start && old >= signals.offset + lag {
+            if old < window.start && old >= signals.offset() + lag {
                 base = base.min(old - lag);
             } else if old < window.start {
                 self.factor.valid = false;
             }
         }
-        let y = signals.position(base..window.end);
-        let u = signals.command(base..window.end);
+        let w = signals.window(base..window.end, 0, "ARX window (past samples + window)")?;
+        let (y, u) = (w.position, w.command);
         if let Some(i) = y.iter().chain(u).position(|v| !v.is_finite()) {
             let ch = if i < y.len() { "position" } else { "command" };
             return Err(Error::NonFinite {

@@ -81,7 +81,6 @@ use nalgebra::{Complex, DMatrix};
 use super::companion::{is_hurwitz, output, reflect_unstable, Companion, MAX_ORDER};
 use super::srivc::srivc;
 use crate::error::{Error, Result};
-use crate::ident::methods::regressor::check_window;
 use crate::ident::{Estimator, LinearModel, Signals, WindowFit};
 use crate::lti::TransferFunction;
 use crate::solve::{
@@ -773,18 +772,18 @@ impl Estimator for OeEstimator {
             });
         }
         // lengths of the signals, and the window inside them (not reversed)
-        check_window(signals, &window, 0)?;
-        let u = signals.command(window.clone());
-        let y = signals.position(window.clone());
+        let w = signals.window(window.clone(), 0, "oe window")?;
+        let (u, y) = (w.command, w.position);
         let w = u.len();
-        check_signals(u, y, signals.dt, p + n + 2)?;
+        check_signals(u, y, signals.dt(), p + n + 2)?;
         self.last_window = None;
-        let first = self.structure.is_none() || (self.dt - signals.dt).abs() > 1e-12 * signals.dt;
+        let first =
+            self.structure.is_none() || (self.dt - signals.dt()).abs() > 1e-12 * signals.dt();
         if first {
-            let (st, theta, _) = initial_estimate(u, y, signals.dt, &self.config)?;
+            let (st, theta, _) = initial_estimate(u, y, signals.dt(), &self.config)?;
             self.theta.copy_from_slice(&theta);
             self.structure = Some(st);
-            self.dt = signals.dt;
+            self.dt = signals.dt();
         }
         let Some(st) = self.structure else {
             return Err(Error::InvalidModel {
@@ -895,8 +894,7 @@ impl Estimator for OeEstimator {
                 actual: out.len(),
             });
         }
-        if horizon.start != window.end || horizon.start > horizon.end || horizon.end > signals.end()
-        {
+        if horizon.start != window.end {
             return Err(Error::TooFewSamples {
                 what: "oe horizon after the window",
                 needed: horizon.end,
@@ -904,7 +902,9 @@ impl Estimator for OeEstimator {
             });
         }
         let n = self.config.poles;
-        let u = signals.command(horizon);
+        let u = signals
+            .window(horizon, 0, "oe horizon after the window")?
+            .command;
         // the discretisation of the last fit is still in the workspace
         self.work.x.copy_from_slice(&self.x_end);
         for (o, &uk) in out.iter_mut().zip(u) {

@@ -196,17 +196,17 @@ impl PaperConfig {
         signals: &Signals<'_>,
         config: &crate::ident::EngineConfig,
     ) -> f64 {
-        let n = signals.time.len();
+        let time = signals.all().time;
         let mut worst = 1.0f64;
-        for (w, _) in config.windows(n, 0) {
+        for (w, _) in config.windows(time.len(), 0) {
             let (Some(&first), Some(&last)) = (
-                signals.time.get(w.start),
-                w.end.checked_sub(1).and_then(|e| signals.time.get(e)),
+                time.get(w.start),
+                w.end.checked_sub(1).and_then(|e| time.get(e)),
             ) else {
                 continue;
             };
             let origin = match self.time_origin {
-                TimeOrigin::Motion => signals.motion_start,
+                TimeOrigin::Motion => signals.motion_start(),
                 TimeOrigin::Window => first,
             };
             worst = worst.max(shift_amplification(first - origin, last - origin));

@@ -195,37 +195,6 @@ impl PaperMethod {
     }
 }
 
-/// Check that the signals cover `r` and the channels have equal lengths.
-pub(super) fn check_range(
-    signals: &Signals<'_>,
-    r: &Range<usize>,
-    what: &'static str,
-) -> Result<()> {
-    let n = signals.time.len();
-    if signals.command.len() != n {
-        return Err(Error::LengthMismatch {
-            what: "command",
-            expected: n,
-            actual: signals.command.len(),
-        });
-    }
-    if signals.position.len() != n {
-        return Err(Error::LengthMismatch {
-            what: "position",
-            expected: n,
-            actual: signals.position.len(),
-        });
-    }
-    if r.start < signals.offset || r.end > signals.end() || r.start > r.end {
-        return Err(Error::TooFewSamples {
-            what,
-            needed: r.end,
-            actual: signals.end(),
-        });
-    }
-    Ok(())
-}
-
 pub(super) fn first_non_finite(v: &[f64], offset: usize, channel: &str) -> Result<()> {
     match v.iter().position(|x| !x.is_finite()) {
         Some(i) => Err(Error::NonFinite {
@@ -271,7 +240,6 @@ impl Estimator for PaperMethod {
                 actual: coef.len(),
             });
         }
-        check_range(signals, &window, "paper window")?;
         let w = window.len();
         if w < NQ {
             return Err(Error::TooFewSamples {
@@ -280,13 +248,12 @@ impl Estimator for PaperMethod {
                 actual: w,
             });
         }
-        let time = signals.time(window.clone());
-        let pos = signals.position(window.clone());
-        let cmd = signals.command(window.clone());
+        let samples = signals.window(window.clone(), 0, "paper window")?;
+        let (time, pos, cmd) = (samples.time, samples.position, samples.command);
         first_non_finite(time, window.start, "time")?;
         first_non_finite(pos, window.start, "position")?;
         first_non_finite(cmd, window.start, "command")?;
-        if self.config.time_origin == TimeOrigin::Motion && time[w - 1] <= signals.motion_start {
+        if self.config.time_origin == TimeOrigin::Motion && time[w - 1] <= signals.motion_start() {
             return Ok(self.rest_window(pos, coef));
         }
         self.rest_hold = None;
@@ -306,11 +273,11 @@ impl Estimator for PaperMethod {
                 // starts in motion (no sample at or before the motion start),
                 // positions are taken as given.
                 let y_ref = *self.reference.get_or_insert_with(|| {
-                    signals
-                        .time
+                    let all = signals.all();
+                    all.time
                         .iter()
-                        .rposition(|&t| t <= signals.motion_start)
-                        .map_or(0.0, |k| signals.position[k])
+                        .rposition(|&t| t <= signals.motion_start())
+                        .map_or(0.0, |k| all.position[k])
                 });
                 (y_ref, 0.0)
             }
@@ -318,7 +285,7 @@ impl Estimator for PaperMethod {
 
         // --- time scaling
         let origin = match self.config.time_origin {
-            TimeOrigin::Motion => signals.motion_start,
+            TimeOrigin::Motion => signals.motion_start(),
             TimeOrigin::Window => time[0],
         };
         if !origin.is_finite() {
@@ -548,7 +515,7 @@ impl Estimator for PaperMethod {
                 actual: out.len(),
             });
         }
-        check_range(signals, &horizon, "paper horizon")?;
+        let hz = signals.window(horizon.clone(), 0, "paper horizon")?;
         if let Some(hold) = self.rest_hold {
             out.fill(hold);
             return Ok(());
@@ -556,7 +523,7 @@ impl Estimator for PaperMethod {
         let fit = self.last.ok_or(Error::InvalidModel {
             reason: "paper: predict called before a successful fit",
         })?;
-        let time = signals.time(horizon.clone());
+        let time = hz.time;
         for (o, &t) in out.iter_mut().zip(time) {
             *o = fit.y_ref + Self::eval_output(&fit, t);
         }
@@ -566,11 +533,12 @@ impl Estimator for PaperMethod {
                 self.du.resize(h, 0.0);
                 self.ysim.resize(h, 0.0);
             }
-            let cmd = signals.command(horizon.clone());
+            let cmd = hz.command;
             for ((d, &u), &t) in self.du.iter_mut().zip(cmd).zip(time) {
                 *d = u - fit.u_ref - Self::eval_input(&fit, t);
             }
-            let ok = tf_response(&fit.coef, signals.dt, &self.du[..h], &mut self.ysim[..h]).is_ok()
+            let ok = tf_response(&fit.coef, signals.dt(), &self.du[..h], &mut self.ysim[..h])
+                .is_ok()
                 && out
                     .iter()
                     .zip(&self.ysim[..h])

@@ -690,11 +690,7 @@ fn signals_with_offset_are_indexed_absolutely() {
     let (p, q) = balanced(0.004);
     let d = model_data(&p, &q, 0.0, 0.0, 60);
     let full = d.signals(0.0);
-    let mut view = full;
-    view.offset = 30;
-    view.time = &d.t[30..];
-    view.command = &d.u[30..];
-    view.position = &d.y[30..];
+    let view = Signals::with_offset(30, &d.t[30..], &d.u[30..], &d.y[30..], DT, 0.0);
     let mut a = method(Solver::Qr, TimeOrigin::Motion);
     let mut b = method(Solver::Qr, TimeOrigin::Motion);
     let (ca, _) = fit(&mut a, &full, 35..55);

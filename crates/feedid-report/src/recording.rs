@@ -44,10 +44,10 @@ use crate::plot::{decimate_minmax, Band, LegendPosition, LineChart, Series};
 use feedid::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
 use feedid::ident::{
     fit_arx, fit_oe, identify, ArxConfig, ArxOrders, EngineConfig, Identification, LinearModel,
-    MethodKind, MethodSpec, OeConfig, ResidualAnalysis,
+    MethodKind, MethodSpec, OeConfig, ResidualAnalysis, WindowOutcome,
 };
 use feedid::lti::{Complex, TransferFunction};
-use feedid::solve::Termination;
+
 use feedid::stats::ErrorStats;
 use feedid::Recording;
 
@@ -732,7 +732,7 @@ impl RecordingAnalysis {
         for (k, &j) in idx.iter().enumerate() {
             let vals: Vec<f64> = (0..s.windows.len())
                 .map(|w| {
-                    if s.windows[w].fit.termination == Termination::Failed {
+                    if s.windows[w].outcome == WindowOutcome::Failed {
                         f64::NAN
                     } else {
                         s.window_coefficients(w)[j]

@@ -191,13 +191,6 @@ pub enum Error {
         iterations: usize,
     },
 
-    /// A method declined to predict (its model is not validated for this horizon).
-    #[error("prediction withheld: {reason}")]
-    PredictionWithheld {
-        /// Why.
-        reason: &'static str,
-    },
-
     // --- io
     /// An error found in a recording file, with the place it was found: the
     /// wrapped error (e.g. [`Error::NonFinite`], [`Error::NonMonotoneTime`])

@@ -20,9 +20,8 @@ use serde::Serialize;
 use crate::drive::{simulate_nominal, RigParams};
 use crate::error::Result;
 use crate::ident::engine::{run as run_engine, EngineConfig, SlidingResult};
-use crate::ident::{Estimator, ModelFile, ResidualAnalysis};
+use crate::ident::{Estimator, ModelFile, ResidualAnalysis, WindowOutcome};
 use crate::recording::Recording;
-use crate::solve::Termination;
 use crate::stats::ErrorStats;
 
 /// The outcome of identifying one recording.
@@ -192,7 +191,7 @@ impl Identification {
         let fallback = s
             .windows
             .iter()
-            .filter(|w| w.fit.termination == Termination::Fallback)
+            .filter(|w| w.outcome == WindowOutcome::Fallback)
             .count();
         IdentifySummary {
             method: s.method.to_string(),

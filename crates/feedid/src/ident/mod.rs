@@ -19,8 +19,8 @@ mod select;
 
 pub use analysis::{ResidualAnalysis, Z_99};
 pub use engine::{
-    batch, stream, EngineConfig, Estimator, Prediction, Samples, Signals, SlidingResult,
-    StreamOptions, StreamStats, Streamer, WindowFit, WindowRecord,
+    batch, stream, EngineConfig, Estimator, FitStatus, PredictStatus, Prediction, Samples, Signals,
+    SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit, WindowOutcome, WindowRecord,
 };
 pub use identify::{identify, Identification, IdentifySummary, RESIDUAL_LAGS};
 pub use method::{MethodKind, MethodSpec, METHOD_NAMES};

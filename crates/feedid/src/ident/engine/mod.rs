@@ -8,7 +8,7 @@ mod signals;
 mod sliding;
 pub mod stream;
 
-pub use estimator::{Estimator, WindowFit};
+pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
 pub use signals::{Samples, Signals};
 pub(crate) use sliding::fit_and_predict;
 pub use sliding::{run, EngineConfig, SlidingResult, WindowIter, WindowRecord};

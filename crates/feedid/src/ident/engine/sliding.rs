@@ -7,12 +7,15 @@
 //! sample after the first window is predicted exactly once; with `hop < H`
 //! horizons overlap and the most recent prediction of a sample is kept.
 //!
-//! A window whose fit or prediction fails (singular problem, non-finite
-//! result) gives no prediction and is recorded with
-//! [`Termination::Failed`]; no NaN ever reaches the prediction series.
+//! Each window ends with a [`WindowOutcome`] — predicted (with the
+//! solver's termination), fallback (the last good model predicted),
+//! withheld by the method, or failed — a value, apart from how a solver
+//! stopped. A window whose fit or prediction fails (singular problem,
+//! non-finite result) gives no prediction and is recorded as
+//! [`WindowOutcome::Failed`]; no NaN ever reaches the prediction series.
 //!
 //! ```
-//! # use feedid::ident::{engine::{run, EngineConfig}, Estimator, Signals, WindowFit};
+//! # use feedid::ident::{engine::{run, EngineConfig}, Estimator, PredictStatus, Signals, WindowFit};
 //! # use feedid::solve::Termination;
 //! /// Predicts the last measured value (a "hold" estimator).
 //! struct Hold;
@@ -20,11 +23,11 @@
 //!     fn name(&self) -> &'static str { "hold" }
 //!     fn coefficient_names(&self) -> Vec<String> { vec![] }
 //!     fn fit(&mut self, _: &Signals<'_>, _: std::ops::Range<usize>, _: &mut [f64]) -> feedid::Result<WindowFit> {
-//!         Ok(WindowFit { residual_rms: 0.0, iterations: 0, termination: Termination::Exact })
+//!         Ok(WindowFit::identified(0.0, 0, Termination::Exact))
 //!     }
-//!     fn predict(&mut self, s: &Signals<'_>, w: std::ops::Range<usize>, _: std::ops::Range<usize>, out: &mut [f64]) -> feedid::Result<()> {
+//!     fn predict(&mut self, s: &Signals<'_>, w: std::ops::Range<usize>, _: std::ops::Range<usize>, out: &mut [f64]) -> feedid::Result<PredictStatus> {
 //!         out.fill(s.window(w.end - 1..w.end, 0, "hold")?.position[0]);
-//!         Ok(())
+//!         Ok(PredictStatus::Predicted)
 //!     }
 //! }
 //! let t: Vec<f64> = (0..100).map(|k| k as f64 * 1e-3).collect();
@@ -38,8 +41,7 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, Signals, WindowFit};
-use crate::solve::Termination;
+use crate::ident::{Estimator, PredictStatus, Signals, WindowOutcome};
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
 /// Sliding-window settings.
@@ -147,8 +149,12 @@ pub struct WindowRecord {
     pub window: Range<usize>,
     /// Samples predicted.
     pub horizon: Range<usize>,
-    /// Fit outcome (`Termination::Failed` if the fit or prediction failed).
-    pub fit: WindowFit,
+    /// RMS of the fit residual over the window \[m\] (0 if the fit failed).
+    pub residual_rms: f64,
+    /// Solver iterations (0 if the fit or the prediction failed).
+    pub iterations: usize,
+    /// What became of the window.
+    pub outcome: WindowOutcome,
 }
 
 /// Everything a sliding run produces.
@@ -191,7 +197,7 @@ impl SlidingResult {
     pub fn failed_windows(&self) -> usize {
         self.windows
             .iter()
-            .filter(|w| w.fit.termination == Termination::Failed)
+            .filter(|w| w.outcome == WindowOutcome::Failed)
             .count()
     }
 
@@ -199,7 +205,7 @@ impl SlidingResult {
     pub fn withheld_windows(&self) -> usize {
         self.windows
             .iter()
-            .filter(|w| w.fit.termination == Termination::Withheld)
+            .filter(|w| w.outcome == WindowOutcome::Withheld)
             .count()
     }
 
@@ -238,16 +244,12 @@ pub fn run<E: Estimator + ?Sized>(
     for (w, (window, horizon)) in config.windows(n, est_warm).enumerate() {
         let coef = &mut coefficients[w * nc..(w + 1) * nc];
         let out = &mut buf[..horizon.len()];
-        let fit = fit_and_predict(estimator, signals, &window, &horizon, coef, out);
-        if fit.termination.predicted() {
-            predicted[horizon.clone()].copy_from_slice(out);
-            has_prediction[horizon.clone()].fill(true);
+        let record = fit_and_predict(estimator, signals, window, horizon, coef, out);
+        if record.outcome.predicted() {
+            predicted[record.horizon.clone()].copy_from_slice(out);
+            has_prediction[record.horizon.clone()].fill(true);
         }
-        windows.push(WindowRecord {
-            window,
-            horizon,
-            fit,
-        });
+        windows.push(record);
     }
     let elapsed = start.elapsed();
 
@@ -273,49 +275,57 @@ pub fn run<E: Estimator + ?Sized>(
 /// Fit one window and predict its horizon into `out`, the one place where
 /// the outcome is decided for the batch engine and the streaming path: a
 /// prediction counts only if it is finite; a withheld prediction is
-/// [`Termination::Withheld`], any other failure [`Termination::Failed`];
-/// non-finite coefficients are zeroed.
+/// [`WindowOutcome::Withheld`], an error or a non-finite prediction
+/// [`WindowOutcome::Failed`]; non-finite coefficients are zeroed.
 pub(crate) fn fit_and_predict<E: Estimator + ?Sized>(
     estimator: &mut E,
     signals: &Signals<'_>,
-    window: &Range<usize>,
-    horizon: &Range<usize>,
+    window: Range<usize>,
+    horizon: Range<usize>,
     coef: &mut [f64],
     out: &mut [f64],
-) -> WindowFit {
-    let fit = match estimator.fit(signals, window.clone(), coef) {
+) -> WindowRecord {
+    let (residual_rms, iterations, outcome) = match estimator.fit(signals, window.clone(), coef) {
         Ok(fit) => match estimator.predict(signals, window.clone(), horizon.clone(), out) {
-            Ok(()) if out.iter().all(|v| v.is_finite()) => fit,
-            Err(Error::PredictionWithheld { .. }) => WindowFit {
-                termination: Termination::Withheld,
-                ..fit
-            },
-            _ => failed(fit.residual_rms),
+            Ok(p @ PredictStatus::Withheld { .. }) => (
+                fit.residual_rms,
+                fit.iterations,
+                WindowOutcome::of(fit.status, p),
+            ),
+            Ok(p) if out.iter().all(|v| v.is_finite()) => (
+                fit.residual_rms,
+                fit.iterations,
+                WindowOutcome::of(fit.status, p),
+            ),
+            _ => (finite_or_zero(fit.residual_rms), 0, WindowOutcome::Failed),
         },
-        Err(_) => failed(f64::NAN),
+        Err(_) => (0.0, 0, WindowOutcome::Failed),
     };
     if !coef.iter().all(|c| c.is_finite()) {
         coef.fill(0.0);
     }
-    fit
+    WindowRecord {
+        window,
+        horizon,
+        residual_rms,
+        iterations,
+        outcome,
+    }
 }
 
-/// The record of a window whose fit or prediction failed.
-fn failed(residual_rms: f64) -> WindowFit {
-    WindowFit {
-        residual_rms: if residual_rms.is_finite() {
-            residual_rms
-        } else {
-            0.0
-        },
-        iterations: 0,
-        termination: Termination::Failed,
+fn finite_or_zero(v: f64) -> f64 {
+    if v.is_finite() {
+        v
+    } else {
+        0.0
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ident::WindowFit;
+    use crate::solve::Termination;
 
     /// Predicts a straight line through the last two samples of the window;
     /// writes [last value, slope] as coefficients.
@@ -335,11 +345,7 @@ mod tests {
             let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             coef[0] = y[1];
             coef[1] = y[1] - y[0];
-            Ok(WindowFit {
-                residual_rms: 0.0,
-                iterations: 0,
-                termination: Termination::Exact,
-            })
+            Ok(WindowFit::identified(0.0, 0, Termination::Exact))
         }
         fn predict(
             &mut self,
@@ -347,13 +353,13 @@ mod tests {
             w: Range<usize>,
             h: Range<usize>,
             out: &mut [f64],
-        ) -> Result<()> {
+        ) -> Result<PredictStatus> {
             let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             assert_eq!(h.start, w.end);
             for (j, o) in out.iter_mut().enumerate() {
                 *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);
             }
-            Ok(())
+            Ok(PredictStatus::Predicted)
         }
     }
 
@@ -375,11 +381,7 @@ mod tests {
             if self.k % 2 == 0 {
                 Err(Error::Singular { context: "test" })
             } else {
-                Ok(WindowFit {
-                    residual_rms: 0.0,
-                    iterations: 0,
-                    termination: Termination::Exact,
-                })
+                Ok(WindowFit::identified(0.0, 0, Termination::Exact))
             }
         }
         fn predict(
@@ -388,9 +390,9 @@ mod tests {
             _: Range<usize>,
             _: Range<usize>,
             out: &mut [f64],
-        ) -> Result<()> {
+        ) -> Result<PredictStatus> {
             out.fill(f64::NAN);
-            Ok(())
+            Ok(PredictStatus::Predicted)
         }
     }
 

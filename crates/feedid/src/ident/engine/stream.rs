@@ -49,7 +49,7 @@
 //! same value causally, when the first moving command sample arrives; until
 //! then [`Signals::motion_start`] is `f64::INFINITY`. The paper method treats
 //! a window whose last sample is at or before the motion start as a rest
-//! window (coefficients 0, [`crate::solve::Termination::Fallback`], the last
+//! window (coefficients 0, [`crate::ident::WindowOutcome::Fallback`], the last
 //! position held), a decision that needs only the window, so batch and stream
 //! agree. One exception: a recording whose command never moves has its first
 //! sample as motion start in batch, while the streamer, which cannot know that
@@ -103,9 +103,8 @@ use std::ops::Range;
 
 use crate::error::{Error, Result};
 use crate::ident::engine::{fit_and_predict, EngineConfig};
-use crate::ident::{Estimator, Signals, WindowFit};
+use crate::ident::{Estimator, Signals, WindowOutcome};
 use crate::recording::MOTION_THRESHOLD;
-use crate::solve::Termination;
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
 /// Largest buffer the streamer allocates \[samples per channel\].
@@ -135,14 +134,18 @@ pub struct Prediction<'a> {
     pub position: &'a [f64],
     /// The window's coefficients (zeros if the fit failed).
     pub coefficients: &'a [f64],
-    /// Fit outcome (`Termination::Failed` if the fit or prediction failed).
-    pub fit: WindowFit,
+    /// RMS of the window's fit residual \[m\] (0 if the fit failed).
+    pub residual_rms: f64,
+    /// Solver iterations (0 if the fit or the prediction failed).
+    pub iterations: usize,
+    /// What became of the window.
+    pub outcome: WindowOutcome,
 }
 
 impl Prediction<'_> {
     /// Whether the window produced a prediction.
     pub fn is_ok(&self) -> bool {
-        self.fit.termination.predicted()
+        self.outcome.predicted()
     }
 }
 
@@ -452,16 +455,16 @@ impl<E: Estimator> Streamer<E> {
         );
         let out = &mut pred[..he - we];
         coef.fill(0.0);
-        let fit = fit_and_predict(est, &signals, &(s..we), &(we..he), coef, out);
-        if fit.termination.predicted() {
+        let record = fit_and_predict(est, &signals, s..we, we..he, coef, out);
+        let ok = record.outcome.predicted();
+        if ok {
             p[we - off..he - off].copy_from_slice(out);
             has[we - off..he - off].fill(true);
         }
-        let ok = fit.termination.predicted();
         self.windows += 1;
         if ok {
             self.top = self.top.max(he);
-        } else if fit.termination == Termination::Withheld {
+        } else if record.outcome == WindowOutcome::Withheld {
             self.withheld += 1;
         } else {
             self.failed += 1;
@@ -475,7 +478,9 @@ impl<E: Estimator> Streamer<E> {
             time: &self.t[we - off..he - off],
             position: if ok { &self.pred[..he - we] } else { &[] },
             coefficients: &self.coef,
-            fit,
+            residual_rms: record.residual_rms,
+            iterations: record.iterations,
+            outcome: record.outcome,
         }))
     }
 
@@ -610,8 +615,9 @@ mod tests {
     use super::*;
     use crate::drive::{RigParams, VirtualRig};
     use crate::ident::engine::{run, SlidingResult};
-    use crate::ident::{PaperConfig, PaperMethod, Solver};
+    use crate::ident::{PaperConfig, PaperMethod, PredictStatus, Solver, WindowFit};
     use crate::signal::Scenario;
+    use crate::solve::Termination;
     use crate::Recording;
 
     /// Straight line through the last two window samples (window-end estimator).
@@ -631,11 +637,7 @@ mod tests {
             let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             c[0] = y[1];
             c[1] = y[1] - y[0];
-            Ok(WindowFit {
-                residual_rms: 0.0,
-                iterations: 0,
-                termination: Termination::Exact,
-            })
+            Ok(WindowFit::identified(0.0, 0, Termination::Exact))
         }
         fn predict(
             &mut self,
@@ -643,12 +645,12 @@ mod tests {
             w: Range<usize>,
             _: Range<usize>,
             out: &mut [f64],
-        ) -> Result<()> {
+        ) -> Result<PredictStatus> {
             let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
             for (j, o) in out.iter_mut().enumerate() {
                 *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);
             }
-            Ok(())
+            Ok(PredictStatus::Predicted)
         }
     }
 
@@ -684,11 +686,7 @@ mod tests {
             } else {
                 1.0
             };
-            Ok(WindowFit {
-                residual_rms: 0.0,
-                iterations: 0,
-                termination: Termination::Exact,
-            })
+            Ok(WindowFit::identified(0.0, 0, Termination::Exact))
         }
         fn predict(
             &mut self,
@@ -696,13 +694,13 @@ mod tests {
             w: Range<usize>,
             h: Range<usize>,
             out: &mut [f64],
-        ) -> Result<()> {
+        ) -> Result<PredictStatus> {
             let y0 = s.window(w.end - 1..w.end, 0, "test").unwrap().position[0];
             let u0 = s.window(w.end - 1..w.end, 0, "test").unwrap().command[0];
             for (o, &u) in out.iter_mut().zip(s.window(h, 0, "test").unwrap().command) {
                 *o = y0 + (u - u0);
             }
-            Ok(())
+            Ok(PredictStatus::Predicted)
         }
     }
 
@@ -713,8 +711,8 @@ mod tests {
         Ahead(usize),
     }
 
-    /// Window, horizon, termination and coefficients of one processed window.
-    type WindowSummary = (Range<usize>, Range<usize>, Termination, Vec<f64>);
+    /// Window, horizon, outcome and coefficients of one processed window.
+    type WindowSummary = (Range<usize>, Range<usize>, WindowOutcome, Vec<f64>);
 
     /// What a stream produced, in the batch engine's layout.
     struct Collected {
@@ -744,7 +742,7 @@ mod tests {
         out.windows.push((
             p.window.clone(),
             p.horizon.clone(),
-            p.fit.termination,
+            p.outcome,
             p.coefficients.to_vec(),
         ));
     }
@@ -818,7 +816,7 @@ mod tests {
             assert_eq!(w.0, bw.window, "{what}: window {i}");
             assert_eq!(w.1.start, bw.horizon.start, "{what}: window {i}");
             assert_eq!(w.1.end.min(n), bw.horizon.end, "{what}: window {i}");
-            assert_eq!(w.2, bw.fit.termination, "{what}: window {i}");
+            assert_eq!(w.2, bw.outcome, "{what}: window {i}");
             assert_eq!(&w.3[..], b.window_coefficients(i), "{what}: window {i}");
         }
         let scale = b.predicted.iter().fold(1e-300_f64, |m, v| m.max(v.abs()));
@@ -844,7 +842,7 @@ mod tests {
             c.stats.failed_windows,
             c.windows
                 .iter()
-                .filter(|w| w.2 == Termination::Failed)
+                .filter(|w| w.2 == WindowOutcome::Failed)
                 .count()
         );
     }
@@ -928,7 +926,7 @@ mod tests {
             let rest = b
                 .windows
                 .iter()
-                .filter(|w| w.fit.termination == Termination::Fallback)
+                .filter(|w| w.outcome == WindowOutcome::Fallback)
                 .count();
             assert!(rest > 0 && rest < b.windows.len() / 2, "{what}: {rest}");
             assert_eq!(b.failed_windows(), 0);

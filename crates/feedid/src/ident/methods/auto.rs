@@ -23,7 +23,8 @@
 //!
 //! # When nothing is emitted
 //!
-//! A prediction is *withheld* ([`Termination::Withheld`]; no value, no NaN)
+//! A prediction is *withheld* ([`PredictStatus::Withheld`], a window outcome,
+//! not an error; no value, no NaN)
 //! unless both hold:
 //! * **validated**: the chosen candidate's rms error was within
 //!   [`AutoConfig::tolerance`] on each of the last [`AutoConfig::min_scored`]
@@ -65,7 +66,9 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::{ArxOrders, Estimator, RlsConfig, RlsEstimator, Samples, Signals, WindowFit};
+use crate::ident::{
+    ArxOrders, Estimator, PredictStatus, RlsConfig, RlsEstimator, Samples, Signals, WindowFit,
+};
 use crate::solve::Termination;
 
 /// Settings of the `auto` method.
@@ -340,7 +343,7 @@ impl Estimator for AutoEstimator {
                 Candidate::Rls(r) => match r.fit(signals, window.clone(), &mut slot.coef) {
                     Ok(f) => {
                         residual[i] = f.residual_rms;
-                        f.termination != Termination::Failed
+                        true
                     }
                     Err(_) => false,
                 },
@@ -390,11 +393,7 @@ impl Estimator for AutoEstimator {
             let n = rest.len().min(src.len());
             rest[..n].copy_from_slice(&src[..n]);
         }
-        Ok(WindowFit {
-            residual_rms: residual[c],
-            iterations: 0,
-            termination: Termination::Exact,
-        })
+        Ok(WindowFit::identified(residual[c], 0, Termination::Exact))
     }
 
     fn predict(
@@ -403,7 +402,7 @@ impl Estimator for AutoEstimator {
         window: Range<usize>,
         horizon: Range<usize>,
         out: &mut [f64],
-    ) -> Result<()> {
+    ) -> Result<PredictStatus> {
         let w = window_samples(signals, &window)?;
         let h = out.len();
         let (last, u_last) = (
@@ -450,25 +449,25 @@ impl Estimator for AutoEstimator {
         };
 
         let Some(c) = self.selected else {
-            return Err(Error::PredictionWithheld {
+            return Ok(PredictStatus::Withheld {
                 reason: "no candidate model",
             });
         };
         let slot = &self.slots[c];
         if slot.pending_len != h {
-            return Err(Error::PredictionWithheld {
+            return Ok(PredictStatus::Withheld {
                 reason: "the chosen model could not predict",
             });
         }
         let tol = self.config.tolerance;
         if slot.streak < self.config.min_scored {
-            return Err(Error::PredictionWithheld {
+            return Ok(PredictStatus::Withheld {
                 reason: "not yet validated",
             });
         }
         let within = self.pending_excursion <= self.config.headroom * self.seen_excursion + tol;
         if !within {
-            return Err(Error::PredictionWithheld {
+            return Ok(PredictStatus::Withheld {
                 reason: "the command leaves the validated range",
             });
         }
@@ -492,7 +491,7 @@ impl Estimator for AutoEstimator {
         } else {
             out.copy_from_slice(&slot.pending[..h]);
         }
-        Ok(())
+        Ok(PredictStatus::Predicted)
     }
 }
 
@@ -500,6 +499,7 @@ impl Estimator for AutoEstimator {
 mod tests {
     use super::*;
     use crate::ident::engine::{run, EngineConfig};
+    use crate::ident::WindowOutcome;
 
     fn first_order(n: usize, u: impl Fn(usize) -> f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
@@ -562,7 +562,7 @@ mod tests {
         let withheld = r
             .windows
             .iter()
-            .filter(|w| w.fit.termination == Termination::Withheld)
+            .filter(|w| w.outcome == WindowOutcome::Withheld)
             .count();
         assert!(withheld > 0);
         // the samples right after the step (300..310) are not predicted

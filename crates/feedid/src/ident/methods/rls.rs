@@ -83,7 +83,7 @@ use std::ops::Range;
 
 use crate::error::{Error, Result};
 use crate::ident::methods::regressor::{poles_inside, predict_horizon};
-use crate::ident::{ArxOrders, Estimator, Signals, WindowFit};
+use crate::ident::{ArxOrders, Estimator, PredictStatus, Signals, WindowFit};
 use crate::solve::Termination;
 
 /// Configuration of the RLS estimator (defaults tuned on the virtual rig and EMPS).
@@ -602,14 +602,10 @@ impl Estimator for RlsEstimator {
         } else {
             0.0
         };
-        Ok(WindowFit {
-            residual_rms: rms,
-            iterations: count,
-            termination: if count > 0 {
-                Termination::Exact
-            } else {
-                Termination::Fallback
-            },
+        Ok(if count > 0 {
+            WindowFit::identified(rms, count, Termination::Exact)
+        } else {
+            WindowFit::fallback(rms, count)
         })
     }
 
@@ -619,7 +615,7 @@ impl Estimator for RlsEstimator {
         window: Range<usize>,
         horizon: Range<usize>,
         out: &mut [f64],
-    ) -> Result<()> {
+    ) -> Result<PredictStatus> {
         let orders = self.config.orders;
         if self.updates == 0 {
             return Err(Error::Singular {
@@ -641,7 +637,8 @@ impl Estimator for RlsEstimator {
             &mut self.past,
             out,
             "RLS",
-        )
+        )?;
+        Ok(PredictStatus::Predicted)
     }
 }
 
@@ -649,6 +646,7 @@ impl Estimator for RlsEstimator {
 mod tests {
     use super::*;
     use crate::ident::methods::regressor::regressor;
+    use crate::ident::FitStatus;
     use nalgebra::{DMatrix, DVector};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -888,7 +886,7 @@ mod tests {
         rls.fit(&s, 900..1010, &mut coef).unwrap();
         let tr0: f64 = (0..4).map(|i| rls.covariance()[i * 5]).sum();
         let f = rls.fit(&s, 1100..3000, &mut coef).unwrap();
-        assert_eq!(f.termination, Termination::Fallback);
+        assert_eq!(f.status, FitStatus::Fallback);
         let tr1: f64 = (0..4).map(|i| rls.covariance()[i * 5]).sum();
         assert_eq!(tr0, tr1);
         // without the gate the trace grows like λ^−k

@@ -18,7 +18,7 @@ use super::config::ArxConfig;
 use super::factor::SlidingFactor;
 use crate::error::{Error, Result};
 use crate::ident::methods::regressor::{dc_gain, poles_inside, predict_horizon, MAX_ARX_ORDER};
-use crate::ident::{Estimator, LinearModel, Signals, WindowFit};
+use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
 use crate::solve::{lstsq_in_place, LstsqOptions, QrWorkspace, Termination};
 
 /// Diagnostics of the last ARX window.
@@ -308,18 +308,15 @@ impl Estimator for ArxEstimator {
         }
         let nc = coef.len().min(n + usize::from(self.config.offset));
         coef[..nc].copy_from_slice(&self.theta[..nc]);
-        Ok(WindowFit {
-            residual_rms: if residual_rms.is_finite() {
-                residual_rms
-            } else {
-                0.0
-            },
-            iterations: 0,
-            termination: if diag.accepted {
-                Termination::Exact
-            } else {
-                Termination::Fallback
-            },
+        let residual_rms = if residual_rms.is_finite() {
+            residual_rms
+        } else {
+            0.0
+        };
+        Ok(if diag.accepted {
+            WindowFit::identified(residual_rms, 0, Termination::Exact)
+        } else {
+            WindowFit::fallback(residual_rms, 0)
         })
     }
 
@@ -329,7 +326,7 @@ impl Estimator for ArxEstimator {
         window: Range<usize>,
         horizon: Range<usize>,
         out: &mut [f64],
-    ) -> Result<()> {
+    ) -> Result<PredictStatus> {
         let orders = self.config.orders;
         if !self.has_model {
             return Err(Error::Singular {
@@ -347,6 +344,7 @@ impl Estimator for ArxEstimator {
             &mut self.past,
             out,
             "ARX",
-        )
+        )?;
+        Ok(PredictStatus::Predicted)
     }
 }

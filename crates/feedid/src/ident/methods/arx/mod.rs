@@ -61,7 +61,7 @@
 //! pole lies outside the radius [`ArxConfig::max_pole_radius`] (Schur–Cohn
 //! step-down test on `A`, allocation-free), or the DC gain `B(1)/A(1)` is
 //! outside [`ArxConfig::dc_gain_bounds`]. In both cases the last good model
-//! is kept and the window reports [`Termination::Fallback`]; without any
+//! is kept and the window reports [`FitStatus::Fallback`](crate::ident::FitStatus::Fallback); without any
 //! good model yet the fit is an error ([`Error::Singular`]) and the engine
 //! records the window as failed.
 //!

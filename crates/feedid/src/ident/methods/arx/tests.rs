@@ -9,7 +9,7 @@ use super::config::*;
 use super::fit::*;
 use crate::ident::engine::{run, EngineConfig};
 use crate::ident::methods::regressor::*;
-use crate::ident::{Estimator, Signals};
+use crate::ident::{Estimator, FitStatus, Signals};
 use crate::lti::poly_roots;
 use crate::solve::Termination;
 use nalgebra::DMatrix;
@@ -250,9 +250,9 @@ fn standstill_keeps_last_model_and_reports_fallback() {
     let still = Signals::new(&t[..100], &zeros, &zeros, 1e-3, 0.0);
     assert!(est.fit(&still, 10..60, &mut coef).is_err());
     let f = est.fit(&s, 100..160, &mut coef).unwrap();
-    assert_eq!(f.termination, Termination::Exact);
+    assert_eq!(f.status, FitStatus::Identified(Termination::Exact));
     let f = est.fit(&s, 300..360, &mut coef).unwrap();
-    assert_eq!(f.termination, Termination::Fallback);
+    assert_eq!(f.status, FitStatus::Fallback);
     assert!((coef[0] + 0.5).abs() < 1e-9 && (coef[1] - 0.5).abs() < 1e-9);
     assert_eq!(
         est.diagnostics().unwrap().reason,

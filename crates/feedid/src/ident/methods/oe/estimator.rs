@@ -31,7 +31,7 @@
 //! (Routh test) gets a large constant residual, so LM rejects the step and
 //! increases its damping; the returned model is stable (an unstable start is
 //! reflected first). A window whose fit fails or is non-finite keeps the
-//! previous window's model ([`Termination::Fallback`]).
+//! previous window's model ([`FitStatus::Fallback`](crate::ident::FitStatus::Fallback)).
 //!
 //! **Global model** ([`fit_oe`]): the recording is assumed to start at rest at
 //! `u[0]`, `ŷ = G(0)·u[0] + G·(u − u[0])` — exactly what
@@ -59,7 +59,7 @@
 //! meets a meaningless model; informative windows move the model freely. The
 //! first window (SRIVC start) is fitted without the prior and with up to
 //! [`OeConfig::max_iterations`]. A window with a
-//! constant command only re-estimates the state ([`Termination::Fallback`]).
+//! constant command only re-estimates the state ([`FitStatus::Fallback`](crate::ident::FitStatus::Fallback)).
 //! The `k`-step-ahead prediction runs the model from the state at the window
 //! end (estimated from the window's measured positions) over the horizon with
 //! the known command.
@@ -81,10 +81,10 @@ use nalgebra::{Complex, DMatrix};
 use super::companion::{is_hurwitz, output, reflect_unstable, Companion, MAX_ORDER};
 use super::srivc::srivc;
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, LinearModel, Signals, WindowFit};
+use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
 use crate::lti::TransferFunction;
 use crate::solve::{
-    lstsq_in_place, LevenbergMarquardt, LmConfig, LmReport, LstsqOptions, QrWorkspace, Termination,
+    lstsq_in_place, LevenbergMarquardt, LmConfig, LmReport, LstsqOptions, QrWorkspace,
 };
 
 /// Settings of the output-error method.
@@ -808,7 +808,8 @@ impl Estimator for OeEstimator {
             });
         let excited = u_max > u_min;
         let mut iterations = 0;
-        let mut termination = Termination::Fallback;
+        // `None`: the previous window's model is kept (fallback)
+        let mut termination = None;
         if excited {
             let y_max = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let penalty = 1e6 * y_max.max(f64::MIN_POSITIVE);
@@ -845,7 +846,7 @@ impl Estimator for OeEstimator {
                     if self.theta.iter().all(|v| v.is_finite()) && is_hurwitz(&self.theta[..n]) =>
                 {
                     iterations = rep.iterations;
-                    termination = rep.termination;
+                    termination = Some(rep.termination);
                 }
                 Ok(rep) => {
                     iterations = rep.iterations;
@@ -868,10 +869,9 @@ impl Estimator for OeEstimator {
         // noise scale of the prior: this window's residual, floored at 1e-12 of the data
         self.sigma = rms.max(1e-12 * y_span(y)).max(f64::MIN_POSITIVE);
         self.last_window = Some(window);
-        Ok(WindowFit {
-            residual_rms: rms,
-            iterations,
-            termination,
+        Ok(match termination {
+            Some(t) => WindowFit::identified(rms, iterations, t),
+            None => WindowFit::fallback(rms, iterations),
         })
     }
 
@@ -881,7 +881,7 @@ impl Estimator for OeEstimator {
         window: Range<usize>,
         horizon: Range<usize>,
         out: &mut [f64],
-    ) -> Result<()> {
+    ) -> Result<PredictStatus> {
         if self.last_window.as_ref() != Some(&window) {
             return Err(Error::InvalidModel {
                 reason: "oe predict called without a fit of this window",
@@ -916,7 +916,7 @@ impl Estimator for OeEstimator {
                 reason: "non-finite oe prediction",
             });
         }
-        Ok(())
+        Ok(PredictStatus::Predicted)
     }
 }
 
@@ -925,7 +925,9 @@ mod tests {
     use super::*;
     use crate::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
     use crate::ident::engine::{run, EngineConfig};
+    use crate::ident::FitStatus;
     use crate::signal::Scenario;
+    use crate::solve::Termination;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     use rand_distr::{Distribution, Normal};
@@ -1219,7 +1221,7 @@ mod tests {
         oe.fit(&s, 100..250, &mut c0).unwrap();
         let mut c1 = [0.0; 4];
         let f = oe.fit(&s, 250..400, &mut c1).unwrap();
-        assert_eq!(f.termination, Termination::Fallback);
+        assert_eq!(f.status, FitStatus::Fallback);
         assert_eq!(c0, c1);
     }
 

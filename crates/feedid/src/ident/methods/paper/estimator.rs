@@ -9,7 +9,7 @@ use super::config::{shift_amplification, PaperConfig, PredictionMode, Solver, Ti
 use super::polynomials::{coefficients_from_polynomials, NAMES, NC, NP, NQ};
 use super::simplex::simplex_fit;
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, Signals, WindowFit};
+use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
 use crate::lti::TransferFunction;
 use crate::solve::{lstsq_in_place, LstsqInfo, LstsqOptions, NelderMead, QrWorkspace, Termination};
 
@@ -148,11 +148,7 @@ impl PaperMethod {
         self.last = None;
         self.diagnostics = None;
         let sse: f64 = pos.iter().map(|y| (y - hold) * (y - hold)).sum();
-        WindowFit {
-            residual_rms: (sse / pos.len().max(1) as f64).sqrt(),
-            iterations: 0,
-            termination: Termination::Fallback,
-        }
+        WindowFit::fallback((sse / pos.len().max(1) as f64).sqrt(), 0)
     }
 
     fn ensure_capacity(&mut self, w: usize) {
@@ -494,11 +490,11 @@ impl Estimator for PaperMethod {
                 0.0
             },
         });
-        Ok(WindowFit {
-            residual_rms: (out_sse.max(0.0) / w as f64).sqrt(),
+        Ok(WindowFit::identified(
+            (out_sse.max(0.0) / w as f64).sqrt(),
             iterations,
             termination,
-        })
+        ))
     }
 
     fn predict(
@@ -507,7 +503,7 @@ impl Estimator for PaperMethod {
         _window: Range<usize>,
         horizon: Range<usize>,
         out: &mut [f64],
-    ) -> Result<()> {
+    ) -> Result<PredictStatus> {
         if out.len() != horizon.len() {
             return Err(Error::LengthMismatch {
                 what: "paper prediction",
@@ -518,7 +514,7 @@ impl Estimator for PaperMethod {
         let hz = signals.window(horizon.clone(), 0, "paper horizon")?;
         if let Some(hold) = self.rest_hold {
             out.fill(hold);
-            return Ok(());
+            return Ok(PredictStatus::Predicted);
         }
         let fit = self.last.ok_or(Error::InvalidModel {
             reason: "paper: predict called before a successful fit",
@@ -561,7 +557,7 @@ impl Estimator for PaperMethod {
                 value: out[i],
             });
         }
-        Ok(())
+        Ok(PredictStatus::Predicted)
     }
 }
 

@@ -90,7 +90,7 @@
 //! motion start (or when the motion start is not known yet, `+∞` while
 //! streaming) holds only rest data: there is nothing to identify, so it
 //! predicts the last measured position held, writes zero coefficients and
-//! reports [`Termination::Fallback`]. The command is fitted as given: its
+//! reports [`FitStatus::Fallback`](crate::ident::FitStatus::Fallback). The command is fitted as given: its
 //! model has a constant term (`Q0 = D7`).
 //!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time

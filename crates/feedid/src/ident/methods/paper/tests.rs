@@ -7,7 +7,7 @@ use super::config::*;
 use super::estimator::*;
 use super::polynomials::*;
 use crate::error::Error;
-use crate::ident::{Estimator, Signals, WindowFit};
+use crate::ident::{Estimator, FitStatus, Signals, WindowFit, WindowOutcome};
 use crate::solve::Termination;
 
 const DT: f64 = 2e-4;
@@ -164,7 +164,7 @@ fn exact_model_polynomial_is_reproduced_by_qr_to_rounding() {
             "{origin:?}: {}",
             max_rel(&c, &expected)
         );
-        assert_eq!(f.termination, Termination::Exact);
+        assert_eq!(f.status, FitStatus::Identified(Termination::Exact));
         assert!(f.residual_rms < 1e-16, "{}", f.residual_rms);
         let diag = m.diagnostics().unwrap();
         assert_eq!(diag.output_qr.unwrap().rank, 3);
@@ -225,7 +225,11 @@ fn simplex_and_qr_agree_to_1e_6_relative_on_exact_model_polynomials() {
         let s = d.signals(0.0);
         let (c_qr, _) = fit(&mut method(Solver::Qr, *origin), &s, 0..W);
         let (c_nm, f) = fit(&mut method(Solver::Simplex, *origin), &s, 0..W);
-        assert_eq!(f.termination, Termination::Converged, "case {k}");
+        assert_eq!(
+            f.status,
+            FitStatus::Identified(Termination::Converged),
+            "case {k}"
+        );
         assert!(f.iterations > 0);
         let e = max_rel(&c_nm, &c_qr);
         assert!(
@@ -499,12 +503,12 @@ fn windows_ending_at_or_before_the_motion_start_are_rest_windows() {
             let mut pred = [0.0; H];
             m.predict(&s, 0..W, W..W + H, &mut pred).unwrap();
             if rest {
-                assert_eq!(f.termination, Termination::Fallback);
+                assert_eq!(f.status, FitStatus::Fallback);
                 assert_eq!(c, [0.0; 11]);
                 assert!(pred.iter().all(|&v| v == last), "{pred:?}");
                 assert!(m.fitted_position(d.t[0]).is_none());
             } else {
-                assert_ne!(f.termination, Termination::Fallback);
+                assert_ne!(f.status, FitStatus::Fallback);
                 assert!(c.iter().any(|&v| v != 0.0));
                 assert!(pred.iter().all(|&v| v != last));
             }
@@ -515,7 +519,7 @@ fn windows_ending_at_or_before_the_motion_start_are_rest_windows() {
     let f = m
         .fit(&d.signals(f64::INFINITY), 0..W, &mut [0.0; 11])
         .unwrap();
-    assert_eq!(f.termination, Termination::Exact);
+    assert_eq!(f.status, FitStatus::Identified(Termination::Exact));
 }
 
 #[test]
@@ -561,7 +565,7 @@ fn simplex_cap_is_reported_as_max_iterations() {
     .build()
     .unwrap();
     let (c, f) = fit(&mut m, &d.signals(0.0), 0..W);
-    assert_eq!(f.termination, Termination::MaxIterations);
+    assert_eq!(f.status, FitStatus::Identified(Termination::MaxIterations));
     assert_eq!(f.iterations, 10);
     assert!(c.iter().all(|v| v.is_finite()));
 }
@@ -628,7 +632,7 @@ fn rest_windows_hold_the_last_position_and_report_fallback() {
     let s = d.signals(f64::INFINITY);
     let mut m = method(Solver::Qr, TimeOrigin::Motion);
     let (c, f) = fit(&mut m, &s, 0..W);
-    assert_eq!(f.termination, Termination::Fallback);
+    assert_eq!(f.status, FitStatus::Fallback);
     assert!(c.iter().all(|&v| v == 0.0));
     let mut pred = vec![0.0; H];
     m.predict(&s, 0..W, W..W + H, &mut pred).unwrap();
@@ -717,7 +721,7 @@ fn sliding_engine_runs_the_paper_method_on_a_lagged_ramp_without_nan() {
     assert!(rq
         .windows
         .iter()
-        .all(|w| w.fit.termination == Termination::Exact));
+        .all(|w| w.outcome == WindowOutcome::Predicted(Termination::Exact)));
     assert!(rq.stats.samples > 500);
     assert!(rq.stats.rms.is_finite() && rq.stats.max_abs.is_finite());
     // independent reference (NumPy lstsq on t⁵, t⁶, t⁷ over samples 0..20,
@@ -731,9 +735,9 @@ fn sliding_engine_runs_the_paper_method_on_a_lagged_ramp_without_nan() {
         .map(|k| (rq.predicted[k] - y[k]).abs())
         .fold(0.0, f64::max);
     assert!(
-        (w0.fit.residual_rms / 7.713548e-6 - 1.0).abs() < 1e-5,
+        (w0.residual_rms / 7.713548e-6 - 1.0).abs() < 1e-5,
         "{}",
-        w0.fit.residual_rms
+        w0.residual_rms
     );
     assert!((e0 / 9.5618237e-3 - 1.0).abs() < 1e-6, "{e0}");
     // once the motion is established the continuation improves steadily
@@ -749,7 +753,7 @@ fn sliding_engine_runs_the_paper_method_on_a_lagged_ramp_without_nan() {
     assert!(rs
         .windows
         .iter()
-        .all(|w| w.fit.termination == Termination::Converged));
+        .all(|w| w.outcome == WindowOutcome::Predicted(Termination::Converged)));
     for k in 0..n {
         assert_eq!(rq.has_prediction[k], rs.has_prediction[k]);
         if rq.has_prediction[k] {

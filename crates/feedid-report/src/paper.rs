@@ -5,12 +5,12 @@
 //!
 //! ```no_run
 //! use feedid::experiment::{run_experiment, PaperExperimentConfig};
-//! use feedid::ident::{MethodKind, MethodSpec};
+//! use feedid::ident::Method;
 //! use feedid_report::paper_report;
 //! use feedid::signal::Scenario;
 //! let cfg = PaperExperimentConfig::default();
 //! let runs = vec![run_experiment(Scenario::Ramp, &cfg).unwrap()];
-//! let page = paper_report(&runs, &cfg, &[MethodSpec::new(MethodKind::Arx)]).unwrap();
+//! let page = paper_report(&runs, &cfg, &["arx".parse::<Method>().unwrap()]).unwrap();
 //! std::fs::write("report.html", page.to_html()).unwrap();
 //! ```
 
@@ -19,7 +19,7 @@ use crate::html::{Block, HtmlReport, Section, Table};
 use crate::recording::{RecordingAnalysis, ReportOptions};
 use feedid::drive::RigEffects;
 use feedid::experiment::{ExperimentResult, PaperExperimentConfig};
-use feedid::ident::{EngineConfig, MethodSpec, PaperConfig};
+use feedid::ident::{EngineConfig, Method, PaperConfig};
 
 /// Title of an experiment's section.
 fn experiment_title(name: &str) -> String {
@@ -36,16 +36,13 @@ fn experiment_title(name: &str) -> String {
 pub fn paper_report(
     results: &[ExperimentResult],
     cfg: &PaperExperimentConfig,
-    others: &[MethodSpec],
+    others: &[Method],
 ) -> Result<HtmlReport> {
     let mut methods = vec![(
-        MethodSpec {
-            paper: PaperConfig {
-                solver: cfg.solver,
-                ..PaperConfig::default()
-            },
-            ..MethodSpec::new(feedid::ident::MethodKind::Paper)
-        },
+        Method::Paper(PaperConfig {
+            solver: cfg.solver,
+            ..PaperConfig::default()
+        }),
         cfg.engine,
     )];
     for spec in others {
@@ -186,7 +183,7 @@ pub fn paper_report(
 mod tests {
     use super::*;
     use feedid::experiment::run_experiment;
-    use feedid::ident::{MethodKind, Solver};
+    use feedid::ident::Solver;
     use feedid::signal::Scenario;
 
     #[test]
@@ -199,7 +196,7 @@ mod tests {
             .iter()
             .map(|&s| run_experiment(s, &cfg).unwrap())
             .collect();
-        let page = paper_report(&results, &cfg, &[MethodSpec::new(MethodKind::Arx)]).unwrap();
+        let page = paper_report(&results, &cfg, &["arx".parse::<Method>().unwrap()]).unwrap();
         let ids = page.figure_ids();
         for exp in ["ramp", "step"] {
             for f in [

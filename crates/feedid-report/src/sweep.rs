@@ -79,7 +79,7 @@ pub fn sweep_heat_map(res: &SweepResult) -> HeatMap {
 mod tests {
     use super::*;
     use feedid::drive::{RigParams, VirtualRig};
-    use feedid::ident::{sweep, ArxOrders, MethodKind, MethodSpec, SweepConfig};
+    use feedid::ident::{sweep, ArxOrders, SweepConfig};
     use feedid::signal::Scenario;
     use feedid::Recording;
 
@@ -94,10 +94,7 @@ mod tests {
 
     fn cfg() -> SweepConfig {
         SweepConfig {
-            methods: vec![
-                MethodSpec::new(MethodKind::Paper),
-                MethodSpec::new(MethodKind::Arx),
-            ],
+            methods: vec!["paper".parse().unwrap(), "arx".parse().unwrap()],
             windows: vec![20, 40, 80],
             horizons: vec![5, 10],
             orders: vec![ArxOrders::new(2, 2, 1), ArxOrders::new(4, 4, 1)],

@@ -59,6 +59,18 @@ pub enum Error {
         expected: &'static str,
     },
 
+    /// A setting was given for a method that has no such setting (it is
+    /// refused, never silently ignored).
+    #[error("{setting}: not applicable to the {method} method (only to {applies_to})")]
+    NotApplicable {
+        /// The setting, e.g. `"ARX orders (na,nb,nk)"`.
+        setting: &'static str,
+        /// The method it was given for.
+        method: &'static str,
+        /// The methods that take it, comma separated.
+        applies_to: &'static str,
+    },
+
     /// A rig parameter file could not be parsed (unknown key, wrong type, ...).
     #[error("{}: {message}", display_path(path))]
     ParamsFile {
@@ -206,6 +218,18 @@ pub enum Error {
         source: Box<Error>,
     },
 
+    // --- pipeline
+    /// A stage of a run failed; the wrapped error says why (e.g.
+    /// `order selection: too few samples for …`).
+    #[error("{stage}: {source}")]
+    Stage {
+        /// The stage, e.g. `"order selection"`, `"global model"`.
+        stage: &'static str,
+        /// Why it failed.
+        #[source]
+        source: Box<Error>,
+    },
+
     // --- greybox
     /// A chosen set of physical parameters cannot be estimated separately
     /// from the data (a null direction of the Jacobian).
@@ -264,10 +288,11 @@ pub enum Error {
 }
 
 impl Error {
-    /// The innermost error: the wrapped one for [`Error::InFile`], else `self`.
+    /// The innermost error: the wrapped one for [`Error::InFile`] and
+    /// [`Error::Stage`], else `self`.
     pub fn root(&self) -> &Error {
         match self {
-            Error::InFile { source, .. } => source.root(),
+            Error::InFile { source, .. } | Error::Stage { source, .. } => source.root(),
             other => other,
         }
     }

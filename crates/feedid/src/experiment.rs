@@ -12,7 +12,8 @@ use std::fmt::Write as _;
 
 use crate::drive::{RigEffects, RigParams, VirtualRig};
 use crate::error::Result;
-use crate::ident::{identify, EngineConfig, Identification, PaperConfig, Solver};
+use crate::ident::{EngineConfig, Method, PaperConfig, Solver};
+use crate::pipeline::{Identification, Pipeline};
 use crate::recording::Recording;
 use crate::signal::Scenario;
 use crate::stats::ErrorStats;
@@ -109,17 +110,17 @@ pub fn run_experiment(scenario: Scenario, cfg: &PaperExperimentConfig) -> Result
 
     let mut runs = Vec::with_capacity(2);
     for solver in [Solver::Qr, Solver::Simplex] {
-        let mut est = PaperConfig {
+        let method = Method::Paper(PaperConfig {
             solver,
             ..PaperConfig::default()
-        }
-        .build()?;
-        runs.push(identify(
-            &recording,
-            &mut est,
-            &cfg.engine,
-            Some(&cfg.params),
-        )?);
+        });
+        runs.push(
+            Pipeline::new(method)
+                .engine(cfg.engine)
+                .method_global_model(false)
+                .nominal(cfg.params)
+                .run(&recording)?,
+        );
     }
     let errors = |id: &Identification, curve: &dyn Fn(usize) -> Option<f64>| {
         let y = recording.position();

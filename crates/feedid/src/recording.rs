@@ -150,6 +150,20 @@ impl Recording {
         Ok(self)
     }
 
+    /// The first `n` samples (all of them if `n` is larger) as a recording
+    /// of its own, without the further channels; the sampling was checked
+    /// when this recording was built, so no jitter tolerance applies again.
+    /// Errors: `n < 2`.
+    pub fn head(&self, n: usize) -> Result<Self> {
+        let n = n.min(self.len());
+        Self::with_tolerance(
+            self.time[..n].to_vec(),
+            self.command[..n].to_vec(),
+            self.position[..n].to_vec(),
+            f64::INFINITY,
+        )
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.time.len()

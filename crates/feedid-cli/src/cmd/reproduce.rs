@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use feedid::experiment::{run_experiment, summary_markdown, PaperExperimentConfig};
-use feedid::ident::{MethodKind, MethodSpec};
+use feedid::ident::Method;
 use feedid::io::write_string_atomic;
 use feedid::signal::Scenario;
 use feedid_report::experiment::{error_chart, response_chart};
@@ -38,7 +38,7 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
         .split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty() && *s != "none")
-        .map(|s| Ok(MethodSpec::new(s.parse::<MethodKind>()?)))
+        .map(|s| Ok(s.parse::<Method>()?))
         .collect::<Result<Vec<_>>>()?;
     let page = paper_report(&results, &cfg, &others)?;
     files.push(("report.html".to_string(), page.to_html()));

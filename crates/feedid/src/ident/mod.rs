@@ -11,19 +11,20 @@
 
 mod analysis;
 pub mod engine;
-mod identify;
 mod method;
 mod methods;
 mod model;
 mod select;
 
-pub use analysis::{ResidualAnalysis, Z_99};
+pub use analysis::{
+    prediction_errors, prediction_residuals, ResidualAnalysis, RESIDUAL_LAGS, RESIDUAL_SAMPLES,
+    Z_99,
+};
 pub use engine::{
     batch, stream, EngineConfig, Estimator, FitStatus, PredictStatus, Prediction, Samples, Signals,
     SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit, WindowOutcome, WindowRecord,
 };
-pub use identify::{identify, Identification, IdentifySummary, RESIDUAL_LAGS};
-pub use method::{MethodKind, MethodSpec, METHOD_NAMES};
+pub use method::{Method, METHOD_NAMES};
 pub use methods::{
     coefficients_from_polynomials, fit_arx, fit_oe, polynomials_from_coefficients, ArxConfig,
     ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, OeConfig,
@@ -32,7 +33,7 @@ pub use methods::{
     SHIFT_AMPLIFICATION_WARNING,
 };
 pub use model::{
-    fit_global_model, global_model_for, GlobalModelKind, LinearModel, ModelFile, ModelProvenance,
+    fit_global_model, GlobalModelKind, LinearModel, ModelFile, ModelProvenance, GLOBAL_FIT_SAMPLES,
 };
 pub use select::{
     frols, order_table, select_order, sweep, Criterion, FrolsConfig, FrolsResult, FrolsTerm,

@@ -31,6 +31,7 @@
 use serde::Serialize;
 
 use crate::error::{Error, Result};
+use crate::ident::SlidingResult;
 
 /// z-value of the two-sided 99 % band.
 pub const Z_99: f64 = 2.58;
@@ -154,6 +155,55 @@ impl ResidualAnalysis {
             .ok()
             .and_then(|i| self.r_ue.get(i).copied())
     }
+}
+
+/// Largest lag of the residual analysis of a run's summary (`feedid identify`).
+pub const RESIDUAL_LAGS: usize = 25;
+
+/// Most recent predicted samples the residual analysis of a run uses.
+pub const RESIDUAL_SAMPLES: usize = 200_000;
+
+/// Residual analysis of the prediction errors `y − ŷ` of a sliding run over
+/// its predicted samples (at most the last [`RESIDUAL_SAMPLES`]) against the
+/// command, lags 0 … `max_lag`; `None` when at most `2·max_lag + 1` samples
+/// were predicted. The k-step errors of one horizon share the state they
+/// were predicted from, so `r_ee` is expected to be positive for lags below
+/// the horizon.
+pub fn prediction_residuals(
+    s: &SlidingResult,
+    command: &[f64],
+    position: &[f64],
+    max_lag: usize,
+) -> Option<ResidualAnalysis> {
+    let (u, e) = prediction_errors(s, command, position, RESIDUAL_SAMPLES);
+    if e.len() <= 2 * max_lag + 1 {
+        return None;
+    }
+    ResidualAnalysis::new(&u, &e, max_lag).ok()
+}
+
+/// The command `u[k]` and the prediction error `y[k] − ŷ[k]` at the
+/// predicted samples `k` of a sliding run, in time order: the last
+/// `max_samples` of them at most.
+pub fn prediction_errors(
+    s: &SlidingResult,
+    command: &[f64],
+    position: &[f64],
+    max_samples: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut u, mut e) = (Vec::new(), Vec::new());
+    for k in (0..s.predicted.len()).rev() {
+        if e.len() >= max_samples {
+            break;
+        }
+        if s.has_prediction[k] {
+            u.push(command.get(k).copied().unwrap_or(0.0));
+            e.push(position.get(k).copied().unwrap_or(0.0) - s.predicted[k]);
+        }
+    }
+    u.reverse();
+    e.reverse();
+    (u, e)
 }
 
 #[cfg(test)]

@@ -11,5 +11,7 @@ pub mod stream;
 pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
 pub use signals::{Samples, Signals};
 pub(crate) use sliding::fit_and_predict;
-pub use sliding::{run, EngineConfig, SlidingResult, WindowIter, WindowRecord};
+pub use sliding::{
+    run, run_with_progress, EngineConfig, Progress, SlidingResult, WindowIter, WindowRecord,
+};
 pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};

@@ -44,6 +44,9 @@ use crate::error::{Error, Result};
 use crate::ident::{Estimator, PredictStatus, Signals, WindowOutcome};
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
+/// How often [`run_with_progress`] reports over a recording.
+const PROGRESS_REPORTS: usize = 500;
+
 /// Sliding-window settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EngineConfig {
@@ -225,6 +228,21 @@ pub fn run<E: Estimator + ?Sized>(
     signals: &Signals<'_>,
     config: &EngineConfig,
 ) -> Result<SlidingResult> {
+    run_with_progress(estimator, signals, config, None)
+}
+
+/// A progress hook: `progress(done, total)` in samples (called from the
+/// thread that runs the engine).
+pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
+
+/// [`run`], reporting `progress(done, total)` in samples: about 500 times
+/// over a recording (never per window on long ones), and `(n, n)` at the end.
+pub fn run_with_progress<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    config: &EngineConfig,
+    progress: Option<Progress<'_>>,
+) -> Result<SlidingResult> {
     signals.check_lengths()?;
     let n = signals.len();
     let est_warm = estimator.warm_up();
@@ -240,8 +258,20 @@ pub fn run<E: Estimator + ?Sized>(
     let mut buf = vec![0.0; config.horizon];
 
     estimator.reset();
+    let total = n as u64;
+    let step = (n / PROGRESS_REPORTS).max(1);
+    let mut next_report = 0;
+    if let Some(p) = progress {
+        p(0, total);
+    }
     let start = Instant::now();
     for (w, (window, horizon)) in config.windows(n, est_warm).enumerate() {
+        if let Some(p) = progress {
+            if horizon.start >= next_report {
+                p(horizon.start as u64, total);
+                next_report = horizon.start.saturating_add(step);
+            }
+        }
         let coef = &mut coefficients[w * nc..(w + 1) * nc];
         let out = &mut buf[..horizon.len()];
         let record = fit_and_predict(estimator, signals, window, horizon, coef, out);
@@ -252,6 +282,9 @@ pub fn run<E: Estimator + ?Sized>(
         windows.push(record);
     }
     let elapsed = start.elapsed();
+    if let Some(p) = progress {
+        p(total, total);
+    }
 
     let mut acc = ErrorAccumulator::default();
     let y = signals.all().position;
@@ -526,5 +559,28 @@ mod tests {
         assert_eq!(cfg.windows(100, 2).count(), 1);
         let r = run(&mut Linear { calls: 0 }, &s, &cfg).unwrap();
         assert_eq!(r.windows.len(), 1);
+    }
+
+    #[test]
+    fn progress_is_reported_from_zero_to_the_total_and_does_not_change_the_result() {
+        let (t, y) = ramp(5000);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let calls = std::sync::Mutex::new(Vec::new());
+        let hook = |d: u64, n: u64| calls.lock().unwrap().push((d, n));
+        let with = run_with_progress(
+            &mut Linear { calls: 0 },
+            &s,
+            &EngineConfig::default(),
+            Some(&hook),
+        )
+        .unwrap();
+        let without = run(&mut Linear { calls: 0 }, &s, &EngineConfig::default()).unwrap();
+        assert_eq!(with.predicted, without.predicted);
+        let calls = calls.into_inner().unwrap();
+        assert_eq!(calls.first(), Some(&(0, 5000)));
+        assert_eq!(calls.last(), Some(&(5000, 5000)));
+        assert!(calls.windows(2).all(|w| w[0].0 <= w[1].0), "monotone");
+        // throttled to about 500 reports (here about one per window)
+        assert!(calls.len() > 100 && calls.len() <= 502, "{}", calls.len());
     }
 }

@@ -121,6 +121,26 @@ impl Default for AutoConfig {
 impl AutoConfig {
     /// Validate and build the estimator.
     pub fn build(self) -> Result<AutoEstimator> {
+        self.validate()?;
+        let long = self.long.build()?;
+        let short = self.short.build()?;
+        let long_names = long.coefficient_names().len();
+        let short_names = short.coefficient_names().len();
+        Ok(AutoEstimator {
+            config: self,
+            slots: [
+                Slot::new(Candidate::Rls(Box::new(long)), long_names),
+                Slot::new(Candidate::Rls(Box::new(short)), short_names),
+                Slot::new(Candidate::Hold, 0),
+            ],
+            selected: None,
+            seen_excursion: 0.0,
+            pending_excursion: 0.0,
+        })
+    }
+
+    /// Check the settings (tolerance, memory, blend, headroom and both RLS candidates).
+    pub fn validate(&self) -> Result<()> {
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "tolerance",
@@ -149,21 +169,8 @@ impl AutoConfig {
                 reason: "must be finite and >= 1",
             });
         }
-        let long = self.long.build()?;
-        let short = self.short.build()?;
-        let long_names = long.coefficient_names().len();
-        let short_names = short.coefficient_names().len();
-        Ok(AutoEstimator {
-            config: self,
-            slots: [
-                Slot::new(Candidate::Rls(Box::new(long)), long_names),
-                Slot::new(Candidate::Rls(Box::new(short)), short_names),
-                Slot::new(Candidate::Hold, 0),
-            ],
-            selected: None,
-            seen_excursion: 0.0,
-            pending_excursion: 0.0,
-        })
+        self.long.validate()?;
+        self.short.validate()
     }
 }
 

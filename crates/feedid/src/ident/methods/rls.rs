@@ -132,6 +132,12 @@ impl Default for RlsConfig {
 impl RlsConfig {
     /// Validate and build the estimator.
     pub fn build(self) -> Result<RlsEstimator> {
+        self.validate()?;
+        Ok(RlsEstimator::new(self))
+    }
+
+    /// Check the settings (orders, λ ∈ (0, 1], positive scales, a window of at least 1).
+    pub fn validate(&self) -> Result<()> {
         self.orders.validate()?;
         if !(self.lambda > 0.0 && self.lambda <= 1.0) {
             return Err(Error::InvalidParameter {
@@ -176,7 +182,7 @@ impl RlsConfig {
                 reason: "must be at least 1 sample",
             });
         }
-        Ok(RlsEstimator::new(self))
+        Ok(())
     }
 }
 

@@ -43,9 +43,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::ident::{
-    fit_arx, fit_oe, ArxConfig, ArxOrders, LinearModel, MethodKind, MethodSpec, OeConfig,
-};
+use crate::ident::{fit_arx, fit_oe, ArxConfig, ArxOrders, LinearModel, OeConfig};
 use crate::recording::Recording;
 use crate::stats::ErrorStats;
 
@@ -230,12 +228,30 @@ impl ModelFile {
     }
 }
 
-/// Fit a global model of `kind` to the whole recording.
+/// Samples a global model is fitted on at most: the first 200 000 (40 s at
+/// 5 kHz, 200 s at 1 kHz). The one cap of every global fit (the summary's
+/// free-run fit, `--model-out`, the report's Bode figure): the output-error
+/// fits of a whole hour at 5 kHz would take minutes. The free-run fit is
+/// reported over the same samples, and [`ModelProvenance::samples`] says
+/// how many.
+pub const GLOBAL_FIT_SAMPLES: usize = 200_000;
+
+/// Fit a global model of `kind` to the recording (its first
+/// [`GLOBAL_FIT_SAMPLES`] samples at most): the one path of every global
+/// model.
 ///
 /// Errors: those of [`fit_arx`] / [`fit_oe`] (too few samples, no
 /// excitation, no stable model); with `auto`, the last candidate's error
 /// when none succeeds.
 pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
+    if rec.len() <= GLOBAL_FIT_SAMPLES {
+        return fit_kind(rec, kind);
+    }
+    fit_kind(&rec.head(GLOBAL_FIT_SAMPLES)?, kind)
+}
+
+/// [`fit_global_model`] without the cap.
+fn fit_kind(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
     if *kind != GlobalModelKind::Auto {
         return fit_one(rec, kind);
     }
@@ -287,38 +303,6 @@ pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<Model
     }
 }
 
-/// Samples a method's global model is fitted on at most (the first ones).
-pub const GLOBAL_FIT_SAMPLES: usize = 200_000;
-
-/// The global model that goes with a sliding-window method, for the
-/// summary's `sim_fit_percent`: `arx` and `rls` → ARX with the method's
-/// orders; `oe` → OE with its poles and zeros; `auto` → [`GlobalModelKind::Auto`];
-/// `paper` → none (its model only exists per window). Fitted on at most the
-/// first [`GLOBAL_FIT_SAMPLES`] samples (a whole hour at 5 kHz would take
-/// minutes for the output-error fits); the free-run fit is over those samples.
-pub fn global_model_for(rec: &Recording, spec: &MethodSpec) -> Result<Option<ModelFile>> {
-    let kind = match spec.kind {
-        MethodKind::Paper => return Ok(None),
-        MethodKind::Arx => GlobalModelKind::Arx(spec.arx.orders),
-        MethodKind::Rls => GlobalModelKind::Arx(spec.rls.orders),
-        MethodKind::Oe => GlobalModelKind::Oe {
-            poles: spec.oe.poles,
-            zeros: spec.oe.zeros,
-        },
-        MethodKind::Auto => GlobalModelKind::Auto,
-    };
-    if rec.len() <= GLOBAL_FIT_SAMPLES {
-        return fit_global_model(rec, &kind).map(Some);
-    }
-    let n = GLOBAL_FIT_SAMPLES;
-    let head = Recording::new(
-        rec.time()[..n].to_vec(),
-        rec.command()[..n].to_vec(),
-        rec.position()[..n].to_vec(),
-    )?;
-    fit_global_model(&head, &kind).map(Some)
-}
-
 fn fit_one(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
     let (u, y, dt) = (rec.command(), rec.position(), rec.dt());
     let model = match kind {
@@ -331,7 +315,7 @@ fn fit_one(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
             };
             fit_oe(u, y, dt, &cfg)?.model
         }
-        GlobalModelKind::Auto => return fit_global_model(rec, kind),
+        GlobalModelKind::Auto => return fit_kind(rec, kind),
     };
     let sim = model.simulate_at(u, dt)?;
     let stats = ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()));

@@ -4,5 +4,7 @@
 mod global;
 mod linear;
 
-pub use global::{fit_global_model, global_model_for, GlobalModelKind, ModelFile, ModelProvenance};
+pub use global::{
+    fit_global_model, GlobalModelKind, ModelFile, ModelProvenance, GLOBAL_FIT_SAMPLES,
+};
 pub use linear::LinearModel;

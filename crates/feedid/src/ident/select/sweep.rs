@@ -16,8 +16,8 @@
 //! no numbers, never NaN.
 //!
 //! Orders (`na, nb, nk`) apply to the methods with an ARX regressor (`arx`,
-//! `rls`); other methods run once per window and horizon with their own
-//! settings. The per-window time is measured while other combinations run
+//! `rls`, and `auto`'s long-memory candidate, see [`Method::set_orders`]);
+//! other methods run once per window and horizon with their own settings. The per-window time is measured while other combinations run
 //! on the other cores.
 //!
 //! Progress is reported through a callback `progress(done, total)` (called
@@ -25,13 +25,13 @@
 //! terminal.
 //!
 //! ```
-//! use feedid::ident::{sweep, MethodKind, MethodSpec, SweepConfig};
+//! use feedid::ident::{sweep, Method, SweepConfig};
 //! use feedid::Recording;
 //! let t: Vec<f64> = (0..600).map(|k| k as f64 * 2e-4).collect();
 //! let u: Vec<f64> = t.iter().map(|&t| if t > 0.01 { 0.05 * (t - 0.01) } else { 0.0 }).collect();
 //! let rec = Recording::new(t, u.clone(), u).unwrap();
 //! let cfg = SweepConfig {
-//!     methods: vec![MethodSpec::new(MethodKind::Paper)],
+//!     methods: vec!["paper".parse::<Method>().unwrap()],
 //!     windows: vec![10, 20, 40],
 //!     horizons: vec![10],
 //!     orders: vec![],
@@ -49,7 +49,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::ident::engine::{run as run_engine, EngineConfig};
-use crate::ident::{ArxOrders, MethodKind, MethodSpec};
+use crate::ident::{ArxOrders, Method};
 use crate::recording::Recording;
 use crate::stats::sig3;
 use crate::stats::ErrorAccumulator;
@@ -61,12 +61,12 @@ pub const PAPER_WINDOW: usize = 20;
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepConfig {
     /// Methods with their settings.
-    pub methods: Vec<MethodSpec>,
+    pub methods: Vec<Method>,
     /// Window lengths W \[samples\].
     pub windows: Vec<usize>,
     /// Horizons H \[samples\].
     pub horizons: Vec<usize>,
-    /// ARX orders for `arx` and `rls`; empty = each method's own.
+    /// ARX orders for the methods that take them (`arx`, `rls`, `auto`); empty = each method's own.
     pub orders: Vec<ArxOrders>,
     /// Hop \[samples\]; `None` = the horizon (the paper's setting).
     pub hop: Option<usize>,
@@ -133,13 +133,9 @@ pub struct SweepResult {
 
 /// One combination to run.
 struct Combo {
-    spec: MethodSpec,
+    method: Method,
     order: Option<ArxOrders>,
     engine: EngineConfig,
-}
-
-fn uses_orders(kind: MethodKind) -> bool {
-    matches!(kind, MethodKind::Arx | MethodKind::Rls)
 }
 
 /// Run every combination of `cfg` over `recording` in parallel; `progress(done, total)`
@@ -177,27 +173,21 @@ pub fn sweep(
         });
     }
     let mut combos = Vec::new();
-    for spec in &cfg.methods {
-        let orders: Vec<Option<ArxOrders>> = if uses_orders(spec.kind) && !cfg.orders.is_empty() {
-            cfg.orders.iter().copied().map(Some).collect()
-        } else if spec.kind == MethodKind::Arx {
-            vec![Some(spec.arx.orders)]
-        } else if spec.kind == MethodKind::Rls {
-            vec![Some(spec.rls.orders)]
-        } else {
-            vec![None]
+    for method in &cfg.methods {
+        let orders: Vec<Option<ArxOrders>> = match method.orders() {
+            Some(_) if !cfg.orders.is_empty() => cfg.orders.iter().copied().map(Some).collect(),
+            own => vec![own],
         };
         for order in orders {
-            let mut s = spec.clone();
+            let mut m = method.clone();
             if let Some(o) = order {
-                s.arx.orders = o;
-                s.rls.orders = o;
+                m.set_orders(o)?;
             }
-            s.build()?; // settings errors are the caller's, not a row's
+            m.validate()?; // settings errors are the caller's, not a row's
             for &horizon in &cfg.horizons {
                 for &window in &cfg.windows {
                     combos.push(Combo {
-                        spec: s.clone(),
+                        method: m.clone(),
                         order,
                         engine: EngineConfig {
                             window,
@@ -215,7 +205,7 @@ pub fn sweep(
     // k₀ over the runnable combinations
     let mut common_start = 0;
     for c in &combos {
-        let warm = c.spec.build()?.warm_up();
+        let warm = c.method.build()?.warm_up();
         if c.engine.validate(n, warm).is_ok() {
             common_start = common_start.max(warm + c.engine.window);
         }
@@ -228,7 +218,7 @@ pub fn sweep(
         .par_iter()
         .map(|c| {
             let mut row = SweepRow {
-                method: c.spec.kind.name().to_string(),
+                method: c.method.name().to_string(),
                 order: c.order,
                 window: c.engine.window,
                 horizon: c.engine.horizon,
@@ -243,7 +233,7 @@ pub fn sweep(
                 error: None,
             };
             let outcome = c
-                .spec
+                .method
                 .build()
                 .and_then(|mut est| run_engine(est.as_mut(), &signals, &c.engine));
             match outcome {
@@ -473,7 +463,6 @@ impl SweepResult {
 mod tests {
     use super::*;
     use crate::drive::{RigParams, VirtualRig};
-    use crate::ident::identify;
     use crate::signal::Scenario;
 
     fn ramp() -> Recording {
@@ -487,10 +476,7 @@ mod tests {
 
     fn cfg() -> SweepConfig {
         SweepConfig {
-            methods: vec![
-                MethodSpec::new(MethodKind::Paper),
-                MethodSpec::new(MethodKind::Arx),
-            ],
+            methods: vec!["paper".parse().unwrap(), "arx".parse().unwrap()],
             windows: vec![20, 40, 80],
             horizons: vec![5, 10],
             orders: vec![ArxOrders::new(2, 2, 1), ArxOrders::new(4, 4, 1)],
@@ -527,26 +513,24 @@ mod tests {
                     && r.horizon == 10
             })
             .unwrap();
-        let mut spec = MethodSpec::new(MethodKind::Arx);
-        spec.arx.orders = ArxOrders::new(4, 4, 1);
-        let mut est = spec.build().unwrap();
-        let run = identify(
-            &rec,
+        let mut method: Method = "arx".parse().unwrap();
+        method.set_orders(ArxOrders::new(4, 4, 1)).unwrap();
+        let mut est = method.build().unwrap();
+        let run = run_engine(
             est.as_mut(),
+            &rec.signals(),
             &EngineConfig {
                 window: 40,
                 horizon: 10,
                 hop: None,
                 warm_up: 0,
             },
-            None,
         )
         .unwrap();
-        assert_eq!(r.rms_m, run.sliding.stats.rms);
-        assert_eq!(r.samples_predicted, run.sliding.stats.samples);
+        assert_eq!(r.rms_m, run.stats.rms);
+        assert_eq!(r.samples_predicted, run.stats.samples);
         let common = crate::stats::ErrorStats::from_pairs(
-            (84..rec.len())
-                .filter_map(|k| run.sliding.prediction(k).map(|p| (rec.position()[k], p))),
+            (84..rec.len()).filter_map(|k| run.prediction(k).map(|p| (rec.position()[k], p))),
         );
         assert_eq!(r.rms_common_m, common.rms);
         let best = res.best().unwrap();

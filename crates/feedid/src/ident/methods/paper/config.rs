@@ -232,6 +232,13 @@ impl PaperConfig {
     /// assert!((next[9] / y[29] - 1.0).abs() < 1e-9);
     /// ```
     pub fn build(self) -> Result<PaperMethod> {
+        self.validate()?;
+        Ok(PaperMethod::new(self))
+    }
+
+    /// Check the simplex settings (finite non-negative tolerances, positive
+    /// start step, iteration and evaluation caps of at least 1).
+    pub fn validate(&self) -> Result<()> {
         let s = &self.simplex;
         for (name, v) in [
             ("simplex.xtol_data", s.xtol_data),
@@ -260,6 +267,6 @@ impl PaperConfig {
                 reason: "must be >= 1",
             });
         }
-        Ok(PaperMethod::new(self))
+        Ok(())
     }
 }

@@ -283,3 +283,162 @@ impl<'a> Pipeline<'a> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::VirtualRig;
+    use crate::ident::{engine, ArxOrders};
+    use crate::signal::Scenario;
+
+    fn ramp() -> Recording {
+        let cmd = Scenario::Ramp.command(5000.0, 0.15, 1).unwrap();
+        let out = VirtualRig::new(RigParams::default())
+            .with_seed(3)
+            .simulate(&cmd, 5000.0)
+            .unwrap();
+        Recording::new(out.time, out.command, out.position).unwrap()
+    }
+
+    #[test]
+    fn pipeline_and_its_results_can_cross_threads() {
+        fn send<T: Send>() {}
+        send::<Pipeline<'static>>();
+        send::<Identification>();
+        send::<Method>();
+        send::<crate::pipeline::IdentifySummary>();
+    }
+
+    #[test]
+    fn predictions_are_those_of_the_engine_and_the_summary_counts_them() {
+        let rec = ramp();
+        for name in ["paper", "arx", "auto"] {
+            let method: Method = name.parse().unwrap();
+            let run = Pipeline::new(method.clone())
+                .method_global_model(false)
+                .run(&rec)
+                .unwrap();
+            let cfg = EngineConfig {
+                window: method.default_window(),
+                ..EngineConfig::default()
+            };
+            let alone =
+                engine::run(method.build().unwrap().as_mut(), &rec.signals(), &cfg).unwrap();
+            assert_eq!(run.sliding.predicted, alone.predicted, "{name}");
+            assert_eq!(run.sliding.has_prediction, alone.has_prediction, "{name}");
+            assert_eq!(run.sliding.coefficients, alone.coefficients, "{name}");
+            let s = run.summary();
+            assert_eq!(s.samples_predicted, alone.stats.samples);
+            assert_eq!(s.rms_error_m, alone.stats.rms);
+            assert_eq!(s.window, method.default_window());
+            assert!(s.global_model.is_none() && s.sim_rms_error_m.is_none());
+            let json = serde_json::to_value(&s).unwrap();
+            assert!(json.get("global_model").is_none(), "absent, not null");
+            assert!(s.to_string().starts_with(&format!(
+                "{} samples at 5000.00 Hz, method {name}, window {}",
+                rec.len(),
+                method.default_window()
+            )));
+        }
+    }
+
+    #[test]
+    fn slices_progress_nominal_model_and_extra_model_are_what_they_say() {
+        let rec = ramp();
+        let calls = std::sync::Mutex::new(Vec::new());
+        let hook = |d: u64, n: u64| calls.lock().unwrap().push((d, n));
+        let p = Pipeline::new("arx".parse().unwrap())
+            .nominal(RigParams::default())
+            .extra_model(GlobalModelKind::Arx(ArxOrders::default()))
+            .progress(&hook);
+        let a = p.run(&rec).unwrap();
+        let b = p
+            .run_slices(rec.time(), rec.command(), rec.position())
+            .unwrap();
+        assert_eq!(a.sliding.predicted, b.sliding.predicted);
+        let calls = calls.into_inner().unwrap();
+        assert_eq!(calls.last(), Some(&(rec.len() as u64, rec.len() as u64)));
+        // the nominal model over the predicted samples
+        let sim = a.simulated.as_ref().unwrap();
+        let expect = ErrorStats::from_pairs(
+            (0..rec.len())
+                .filter(|&k| a.sliding.has_prediction[k])
+                .map(|k| (rec.position()[k], sim[k])),
+        );
+        assert_eq!(a.simulation_stats, Some(expect));
+        // the extra model of the method's own kind is the method's global model
+        assert!(a.global.is_some());
+        assert_eq!(a.model, a.global);
+        let s = a.summary();
+        assert_eq!(s.global_model.as_deref(), Some("arx 8,8,1"));
+        assert!(s
+            .to_string()
+            .contains("global model of the method (arx 8,8,1)"));
+    }
+
+    #[test]
+    fn orders_are_chosen_for_regressor_methods_and_refused_for_the_others() {
+        let rec = ramp();
+        let search = OrderSearch::default();
+        let sel = select_order(rec.command(), rec.position(), rec.dt(), &search).unwrap();
+        let run = Pipeline::new("rls".parse().unwrap())
+            .select_orders(search)
+            .method_global_model(false)
+            .run(&rec)
+            .unwrap();
+        assert_eq!(run.method.orders(), Some(sel.chosen));
+        assert!(run
+            .summary()
+            .to_string()
+            .contains("  order auto (bic): na "));
+        let e = Pipeline::new("paper".parse().unwrap())
+            .select_orders(search)
+            .run(&rec)
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::NotApplicable {
+                    method: "paper",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // a failed selection says why, under its stage
+        let flat = Recording::from_rate(1000.0, vec![1e-3; 300], vec![1e-3; 300]).unwrap();
+        let e = Pipeline::new("arx".parse().unwrap())
+            .select_orders(OrderSearch::default())
+            .run(&flat)
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::Stage {
+                    stage: "order selection",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().len() > "order selection: ".len() + 5, "{e}");
+        assert!(!matches!(e.root(), Error::Stage { .. }));
+    }
+
+    #[test]
+    fn paper_windows_far_from_the_time_origin_warn() {
+        // the motion starts at 0 and the recording lasts 25 s: windows far from it
+        let n = 2000;
+        let t: Vec<f64> = (0..n).map(|k| 25.0 + k as f64 * 1e-3).collect();
+        let u: Vec<f64> = (0..n).map(|k| 1e-3 * (k as f64 * 0.01).sin()).collect();
+        let rec = Recording::new(t, u.clone(), u).unwrap();
+        let run = Pipeline::new("paper".parse().unwrap()).run(&rec).unwrap();
+        assert!(matches!(
+            run.warnings.as_slice(),
+            [Warning::PaperCoefficientAccuracy { .. }]
+        ));
+        assert!(run.warnings[0].to_string().contains("lose about"));
+        let run = Pipeline::new("arx".parse().unwrap()).run(&rec).unwrap();
+        assert!(run.warnings.is_empty());
+    }
+}

@@ -35,4 +35,5 @@ pub mod solve;
 pub mod stats;
 
 pub use error::{Error, Result};
+pub use pipeline::Pipeline;
 pub use recording::Recording;

@@ -34,7 +34,7 @@ pub struct ArxOrders {
 }
 
 impl Default for ArxOrders {
-    /// `na = 8, nb = 8, nk = 1` (chosen on the virtual rig, see [`ArxConfig`]).
+    /// `na = 8, nb = 8, nk = 1` (chosen on the virtual rig, see [`ArxConfig`](crate::ident::ArxConfig)).
     fn default() -> Self {
         Self {
             na: 8,

@@ -117,7 +117,7 @@ impl FromStr for PredictionMode {
 /// for the input fit); the coordinates are the coefficients of the
 /// unit-norm basis columns, so they carry the units of the data.
 ///
-/// The fit stops ([`Termination::Converged`]) when the simplex size is
+/// The fit stops ([`Termination::Converged`](crate::solve::Termination::Converged)) when the simplex size is
 /// `≤ xtol_data·‖b‖` and the spread of the sum of squares `f` over the
 /// simplex is `≤ ftol_data·‖b‖² + noise_factor·ε·√W·‖b‖·√f_best`. The second
 /// term is the rounding level of `f` (its residuals cancel against the data to
@@ -169,7 +169,7 @@ pub struct PaperConfig {
 
 /// Growth factor `(1 + |τ_c|/h)⁷` of the change of basis to monomial
 /// coefficients for a window spanning `τ_first … τ_last` (see
-/// [`PaperDiagnostics::shift_amplification`]); infinite for an empty span.
+/// [`PaperDiagnostics::shift_amplification`](crate::ident::PaperDiagnostics::shift_amplification)); infinite for an empty span.
 pub(super) fn shift_amplification(tau_first: f64, tau_last: f64) -> f64 {
     let centre = 0.5 * (tau_first + tau_last);
     let half = 0.5 * (tau_last - tau_first);
@@ -186,7 +186,7 @@ pub(super) fn shift_amplification(tau_first: f64, tau_last: f64) -> f64 {
 pub const SHIFT_AMPLIFICATION_WARNING: f64 = 1e8;
 
 impl PaperConfig {
-    /// The largest [`PaperDiagnostics::shift_amplification`] over the windows
+    /// The largest [`PaperDiagnostics::shift_amplification`](crate::ident::PaperDiagnostics::shift_amplification) over the windows
     /// that `config` visits on `signals` (offset 0): how far from the time
     /// origin the windows lie. Above [`SHIFT_AMPLIFICATION_WARNING`] the
     /// identified `N`, `D` lose accuracy (predictions in

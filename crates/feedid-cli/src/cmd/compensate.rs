@@ -11,7 +11,6 @@ use feedid::compensate::{
 };
 use feedid::drive::{RigEffects, VirtualRig};
 use feedid::greybox::LoopModel;
-use feedid::ident::ModelFile;
 use feedid::io::{cell, read_recording, ChannelRef, ReadOptions};
 
 use crate::args::CompensateArgs;
@@ -73,7 +72,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     let mut text = String::new();
     let (source, comp) = match (&a.model, &a.params) {
         (Some(path), _) => {
-            let file = ModelFile::load(path)?;
+            let file = crate::cmd::load_model_file(path)?;
             let comp = compensate_model(&file.model, desired, dt, &cfg)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             let how = match &file.identified_by {

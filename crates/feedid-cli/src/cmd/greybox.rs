@@ -12,9 +12,8 @@ use feedid::greybox::{
     fit_coefficients, fit_greybox, track_greybox, Dynamics, GreyboxConfig, GreyboxFit, LoopModel,
     Measurements, PhysicalParameter, TrackConfig, TrackWindow,
 };
-use feedid::ident::{LinearModel, ModelFile};
+use feedid::ident::LinearModel;
 use feedid::io::cell;
-use feedid::solve::Termination;
 
 use crate::args::GreyboxArgs;
 use crate::cmd::{check_distinct, load_effects, load_model_params, recording, Outputs};
@@ -57,7 +56,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     let mut context = serde_json::Map::new();
     let (fit, track) = match (&a.from_model, &a.input) {
         (Some(path), _) => {
-            let file = ModelFile::load(path)?;
+            let file = crate::cmd::load_model_file(path)?;
             let (num, den) = match &file.model {
                 LinearModel::Continuous { num, den } if den.len() == 8 && num.len() <= 3 => {
                     (num.clone(), den.clone())
@@ -286,10 +285,7 @@ fn report(t: &mut String, fit: &GreyboxFit) {
 }
 
 fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWindow]) {
-    let skipped = rows
-        .iter()
-        .filter(|r| r.termination == Termination::Fallback)
-        .count();
+    let skipped = rows.iter().filter(|r| !r.excited).count();
     let _ = writeln!(
         t,
         "  tracking: {} windows ({skipped} without excitation of a parameter: no estimate, the previous one kept)",
@@ -307,7 +303,7 @@ fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWin
         }
         let _ = write!(t, "  {:>9.4} {:>10.5}", r.time_s, r.nut_position_m);
         for (v, s) in r.values.iter().zip(&r.std_errors) {
-            let v = if r.termination == Termination::Fallback {
+            let v = if !r.excited {
                 "-".to_string()
             } else {
                 format!("{v:.5e}")
@@ -319,7 +315,7 @@ fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWin
                 s.map_or("-".to_string(), |s| format!("{s:.2e}"))
             );
         }
-        if r.termination == Termination::Fallback {
+        if !r.excited {
             let _ = write!(t, "  not excited");
         }
         let _ = writeln!(t);
@@ -346,14 +342,19 @@ fn write_track_csv(
         )?;
         for ((v, s), verdict) in r.values.iter().zip(&r.std_errors).zip(&r.verdicts) {
             // a window that does not determine the parameter has no estimate of it
-            let v = (r.termination != Termination::Fallback).then_some(*v);
+            let v = (r.excited).then_some(*v);
             write!(w, ",{},{},{}", cell(v), cell(*s), verdict.label())?;
         }
         writeln!(
             w,
             ",{},{}",
             cell(Some(r.residual_rms_m)),
-            r.termination.label()
+            // a window that does not excite a parameter has no estimate
+            if r.excited {
+                r.termination.label()
+            } else {
+                "not_excited"
+            }
         )?;
     }
     Ok(())

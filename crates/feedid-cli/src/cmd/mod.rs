@@ -2,8 +2,10 @@
 
 mod identify;
 mod info;
+mod method;
 mod model;
 mod order;
+mod progress;
 mod recording;
 mod reproduce;
 mod simulate;
@@ -43,7 +45,10 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 /// everywhere, not only by `feedid model`).
 pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigParams> {
     let params = match path {
-        Some(p) => feedid::drive::RigParams::load(p)?,
+        // bounded: `--params /dev/zero` must not read forever
+        Some(p) => {
+            feedid::drive::RigParams::from_toml_str(&feedid::io::read_small_text(p)?, Some(p))?
+        }
         None => feedid::drive::RigParams::default(),
     };
     feedid::drive::check_model(&params).map_err(|e| params_error(path, e))?;
@@ -73,6 +78,12 @@ pub fn load_model_params(
         eprintln!("warning: {name}: {e}");
     }
     Ok(params)
+}
+
+/// An identified model file (`--model`, `--from-model`), read with a bound.
+pub fn load_model_file(path: &Path) -> anyhow::Result<feedid::ident::ModelFile> {
+    let text = feedid::io::read_small_text(path)?;
+    Ok(feedid::ident::ModelFile::from_json_file(&text, path)?)
 }
 
 /// Rig effects from a TOML file (`--effects`): friction law, limits, noise.

@@ -48,6 +48,12 @@ pub fn read_options(a: &RecordingArgs) -> Result<ReadOptions> {
     Ok(opts)
 }
 
+/// Read and check a recording, without printing its plausibility warnings
+/// (for commands whose library call reports them, as the pipeline does).
+pub fn read(path: &Path, a: &RecordingArgs) -> Result<Recording> {
+    Ok(read_recording(path, &read_options(a)?)?)
+}
+
 /// Read and check a recording; its plausibility warnings go to standard error.
 pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
     Ok(load_checked(path, a)?.0)

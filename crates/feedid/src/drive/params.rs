@@ -402,7 +402,10 @@ impl RigParams {
 
     /// Read and validate a TOML parameter file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::io::read_small_text(path)?;
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Self::from_toml_str(&text, Some(path))
     }
 

@@ -585,21 +585,12 @@ pub fn fit_greybox(
                 .iter()
                 .enumerate()
                 .map(|(j, v)| {
+                    let even = j % 2 == 0;
                     let sign = match k % 4 {
-                        0 => {
-                            if j % 2 == 0 {
-                                1.0
-                            } else {
-                                -1.0
-                            }
-                        }
-                        1 => {
-                            if j % 2 == 0 {
-                                -1.0
-                            } else {
-                                1.0
-                            }
-                        }
+                        0 if even => 1.0,
+                        0 => -1.0,
+                        1 if even => -1.0,
+                        1 => 1.0,
                         2 => 1.0,
                         _ => -1.0,
                     };

@@ -13,8 +13,8 @@
 //! the previous window's estimate, with standard errors from the window's
 //! Jacobian and residuals as in [`super::fit_greybox`]. A window that leaves
 //! a parameter *not identifiable* (it does not excite it: a plain ramp for
-//! the stiffness) keeps the previous window's estimates, reported with
-//! termination `fallback` and no standard errors.
+//! the stiffness) keeps the previous window's estimates, reported as not
+//! excited and without standard errors.
 //!
 //! The nut position of a window is `geometry.nut_position` plus the mean
 //! measured position over the window (the virtual rig's convention: position
@@ -85,10 +85,12 @@ pub struct TrackWindow {
     pub values: Vec<f64>,
     /// Their standard errors (`None` when not determined in this window).
     pub std_errors: Vec<Option<f64>>,
-    /// How well this window determines each parameter; a window that leaves
-    /// one *not identifiable* (no excitation of it) keeps the previous
-    /// window's estimates (`termination` [`Termination::Fallback`]).
+    /// How well this window determines each parameter.
     pub verdicts: Vec<Verdict>,
+    /// Whether the window excites every parameter (no verdict *not
+    /// identifiable*); a window that does not keeps the previous window's
+    /// estimates in `values` and has no standard errors.
+    pub excited: bool,
     /// RMS of the window's residuals \[m\].
     pub residual_rms_m: f64,
     /// LM termination.
@@ -203,13 +205,11 @@ pub fn track_greybox(
         // previous estimate (on a plain ramp the stiffness would otherwise
         // run off to 1e16 N/m, "converged")
         let excited = a.verdicts.iter().all(|v| *v != Verdict::NotIdentifiable);
-        let mut termination = report.termination;
         let mut residual_ss = ss;
         if !excited {
             theta.copy_from_slice(&before);
             residual(&theta, &mut r);
             residual_ss = r.iter().map(|v| v * v).sum();
-            termination = Termination::Fallback;
         }
         let values: Vec<f64> = base.iter().zip(&theta).map(|(b, t)| b * t.exp()).collect();
         let mean = position[s..s + w].iter().sum::<f64>() / w as f64;
@@ -226,8 +226,9 @@ pub fn track_greybox(
                 .collect(),
             values,
             verdicts: a.verdicts.clone(),
+            excited,
             residual_rms_m: (residual_ss / w as f64).sqrt(),
-            termination,
+            termination: report.termination,
             iterations: report.iterations,
         });
         apply(estimate, &base, &theta, &mut ref_params, &mut ref_effects);
@@ -337,7 +338,7 @@ mod tests {
         for r in &rows {
             // never far from a plausible stiffness
             assert!(r.values[0] < 10.0 * k0 && r.values[0] > 0.1 * k0, "{r:?}");
-            if r.termination == Termination::Fallback {
+            if !r.excited {
                 fallbacks += 1;
                 assert_eq!(r.verdicts[0], Verdict::NotIdentifiable);
                 assert_eq!(r.std_errors[0], None);

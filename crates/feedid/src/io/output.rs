@@ -71,12 +71,16 @@ impl Destination {
 fn is_descriptor_path(path: &Path) -> bool {
     let parts: Vec<Component<'_>> = path.components().collect();
     let name = |i: usize| parts.get(i).and_then(|c| c.as_os_str().to_str());
-    match (parts.first(), name(1), name(2), name(3)) {
-        (Some(Component::RootDir), Some("dev"), Some("stdout" | "stderr"), None) => true,
-        (Some(Component::RootDir), Some("dev"), Some("fd"), Some(_)) => true,
-        (Some(Component::RootDir), Some("proc"), Some(_), Some("fd")) => true,
-        _ => false,
-    }
+    matches!(
+        (parts.first(), name(1), name(2), name(3)),
+        (
+            Some(Component::RootDir),
+            Some("dev"),
+            Some("stdout" | "stderr"),
+            None
+        ) | (Some(Component::RootDir), Some("dev"), Some("fd"), Some(_))
+            | (Some(Component::RootDir), Some("proc"), Some(_), Some("fd"))
+    )
 }
 
 /// Decide where an output path goes (see the module doc). Errors:

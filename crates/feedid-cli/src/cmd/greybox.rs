@@ -9,13 +9,15 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use feedid::drive::RigEffects;
 use feedid::greybox::{
-    fit_coefficients, fit_greybox, track_greybox, Dynamics, GreyboxConfig, GreyboxFit, LoopModel,
-    Measurements, PhysicalParameter, TrackConfig, TrackWindow,
+    fit_coefficients, fit_greybox_with_progress, track_greybox_with_progress, Dynamics,
+    GreyboxConfig, GreyboxFit, LoopModel, Measurements, PhysicalParameter, TrackConfig,
+    TrackWindow,
 };
 use feedid::ident::LinearModel;
 use feedid::io::cell;
 
 use crate::args::GreyboxArgs;
+use crate::cmd::progress::ProgressBar;
 use crate::cmd::{check_distinct, load_effects, load_model_params, recording, Outputs};
 
 /// Run the fit(s), write the outputs, print the report.
@@ -102,8 +104,11 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             if let Some(c) = current {
                 data = data.with_current(c);
             }
-            let fit = fit_greybox(&data, &start, &estimate, &cfg)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+            let bar = ProgressBar::new("greybox", "fits");
+            let update = |done: u64, total: u64| bar.update(done, total);
+            let fit = fit_greybox_with_progress(&data, &start, &estimate, &cfg, Some(&update));
+            bar.finish();
+            let fit = fit.map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
             let _ = writeln!(
                 text,
                 "{}: {} samples at {:.2} Hz; {} model, {} position loop; outputs: position{}",
@@ -149,7 +154,9 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                         ..TrackConfig::default()
                     };
                     let start_track = fit.params;
-                    let rows = track_greybox(
+                    let bar = ProgressBar::new("tracking", "windows");
+                    let update = |done: u64, total: u64| bar.update(done, total);
+                    let rows = track_greybox_with_progress(
                         rec.command(),
                         rec.position(),
                         rec.dt(),
@@ -157,8 +164,11 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                         &estimate,
                         &cfg,
                         &tc,
-                    )
-                    .map_err(|e| anyhow::anyhow!("{}: tracking: {e}", input.display()))?;
+                        Some(&update),
+                    );
+                    bar.finish();
+                    let rows =
+                        rows.map_err(|e| anyhow::anyhow!("{}: tracking: {e}", input.display()))?;
                     Some(rows)
                 }
                 None => None,

@@ -6,6 +6,7 @@ use feedid_report::{recording_report, RecordingAnalysis, ReportOptions};
 
 use crate::args::ReportArgs;
 use crate::cmd::method::OrderOption;
+use crate::cmd::progress::ProgressBar;
 use crate::cmd::{check_distinct, load_model_params, params_error, recording, Outputs};
 
 /// Identify with every method, build the page, write it atomically.
@@ -50,7 +51,11 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         || a.input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let mut analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| match e {
+    let bar = ProgressBar::new("report", "samples");
+    let update = |done: u64, total: u64| bar.update(done, total);
+    let analysis = RecordingAnalysis::run_with_progress(&name, rec, &opts, Some(&update));
+    bar.finish();
+    let mut analysis = analysis.map_err(|e| match e {
         // extreme but valid parameters can give no usable nominal model: say which file
         feedid_report::Error::Core(core)
             if matches!(core.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() =>

@@ -10,6 +10,7 @@ use feedid_report::experiment::{error_chart, response_chart};
 use feedid_report::paper_report;
 
 use crate::args::ReproduceArgs;
+use crate::cmd::progress::ProgressBar;
 use crate::cmd::{check_distinct, load_model_params, Outputs};
 
 /// Run ramp and step, write figures, summary.md and report.html, print the table.
@@ -20,9 +21,13 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
         solver: a.solver.parse()?,
         ..PaperExperimentConfig::default()
     };
+    // three steps of about equal length: the two experiments, the report
+    let bar = ProgressBar::new("reproduce", "steps");
+    bar.update(0, 3);
     let mut results = Vec::new();
     for s in [Scenario::Ramp, Scenario::Step] {
         results.push(run_experiment(s, &cfg)?);
+        bar.update(results.len() as u64, 3);
     }
     let mut files = Vec::new();
     for r in &results {
@@ -42,6 +47,7 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
         .map(|s| Ok(s.parse::<Method>()?))
         .collect::<Result<Vec<_>>>()?;
     let page = paper_report(&results, &cfg, &others)?;
+    bar.finish();
     files.push(("report.html".to_string(), page.to_html()));
 
     std::fs::create_dir_all(&a.out)

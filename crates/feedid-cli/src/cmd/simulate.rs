@@ -5,6 +5,7 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
+use crate::cmd::progress::ProgressBar;
 use crate::cmd::{check_distinct, load_effects, load_model_params, params_error, Outputs};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
@@ -30,9 +31,11 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let rig = VirtualRig::new(params)
         .with_effects(effects)
         .with_seed(a.seed);
-    let out = rig
-        .simulate(&command, a.rate)
-        .map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
+    let bar = ProgressBar::new("simulate", "samples");
+    let update = |done: u64, total: u64| bar.update(done, total);
+    let out = rig.simulate_with_progress(&command, a.rate, &update);
+    bar.finish();
+    let out = out.map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
     // an unstable rig (allowed by --allow-unstable) may run away: never write
     // what cannot be read back as a recording
     let channels = [

@@ -2,14 +2,13 @@
 //! order combination, in parallel, with a heat map and the best choice.
 
 use std::fmt::Write as _;
-use std::io::IsTerminal;
 
 use anyhow::{bail, Context, Result};
 use feedid::ident::{sweep, SweepConfig, SweepResult};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::SweepArgs;
 use crate::cmd::method::{parse_orders, OrderOption};
+use crate::cmd::progress::ProgressBar;
 use crate::cmd::{check_distinct, recording, Outputs};
 
 /// A comma-separated list of sample counts ≥ 1 (duplicates dropped, order kept).
@@ -29,20 +28,6 @@ fn parse_counts(flag: &str, s: &str) -> Result<Vec<usize>> {
         }
     }
     Ok(out)
-}
-
-/// A progress bar on standard error when it is a terminal; hidden otherwise (pipes, CI).
-fn progress_bar() -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template(
-        "sweep [{bar:40.cyan/blue}] {pos}/{len} combinations, {elapsed} (eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
 }
 
 /// The text table: one line per method/order/horizon, one column per window.
@@ -108,12 +93,11 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         orders,
         hop: a.hop,
     };
-    let bar = progress_bar();
+    let bar = ProgressBar::new("sweep", "combinations");
     let res = sweep(&rec, &cfg, &|done, total| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
+        bar.update(done as u64, total as u64);
     });
-    bar.finish_and_clear();
+    bar.finish();
     let res = res?;
     if !res.rows.iter().any(|r| r.ok()) {
         let why = res

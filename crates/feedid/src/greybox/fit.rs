@@ -481,6 +481,27 @@ pub fn fit_greybox(
     estimate: &[PhysicalParameter],
     cfg: &GreyboxConfig,
 ) -> Result<GreyboxFit> {
+    fit_greybox_with_progress(data, start, estimate, cfg, None)
+}
+
+/// [`fit_greybox`], reporting `progress(done, total)` in stages: the
+/// analysis at the start, each Levenberg–Marquardt pass, each restart and
+/// the analysis at the estimate (a plain callback, e.g. for a progress bar).
+pub fn fit_greybox_with_progress(
+    data: &Measurements<'_>,
+    start: &RigParams,
+    estimate: &[PhysicalParameter],
+    cfg: &GreyboxConfig,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> Result<GreyboxFit> {
+    let stages = 3 + u64::from(data.current.is_some()) + cfg.restarts as u64;
+    let mut stage = 0;
+    let mut step = || {
+        stage += 1;
+        if let Some(p) = progress {
+            p(stage.min(stages), stages);
+        }
+    };
     let base = check_set(
         estimate,
         start,
@@ -541,6 +562,7 @@ pub fn fit_greybox(
         }
     }
 
+    step();
     let mut lm = LevenbergMarquardt::new(m, n);
     let lm_cfg = LmConfig {
         ftol: cfg.tolerance,
@@ -554,6 +576,7 @@ pub fn fit_greybox(
         &mut theta,
         &lm_cfg,
     )?;
+    step();
     if data.current.is_some() {
         // second pass: each channel weighted by its residual level
         prob.eval(&theta, &mut r);
@@ -572,6 +595,7 @@ pub fn fit_greybox(
         report.evaluations += second.evaluations;
         report.termination = second.termination;
         report.residual_norm = second.residual_norm;
+        step();
     }
 
     // restarts: does the fit end where it started?
@@ -603,6 +627,7 @@ pub fn fit_greybox(
                 &lm_cfg,
             )?;
             report.evaluations += rep.evaluations;
+            step();
             prob.eval(&t, &mut r);
             let ss_k: f64 = r.iter().map(|v| v * v).sum();
             if ss_k < best_ss * (1.0 - 1e-9) {
@@ -628,6 +653,7 @@ pub fn fit_greybox(
     prob.eval(&theta, &mut r);
     let ss: f64 = r.iter().map(|v| v * v).sum();
     let mut analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
+    step();
     let (rms_y, rms_i) = prob.channel_rms();
 
     // structure left in the residuals; not measured when the fit is exact to

@@ -114,6 +114,21 @@ pub fn track_greybox(
     cfg: &GreyboxConfig,
     track: &TrackConfig,
 ) -> Result<Vec<TrackWindow>> {
+    track_greybox_with_progress(command, position, dt, start, estimate, cfg, track, None)
+}
+
+/// [`track_greybox`], reporting `progress(done, total)` in windows (a plain callback).
+#[allow(clippy::too_many_arguments)]
+pub fn track_greybox_with_progress(
+    command: &[f64],
+    position: &[f64],
+    dt: f64,
+    start: &RigParams,
+    estimate: &[PhysicalParameter],
+    cfg: &GreyboxConfig,
+    track: &TrackConfig,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> Result<Vec<TrackWindow>> {
     if cfg.dynamics != Dynamics::Linear {
         return Err(Error::InvalidChoice {
             what: "model for tracking",
@@ -160,7 +175,15 @@ pub fn track_greybox(
     let mut x = vec![0.0; 7];
 
     let mut s = 0usize;
+    let total = if len >= w {
+        ((len - w) / track.hop + 1) as u64
+    } else {
+        0
+    };
     while s + w <= len {
+        if let Some(p) = progress {
+            p(rows.len() as u64, total);
+        }
         let b = s.saturating_sub(track.warm_up).max(ref_at);
         // advance the reference to b with the latest estimate
         if b > ref_at {

@@ -43,9 +43,7 @@ fn main() -> ExitCode {
     install_signal_handlers();
     // `--scale -1e-6`, `--rate -5000`: a negative number is a value (for the
     // validators to judge), not an unknown flag
-    let matches = args::Cli::command()
-        .mut_subcommands(|c| c.allow_negative_numbers(true))
-        .get_matches();
+    let matches = numbers_take_a_minus(args::Cli::command()).get_matches();
     let cli = match args::Cli::from_arg_matches(&matches) {
         Ok(c) => c,
         Err(e) => e.exit(),
@@ -60,6 +58,28 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// `--scale -1e-6`, `--rate -5000`, `--window -5`: an option that takes a
+/// number takes a value starting with `-` (clap would read `-1e-6` as the
+/// flags `-1`, `-e`, `-6`), so that its validator names the value; any
+/// other negative number is accepted as a value too.
+fn numbers_take_a_minus(c: clap::Command) -> clap::Command {
+    use std::any::TypeId;
+    let numeric = [
+        TypeId::of::<f64>(),
+        TypeId::of::<usize>(),
+        TypeId::of::<u64>(),
+    ];
+    c.allow_negative_numbers(true)
+        .mut_args(move |a| {
+            if numeric.iter().any(|t| a.get_value_parser().type_id() == *t) {
+                a.allow_hyphen_values(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(numbers_take_a_minus)
 }
 
 /// Signals: SIGINT, SIGTERM and SIGHUP remove the temporary files of

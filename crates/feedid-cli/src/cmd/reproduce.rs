@@ -29,6 +29,21 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
         results.push(run_experiment(s, &cfg)?);
         bar.update(results.len() as u64, 3);
     }
+    // an unstable rig (allowed by --allow-unstable) runs its simulation model
+    // away: the comparison has nothing to compare then, and never prints inf
+    for r in &results {
+        let e = &r.simulation.whole;
+        if !(e.rms.is_finite() && e.max_abs.is_finite() && e.max_abs < 1e100) {
+            anyhow::bail!(
+                "{}: the nominal simulation model diverged on the {} (unstable parameters); \
+                 the paper's comparison needs a running model; nothing written",
+                a.params
+                    .as_deref()
+                    .map_or_else(|| "the rig".to_string(), |p| p.display().to_string()),
+                r.name
+            );
+        }
+    }
     let mut files = Vec::new();
     for r in &results {
         files.push((

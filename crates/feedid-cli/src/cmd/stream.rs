@@ -106,6 +106,21 @@ fn run_on<R: BufRead, W: Write, E: Write>(
         if text.is_empty() || text.starts_with('#') {
             continue;
         }
+        // lines are read as they come, so they must end with `\n` (`\r\n` is fine)
+        if text.contains('\r') {
+            counts.skipped += 1;
+            let _ = writeln!(
+                err,
+                "line {number}: carriage returns inside the line (CR-only line endings?); \
+                 end lines with LF or CR LF; skipped"
+            );
+            continue;
+        }
+        if text.contains('\0') {
+            counts.skipped += 1;
+            let _ = writeln!(err, "line {number}: NUL byte (binary data?); skipped");
+            continue;
+        }
         let first = !seen_data_line;
         seen_data_line = true;
         match parse_fields(text, &mut values[..fields]) {

@@ -88,8 +88,10 @@ pub struct TrackWindow {
     /// How well this window determines each parameter.
     pub verdicts: Vec<Verdict>,
     /// Whether the window excites every parameter (no verdict *not
-    /// identifiable*); a window that does not keeps the previous window's
-    /// estimates in `values` and has no standard errors.
+    /// identifiable* at the previous estimate nor at this one); a window
+    /// that does not keeps the previous window's estimates in `values`, has
+    /// no standard errors, and is not fitted when it fails already at the
+    /// previous estimate (`iterations` 0).
     pub excited: bool,
     /// RMS of the window's residuals \[m\].
     pub residual_rms_m: f64,
@@ -218,22 +220,41 @@ pub fn track_greybox_with_progress(
                 out.iter_mut().for_each(|v| *v = penalty);
             }
         };
+        // Does the window excite every parameter? Judged at the previous
+        // estimate, before any fit (a fit in a window that does not pin a
+        // parameter can run it off to absurd values, where the local analysis
+        // is fooled: on a plain ramp the stiffness went to 1e16 N/m,
+        // "converged"), and again at the estimate.
         let before = theta.clone();
-        let report = lm.minimize(&mut residual, &mut theta, &lm_cfg)?;
         central_jacobian(&mut residual, &theta, w, &mut r, &mut jac);
         residual(&theta, &mut r);
-        let ss: f64 = r.iter().map(|v| v * v).sum();
-        let a = analyse(&jac, w, estimate, ss, &cfg.thresholds)?;
-        // a window that does not excite a parameter cannot move it: keep the
-        // previous estimate (on a plain ramp the stiffness would otherwise
-        // run off to 1e16 N/m, "converged")
-        let excited = a.verdicts.iter().all(|v| *v != Verdict::NotIdentifiable);
+        let ss0: f64 = r.iter().map(|v| v * v).sum();
+        let pre = analyse(&jac, w, estimate, ss0, &cfg.thresholds)?;
+        let excited_before = pre.verdicts.iter().all(|v| *v != Verdict::NotIdentifiable);
+        let (a, report, ss) = if excited_before {
+            let report = lm.minimize(&mut residual, &mut theta, &lm_cfg)?;
+            central_jacobian(&mut residual, &theta, w, &mut r, &mut jac);
+            residual(&theta, &mut r);
+            let ss: f64 = r.iter().map(|v| v * v).sum();
+            (
+                analyse(&jac, w, estimate, ss, &cfg.thresholds)?,
+                Some(report),
+                ss,
+            )
+        } else {
+            (pre, None, ss0)
+        };
+        let excited = excited_before && a.verdicts.iter().all(|v| *v != Verdict::NotIdentifiable);
         let mut residual_ss = ss;
-        if !excited {
+        if !excited && theta != before {
             theta.copy_from_slice(&before);
             residual(&theta, &mut r);
             residual_ss = r.iter().map(|v| v * v).sum();
         }
+        let (termination, iterations) = match &report {
+            Some(rep) => (rep.termination, rep.iterations),
+            None => (Termination::Converged, 0),
+        };
         let values: Vec<f64> = base.iter().zip(&theta).map(|(b, t)| b * t.exp()).collect();
         let mean = position[s..s + w].iter().sum::<f64>() / w as f64;
         rows.push(TrackWindow {
@@ -251,8 +272,8 @@ pub fn track_greybox_with_progress(
             verdicts: a.verdicts.clone(),
             excited,
             residual_rms_m: (residual_ss / w as f64).sqrt(),
-            termination: report.termination,
-            iterations: report.iterations,
+            termination,
+            iterations,
         });
         apply(estimate, &base, &theta, &mut ref_params, &mut ref_effects);
         s += track.hop;

@@ -633,6 +633,25 @@ mod tests {
 
     #[cfg(unix)]
     #[test]
+    fn a_block_device_is_refused_before_anything_is_written() {
+        // classification only: nothing is ever opened for writing here
+        use std::os::unix::fs::FileTypeExt;
+        let dev = std::fs::read_dir("/dev")
+            .ok()
+            .into_iter()
+            .flatten()
+            .filter_map(|e| e.ok())
+            .find(|e| e.file_type().is_ok_and(|t| t.is_block_device()));
+        let Some(dev) = dev else { return };
+        let e = destination(&dev.path()).unwrap_err().to_string();
+        assert!(e.contains("block device"), "{e}");
+        let mut set = OutputSet::new();
+        assert!(set.add(&dev.path(), |_| Ok(())).is_err());
+        assert!(set.is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
     fn a_full_device_is_an_error_and_leaves_the_device() {
         let full = Path::new("/dev/full");
         if !full.exists() {

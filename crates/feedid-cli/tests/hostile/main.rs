@@ -24,7 +24,12 @@
 //! The inputs are small (at most a few hundred samples, a few MB for the long
 //! lines) so that the whole catalogue runs in a few seconds.
 
+mod args;
+#[path = "../common/mod.rs"]
 mod common;
+mod outputs;
+mod params;
+mod verdicts;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -186,6 +191,36 @@ fn with_bad_row(row: &str) -> Vec<u8> {
         rows(10, 0.0, 1e-3, 1.0),
         rows(30, 0.011, 1e-3, 1.0)
     ))
+}
+
+/// A first-order loop (lag 2 ms) following a 3 mm ramp at 1 kHz, 200 samples,
+/// columns scaled: command × `c`, position × `x`, time × `t`.
+fn scaled_columns(c: f64, x: f64, t: f64) -> String {
+    let mut s = String::new();
+    let mut y = 0.0;
+    for k in 0..200 {
+        let u = 3e-5 * (k as f64 - 20.0).clamp(0.0, 100.0);
+        s += &format!("{},{},{}\n", t * k as f64 * 1e-3, c * u, x * y);
+        y += 0.5 * (u - y);
+    }
+    s
+}
+
+/// The loop of [`scaled_columns`] whose position (with a 1 nm dither, so the
+/// encoder's resolution is fine) stops changing from sample 80 on while the
+/// command goes on moving.
+fn frozen_mid_move() -> String {
+    let mut s = String::new();
+    let (mut y, mut x) = (0.0, 0.0);
+    for k in 0..200 {
+        let u = 3e-5 * (k as f64 - 20.0).clamp(0.0, 100.0);
+        if k < 80 {
+            x = y + if k % 2 == 0 { 1e-9 } else { -1e-9 };
+        }
+        s += &format!("{},{u},{x}\n", k as f64 * 1e-3);
+        y += 0.5 * (u - y);
+    }
+    s
 }
 
 /// A fixture under `tests/data/`.
@@ -450,6 +485,97 @@ fn catalogue() -> Vec<Case> {
             expect: Fails(&["{file}", "no variable `time`", "qg"]),
             stream: Succeeds,
         },
+        // --- issue 15: hostile text and implausible recordings
+        Case {
+            name: "CR-only line endings",
+            file: "mac.csv",
+            bytes: csv(&good)
+                .iter()
+                .map(|&b| if b == b'\n' { b'\r' } else { b })
+                .collect(),
+            extra: &[],
+            expect: Succeeds,
+            stream: Reports(&["line 1:", "carriage returns", "skipped lines 1"]),
+        },
+        Case {
+            name: "NUL byte in a row",
+            file: "nul.csv",
+            bytes: with_bad_row("0.01,\u{0}0.001,0"),
+            extra: &[],
+            expect: Fails(&["{file}", "line 12", "NUL byte"]),
+            stream: Reports(&["line 12:", "NUL byte", "skipped lines 1"]),
+        },
+        Case {
+            name: "zeros from the first byte (/dev/zero)",
+            file: "zero.csv",
+            bytes: vec![0u8; 4 << 20],
+            extra: &[],
+            expect: Fails(&["{file}", "line 1", "NUL byte at byte 1"]),
+            stream: Reports(&["line 1: longer than"]),
+        },
+        Case {
+            name: "two columns named position_m",
+            file: "twice.csv",
+            bytes: format!(
+                "time_s,command_m,position_m,position_m\n{}",
+                good.lines().map(|l| format!("{l},0\n")).collect::<String>()
+            )
+            .into_bytes(),
+            extra: &[],
+            expect: Fails(&[
+                "{file}",
+                "line 1",
+                "position column `position_m` is ambiguous",
+                "3, 4",
+            ]),
+            stream: Reports(&["expected 3 numbers"]),
+        },
+        Case {
+            name: "dead encoder (position never changes)",
+            file: "dead.csv",
+            bytes: csv(&rows(60, 0.0, 1e-3, 1.0)
+                .lines()
+                .map(|l| {
+                    let f: Vec<&str> = l.split(',').collect();
+                    format!("{},{},0\n", f[0], f[1])
+                })
+                .collect::<String>()),
+            extra: &[],
+            expect: Reports(&["never changes", "dead encoder"]),
+            stream: Succeeds,
+        },
+        Case {
+            name: "encoder stops counting mid-move",
+            file: "frozen.csv",
+            bytes: csv(&frozen_mid_move()),
+            extra: &[],
+            expect: Reports(&["stays at", "dead encoder"]),
+            stream: Succeeds,
+        },
+        Case {
+            name: "position in mm, command in m",
+            file: "mixed_units.csv",
+            bytes: csv(&scaled_columns(1.0, 1e3, 1.0)),
+            extra: &[],
+            expect: Reports(&["10^3", "different units"]),
+            stream: Succeeds,
+        },
+        Case {
+            name: "lengths in mm read as metres",
+            file: "mm_as_m.csv",
+            bytes: csv(&scaled_columns(1e3, 1e3, 1.0)),
+            extra: &[],
+            expect: Reports(&["m/s", "--unit mm"]),
+            stream: Succeeds,
+        },
+        Case {
+            name: "time in ms read as seconds",
+            file: "ms_as_s.csv",
+            bytes: csv(&scaled_columns(1.0, 1.0, 1e3)),
+            extra: &[],
+            expect: Reports(&["lags the command", "--time-unit ms"]),
+            stream: Succeeds,
+        },
         Case {
             name: "text named .mat",
             file: "text.mat",
@@ -477,6 +603,10 @@ fn expectation(case: &Case, cmd: Cmd) -> Expect {
         ("constant signals", Cmd::Greybox) => Fails(&["{file}", "not identifiable", "Kv"]),
         // nothing moves: the warning, then no regression to solve
         ("constant signals", Cmd::Order) => Fails(&["{file}", "singular"]),
+        // at 1 Hz the rig's dynamics are invisible: Kv cannot be told (after the warning)
+        ("time in ms read as seconds", Cmd::Greybox) => Fails(&["{file}", "not identifiable"]),
+        // a position that never changes has no output energy to select terms by
+        ("dead encoder (position never changes)", Cmd::Order) => Fails(&["{file}", "singular"]),
         _ => case.expect,
     }
 }

@@ -6,7 +6,8 @@
 //! test commands ([`drive`], [`signal`]), the windowed identification methods
 //! and the sliding prediction engine ([`ident`]), solvers ([`solve`]) and
 //! file input ([`io`]); physical parameters from data ([`greybox`]) and
-//! model-based compensation of the command ([`compensate`]).
+//! model-based compensation of the command ([`compensate`]); the drive zoo,
+//! a generated family of recordings to benchmark on ([`zoo`]).
 //!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
 //! Identification of Feed Drive Systems using Nonlinear Least Squares Method".
@@ -30,6 +31,7 @@ pub mod report;
 pub mod signal;
 pub mod solve;
 pub mod stats;
+pub mod zoo;
 
 pub use error::{Error, Result};
 pub use recording::Recording;

@@ -421,7 +421,10 @@ mod tests {
             let ss = closed_loop_state_space(&p).unwrap();
             assert!((ss.dc_gain().unwrap() - 1.0).abs() < 1e-9);
             assert!(
-                rel(c.following_error_per_velocity(), (1.0 - kvff) / p.control.kv) < 1e-9
+                rel(
+                    c.following_error_per_velocity(),
+                    (1.0 - kvff) / p.control.kv
+                ) < 1e-9
                     || kvff == 1.0 && c.following_error_per_velocity().abs() < 1e-12
             );
         }
@@ -440,8 +443,8 @@ mod tests {
         let h = p.stiffness_k() * g.kpi * g.kaff * (p.inertia_j() + p.table.mass * r * r);
         let n = c.numerator();
         for s in [-300.0, -17.0, 0.5, 40.0, 2000.0] {
-            let direct = gain * (g.kv + g.kvff * s) * (s + g.ki) * (s + g.kii)
-                + h * s * s * s * (s + g.kii);
+            let direct =
+                gain * (g.kv + g.kvff * s) * (s + g.ki) * (s + g.kii) + h * s * s * s * (s + g.kii);
             let poly = n.iter().fold(0.0, |acc, &a| acc * s + a);
             assert!(rel(poly, direct) < 1e-12, "s = {s}: {poly} vs {direct}");
         }

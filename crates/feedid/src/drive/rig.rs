@@ -608,7 +608,15 @@ impl FeedForward {
         let ca = p.acceleration_feed_forward_gain();
         // b₁ = kvff·b_v with b_v = [1, Kp, Kpi·Kp/L, 0, 0, 0, 0] (velocity reference),
         // b₂ = c_a·b_i with b_i = [0, 1, Kpi/L, 0, 0, 0, 0] (current reference)
-        let b1 = [c.kvff, c.kvff * kp, c.kvff * kpi * kp / l, 0.0, 0.0, 0.0, 0.0];
+        let b1 = [
+            c.kvff,
+            c.kvff * kp,
+            c.kvff * kpi * kp / l,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ];
         let b2 = [0.0, ca, ca * kpi / l, 0.0, 0.0, 0.0, 0.0];
         // A·b₂ with the columns z_i and i of the cascade's A
         let ab2 = [

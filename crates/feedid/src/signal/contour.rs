@@ -180,7 +180,10 @@ mod tests {
         assert_eq!(xs[0], 0.0);
         assert_eq!(xc[0], 0.0);
         // two turns: the sine axis crosses zero 4 times (plus the start and end)
-        let reversals = xc.windows(3).filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < 0.0).count();
+        let reversals = xc
+            .windows(3)
+            .filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < 0.0)
+            .count();
         assert_eq!(reversals, 3, "cosine axis reverses at φ = π, 2π, 3π");
         assert!(xs.last().unwrap().abs() < 1e-12 && xc.last().unwrap().abs() < 1e-12);
     }

@@ -391,7 +391,11 @@ fn new_effects_read_from_toml_and_bad_values_are_rejected() {
         backlash_width: -1e-6,
         ..RigEffects::default()
     };
-    assert!(bad.validate().unwrap_err().to_string().contains("backlash_width"));
+    assert!(bad
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("backlash_width"));
     assert!(toml::from_str::<RigEffects>("dead_time = -1").is_err());
     let p = RigParams::from_toml_str("[control]\nkvff = 0.95\nkaff = 0.5\n", None).unwrap();
     assert_eq!((p.control.kvff, p.control.kaff), (0.95, 0.5));

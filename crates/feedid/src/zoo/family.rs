@@ -1,0 +1,420 @@
+//! The zoo itself: the standard family of generated recordings, random access
+//! by index, parallel generation.
+
+use std::ops::Range;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use rayon::prelude::*;
+
+use super::axis::{self, class_ranges, AxisInputs};
+use super::command::{self, CommandKind, Limits};
+use super::defects;
+use super::design::{log_lerp, Dim, Draws};
+use super::member::ZooMember;
+use super::servo;
+use super::spec::{AxisClass, MemberSpec, PlantKind, ServoSetup};
+use crate::drive::VirtualRig;
+use crate::error::{Error, Result};
+
+/// Seed of the standard zoo.
+pub const ZOO_SEED: u64 = 13;
+/// Members of the standard zoo without dropped rows.
+pub const STANDARD_REGULAR: usize = 210;
+/// Members of the standard zoo with dropped rows (after the regular ones).
+pub const STANDARD_GAPPED: usize = 10;
+/// Members of the small subset (the first regular members).
+pub const SMALL_MEMBERS: usize = 20;
+/// Most rows of a member's recording.
+pub const MAX_ROWS: usize = 20_000;
+/// Most samples a member's loop is simulated at (rows × decimation).
+pub const MAX_LOOP_SAMPLES: usize = 60_000;
+/// Highest position-loop rate \[Hz\].
+pub const MAX_LOOP_RATE: f64 = 20_000.0;
+/// Fewest rows of a member (unless its command is shorter).
+pub const MIN_ROWS: usize = 1000;
+
+/// A family of generated recordings (see the module doc of [`crate::zoo`]).
+///
+/// ```
+/// use feedid::zoo::Zoo;
+/// let zoo = Zoo::standard();
+/// assert_eq!(zoo.len(), 220);
+/// let m = zoo.member(3).unwrap();
+/// assert_eq!(m, zoo.member(3).unwrap()); // the same bits every time
+/// assert!(m.recording().is_ok());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Zoo {
+    seed: u64,
+    regular: usize,
+    gapped: usize,
+}
+
+impl Zoo {
+    /// The standard zoo: seed 13, 210 regular members and 10 with dropped rows.
+    pub fn standard() -> Self {
+        Self {
+            seed: ZOO_SEED,
+            regular: STANDARD_REGULAR,
+            gapped: STANDARD_GAPPED,
+        }
+    }
+
+    /// A zoo with another seed or size (member `i` depends only on the seed
+    /// and `i`, not on the size; gapped members copy regular ones).
+    pub fn new(seed: u64, regular: usize, gapped: usize) -> Result<Self> {
+        if regular == 0 && gapped > 0 {
+            return Err(Error::InvalidParameter {
+                name: "gapped",
+                value: gapped as f64,
+                reason: "gapped members copy regular ones: needs at least one regular member",
+            });
+        }
+        Ok(Self {
+            seed,
+            regular,
+            gapped,
+        })
+    }
+
+    /// Seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Number of members.
+    pub fn len(&self) -> usize {
+        self.regular + self.gapped
+    }
+
+    /// True when the zoo has no member.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Indices of the members without dropped rows (every one readable).
+    pub fn regular(&self) -> Range<usize> {
+        0..self.regular
+    }
+
+    /// Indices of the members with dropped rows.
+    pub fn gapped(&self) -> Range<usize> {
+        self.regular..self.len()
+    }
+
+    /// Indices of the small subset for fast tests: the first 20 regular
+    /// members (every plant, command and feed-forward kind, two glitched).
+    pub fn small(&self) -> Range<usize> {
+        0..SMALL_MEMBERS.min(self.regular)
+    }
+
+    /// The description of member `index` (no simulation).
+    pub fn spec(&self, index: usize) -> Result<MemberSpec> {
+        Ok(self.plan(index)?.spec)
+    }
+
+    /// Generate member `index`.
+    pub fn member(&self, index: usize) -> Result<ZooMember> {
+        simulate(self.plan(index)?)
+    }
+
+    /// Generate several members in parallel (all cores), in the order given.
+    pub fn members(&self, indices: &[usize]) -> Vec<Result<ZooMember>> {
+        indices.par_iter().map(|&i| self.member(i)).collect()
+    }
+
+    /// Describe several members in parallel, in the order given.
+    pub fn specs(&self, indices: &[usize]) -> Vec<Result<MemberSpec>> {
+        indices.par_iter().map(|&i| self.spec(i)).collect()
+    }
+
+    /// The regular member a gapped member copies.
+    fn gap_source(&self, g: usize) -> usize {
+        (g * 23 + 4) % self.regular
+    }
+
+    fn plan(&self, index: usize) -> Result<Plan> {
+        if index >= self.len() {
+            return Err(Error::InvalidParameter {
+                name: "member",
+                value: index as f64,
+                reason: "is past the last member of the zoo",
+            });
+        }
+        if index < self.regular {
+            return plan_regular(self.seed, index);
+        }
+        let source = self.gap_source(index - self.regular);
+        let mut plan = plan_regular(self.seed, source)?;
+        let mut d = Draws::new(self.seed, index);
+        let rows = defects::dropped_rows(&mut d, plan.rows);
+        let s = &mut plan.spec;
+        s.index = index;
+        s.samples = plan.rows - rows.len();
+        s.dropped_rows = rows;
+        s.gap_source = Some(source);
+        s.label = s.make_label();
+        Ok(plan)
+    }
+}
+
+/// A member before simulation.
+struct Plan {
+    spec: MemberSpec,
+    /// Command at the loop rate, `(rows − 1)·decimation + 1` samples.
+    command: Vec<f64>,
+    /// Loop samples per recorded row.
+    decimation: usize,
+    /// Rows of the uniform recording.
+    rows: usize,
+}
+
+/// Plant of member `i` (design.rs).
+fn plant_of(i: usize) -> PlantKind {
+    match i % 8 {
+        0 | 3 => PlantKind::Rig(AxisClass::Heavy),
+        1 | 4 => PlantKind::Rig(AxisClass::Conventional),
+        2 | 5 => PlantKind::Rig(AxisClass::Stiff),
+        6 => PlantKind::FirstOrder,
+        _ => PlantKind::SecondOrder,
+    }
+}
+
+/// Range of Kv \[1/s\] of the servo members.
+const SERVO_KV: (f64, f64) = (10.0, 3000.0);
+
+fn plan_regular(seed: u64, i: usize) -> Result<Plan> {
+    let mut d = Draws::new(seed, i);
+    let plant = plant_of(i);
+    let kind = CommandKind::of(i);
+    let (kv_range, amplitude_max) = match plant {
+        PlantKind::Rig(c) => {
+            let r = class_ranges(c);
+            (r.kv, r.amplitude_max)
+        }
+        _ => (SERVO_KV, 1.0),
+    };
+    let kv_asked = d.log_in(Dim::Kv, kv_range);
+    // recording rate: a loop of Kv·Δt ≤ 0.15 within 20 samples per row
+    let rate_lo = (kv_asked / (0.15 * 20.0)).max(100.0);
+    let rate = d.log_in(Dim::Rate, (rate_lo, MAX_LOOP_RATE));
+    let loop_min = (kv_asked / 0.15).max(250.0);
+    let mut decimation = ((loop_min / rate) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+    while decimation > 1 && rate * decimation as f64 > MAX_LOOP_RATE * (1.0 + 1e-12) {
+        decimation -= 1;
+    }
+    let decimation = decimation.min(20);
+    let loop_rate = rate * decimation as f64;
+    let amplitude = d.log_in(Dim::Amplitude, (1e-4, amplitude_max));
+    let resolution = d.log_in(Dim::Resolution, (1e-9, 2e-5));
+    let u_noise = d.u(Dim::Noise);
+    let noise_std = if u_noise < 0.1 {
+        0.0
+    } else {
+        resolution * log_lerp(0.05, 3.0, (u_noise - 0.1) / 0.9)
+    };
+    let dead_time = ((d.u(Dim::DeadTime) * 4.0) as usize).min(3);
+    let ff_mode = (i / 7) % 3;
+    let kvff = if ff_mode > 0 {
+        d.lin_in(Dim::Kvff, (0.8, 1.0))
+    } else {
+        0.0
+    };
+    let kaff = if ff_mode == 2 && matches!(plant, PlantKind::Rig(_)) {
+        d.lin_in(Dim::Kaff, (0.5, 1.0))
+    } else {
+        0.0
+    };
+    let max_rows = MAX_ROWS.min(MAX_LOOP_SAMPLES / decimation);
+    let wanted = d.log_in(Dim::Duration, (1.0, 5.0));
+    let rows0 = ((wanted * rate).round() as usize).clamp(MIN_ROWS, max_rows);
+    let loop_dt = 1.0 / loop_rate;
+
+    let mut friction_share = 0.0;
+    let mut backlash = 0.0;
+    let (kv, velocity_bandwidth, velocity, acceleration, rig, servo_setup, mass, mode, placed);
+    let stability;
+    match plant {
+        PlantKind::Rig(class) => {
+            friction_share = d.lin_in(Dim::Friction, (0.0, 0.1));
+            if d.u(Dim::Backlash) < 0.35 {
+                backlash = d.lin_in(Dim::BacklashWidth, (1e-6, 2e-5));
+            }
+            let placed_mode_hz = (d.u(Dim::Resonance) < 0.3)
+                .then(|| d.log_in(Dim::ResonanceFrequency, (20.0, 300.0)));
+            let a = axis::build(
+                &mut d,
+                &AxisInputs {
+                    class,
+                    kv: kv_asked,
+                    stroke: amplitude,
+                    kvff,
+                    kaff,
+                    friction_share,
+                    backlash,
+                    placed_mode_hz,
+                    resolution,
+                    noise_std,
+                    dead_time: dead_time * decimation,
+                    loop_dt,
+                },
+            )?;
+            kv = a.kv;
+            velocity_bandwidth = Some(a.velocity_bandwidth);
+            velocity = a.velocity;
+            acceleration = a.acceleration;
+            rig = Some(a.setup);
+            servo_setup = None;
+            mass = Some(a.mass);
+            mode = Some(a.axial_mode_hz);
+            placed = a.placed;
+            stability = a.stability;
+        }
+        PlantKind::FirstOrder | PlantKind::SecondOrder => {
+            let zeta = d.lin_in(Dim::ServoDamping, (0.35, 1.2));
+            let s = ServoSetup {
+                kv: kv_asked,
+                velocity_bandwidth: (plant == PlantKind::SecondOrder)
+                    .then_some(4.0 * zeta * zeta * kv_asked),
+                kvff,
+            };
+            kv = kv_asked;
+            velocity_bandwidth = s.velocity_bandwidth;
+            velocity = d.log_in(Dim::Velocity, (0.05, 2.0));
+            acceleration = d.log_in(Dim::Acceleration, (2.0, 50.0));
+            stability = servo::check(&s, loop_dt)?;
+            rig = None;
+            servo_setup = Some(s);
+            mass = None;
+            mode = None;
+            placed = false;
+        }
+    }
+
+    let limits = Limits {
+        amplitude,
+        velocity,
+        acceleration,
+        kv,
+        rate,
+        loop_rate,
+        duration: rows0 as f64 / rate,
+        max_duration: max_rows as f64 / rate,
+    };
+    let (command_spec, duration) = command::plan(kind, &limits, &mut d);
+    let rows = ((duration * rate).round() as usize).clamp(2, max_rows);
+    let command = command::sample(&command_spec, loop_rate, (rows - 1) * decimation + 1)?;
+    let amplitude_m = command
+        .iter()
+        .step_by(decimation)
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let glitches = if i % 12 == 5 {
+        defects::glitches(&mut d, rows, amplitude_m)
+    } else {
+        Vec::new()
+    };
+    let noise_seed = d.seed();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let mut spec = MemberSpec {
+        index: i,
+        label: String::new(),
+        plant,
+        rate_hz: rate,
+        loop_rate_hz: loop_rate,
+        samples: rows,
+        duration_s: rows as f64 / rate,
+        kv,
+        velocity_bandwidth_hz: velocity_bandwidth.map(|w| w / two_pi),
+        kvff,
+        kaff,
+        mass_kg: mass,
+        axial_mode_hz: mode,
+        resonance_placed: placed,
+        friction_share,
+        backlash_m: backlash,
+        dead_time_samples: dead_time,
+        resolution_m: resolution,
+        noise_std_m: noise_std,
+        amplitude_m,
+        command: command_spec,
+        glitches,
+        dropped_rows: Vec::new(),
+        gap_source: None,
+        noise_seed,
+        stability,
+        rig,
+        servo: servo_setup,
+    };
+    spec.label = spec.make_label();
+    Ok(Plan {
+        spec,
+        command,
+        decimation,
+        rows,
+    })
+}
+
+/// Simulate a planned member.
+fn simulate(plan: Plan) -> Result<ZooMember> {
+    let Plan {
+        spec,
+        command,
+        decimation: m,
+        rows,
+    } = plan;
+    let loop_dt = 1.0 / spec.loop_rate_hz;
+    let (measured, truth) = if let Some(rig) = &spec.rig {
+        let out = VirtualRig::new(rig.params)
+            .with_effects(rig.effects)
+            .with_seed(spec.noise_seed)
+            .with_max_step(rig.max_step)
+            .simulate(&command, spec.loop_rate_hz)?;
+        (out.position, out.true_position)
+    } else if let Some(s) = &spec.servo {
+        let delay = spec.dead_time_samples * m;
+        let delayed: Vec<f64> = (0..command.len())
+            .map(|k| command[k.saturating_sub(delay)])
+            .collect();
+        let truth = servo::simulate(s, &delayed, loop_dt)?;
+        let q = spec.resolution_m;
+        let noise = Normal::new(0.0, spec.noise_std_m).map_err(|_| Error::InvalidParameter {
+            name: "noise_std",
+            value: spec.noise_std_m,
+            reason: "must be finite and >= 0",
+        })?;
+        let mut rng = ChaCha8Rng::seed_from_u64(spec.noise_seed);
+        let measured = truth
+            .iter()
+            .map(|&x| (x / q).round() * q + noise.sample(&mut rng))
+            .collect();
+        (measured, truth)
+    } else {
+        return Err(Error::InvalidModel {
+            reason: "zoo member without a plant",
+        });
+    };
+    let keep = |k: usize| !spec.dropped_rows.binary_search(&k).is_ok();
+    let pick =
+        |v: &[f64]| -> Vec<f64> { (0..rows).filter(|&k| keep(k)).map(|k| v[k * m]).collect() };
+    let time: Vec<f64> = (0..rows)
+        .filter(|&k| keep(k))
+        .map(|k| k as f64 / spec.rate_hz)
+        .collect();
+    let mut position: Vec<f64> = (0..rows).map(|k| measured[k * m]).collect();
+    for g in &spec.glitches {
+        position[g.index] += g.offset;
+    }
+    let position = (0..rows)
+        .filter(|&k| keep(k))
+        .map(|k| position[k])
+        .collect();
+    Ok(ZooMember {
+        time,
+        command: pick(&command),
+        position,
+        truth: pick(&truth),
+        spec,
+    })
+}

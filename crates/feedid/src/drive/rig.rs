@@ -76,7 +76,9 @@
 //!   `dz_b(δ) = δ − clamp(δ, −b/2, b/2)`: inside the play the screw transmits
 //!   no force and the table coasts on its friction and damping. The position
 //!   loop closes on the table encoder, so the play shows as lost motion at
-//!   reversals.
+//!   reversals; in a stiff loop (the default rig's) the dead band lets the
+//!   axis hunt in a limit cycle of the order of the play even on a steady
+//!   move, as real axes with linear scales and worn screws do.
 //! * **Dead time** (`dead_time` = d samples, default 0): the loop acts on the
 //!   command `d` samples late, `x_s[k − d]` (set-point transport to the drive),
 //!   while the recorded command is `x_s[k]`; the command before the first

@@ -45,7 +45,7 @@ impl ZooMember {
 
     /// Write `time_s,command_m,position_m,true_position_m` (a file
     /// `feedid identify` reads with no options; shortest round-trip numbers).
-    pub fn write_csv<W: Write>(&self, w: &mut W) -> std::io::Result<()> {
+    pub fn write_csv<W: Write + ?Sized>(&self, w: &mut W) -> std::io::Result<()> {
         writeln!(w, "time_s,command_m,position_m,true_position_m")?;
         for k in 0..self.len() {
             writeln!(

@@ -21,7 +21,7 @@
 //! | feed-forward | none / velocity (kvff 0.8 … 1) / velocity and acceleration (kaff 0.5 … 1, rig), a third each |
 //! | moving mass | 0.5 … 500 kg (rig) |
 //! | friction | Coulomb + Stribeck, 0 … 10 % of the drive's peak force (rig) |
-//! | backlash | 1 … 20 µm on 35 % of the rig members |
+//! | backlash | 1 … 20 µm on 35 % of the rig members (stiff loops then hunt in a small limit cycle, as real ones do) |
 //! | resonance | the axial two-mass mode of each rig member; placed at 20 … 300 Hz on ~30 % |
 //! | dead time | 0 … 3 recorded samples (set-point to drive) |
 //! | encoder | resolution 1 nm … 20 µm; noise 0 (10 %) or 0.05 … 3 counts |

@@ -235,3 +235,41 @@ fn unknown_members_are_an_error_not_a_panic() {
     assert!(zoo.spec(usize::MAX).is_err());
     assert!(Zoo::new(1, 0, 3).is_err());
 }
+
+#[test]
+fn run_plant_on_the_members_own_command_gives_its_recording() {
+    let zoo = Zoo::standard();
+    let mut exact = 0;
+    for i in zoo.small() {
+        let m = zoo.member(i).unwrap();
+        let s = &m.spec;
+        let run = s.run_plant(&m.command, s.noise_seed).unwrap();
+        assert_eq!(run.time, m.time);
+        if s.decimation() == 1 {
+            // the same loop samples: bit for bit
+            exact += 1;
+            assert_eq!(run.truth, m.truth, "member {i}");
+            for (k, (a, b)) in run.position.iter().zip(&m.position).enumerate() {
+                if s.glitches.iter().all(|g| g.index != k) {
+                    assert_eq!(a, b, "member {i} row {k}");
+                }
+            }
+        } else {
+            // the loop sees the interpolated command instead of the
+            // generator's: close, except right after steps
+            let scale = s.amplitude_m;
+            let d = (run
+                .truth
+                .iter()
+                .zip(&m.truth)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+                / m.len() as f64)
+                .sqrt();
+            assert!(d < 0.05 * scale, "member {i}: rms {d} of {scale}");
+        }
+    }
+    assert!(exact >= 5, "{exact}");
+    assert!(zoo.spec(0).unwrap().run_plant(&[0.0], 1).is_err());
+    assert!(zoo.spec(0).unwrap().run_plant(&[0.0, f64::NAN], 1).is_err());
+}

@@ -3,9 +3,6 @@
 
 use std::ops::Range;
 
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
 
 use super::axis::{self, class_ranges, AxisInputs};
@@ -13,9 +10,8 @@ use super::command::{self, CommandKind, Limits};
 use super::defects;
 use super::design::{log_lerp, Dim, Draws};
 use super::member::ZooMember;
-use super::servo;
 use super::spec::{AxisClass, MemberSpec, PlantKind, ServoSetup};
-use crate::drive::VirtualRig;
+use super::{plant, servo};
 use crate::error::{Error, Result};
 
 /// Seed of the standard zoo.
@@ -364,37 +360,7 @@ fn simulate(plan: Plan) -> Result<ZooMember> {
         decimation: m,
         rows,
     } = plan;
-    let loop_dt = 1.0 / spec.loop_rate_hz;
-    let (measured, truth) = if let Some(rig) = &spec.rig {
-        let out = VirtualRig::new(rig.params)
-            .with_effects(rig.effects)
-            .with_seed(spec.noise_seed)
-            .with_max_step(rig.max_step)
-            .simulate(&command, spec.loop_rate_hz)?;
-        (out.position, out.true_position)
-    } else if let Some(s) = &spec.servo {
-        let delay = spec.dead_time_samples * m;
-        let delayed: Vec<f64> = (0..command.len())
-            .map(|k| command[k.saturating_sub(delay)])
-            .collect();
-        let truth = servo::simulate(s, &delayed, loop_dt)?;
-        let q = spec.resolution_m;
-        let noise = Normal::new(0.0, spec.noise_std_m).map_err(|_| Error::InvalidParameter {
-            name: "noise_std",
-            value: spec.noise_std_m,
-            reason: "must be finite and >= 0",
-        })?;
-        let mut rng = ChaCha8Rng::seed_from_u64(spec.noise_seed);
-        let measured = truth
-            .iter()
-            .map(|&x| (x / q).round() * q + noise.sample(&mut rng))
-            .collect();
-        (measured, truth)
-    } else {
-        return Err(Error::InvalidModel {
-            reason: "zoo member without a plant",
-        });
-    };
+    let (measured, truth) = plant::run_loop(&spec, &command, spec.noise_seed)?;
     let keep = |k: usize| !spec.dropped_rows.binary_search(&k).is_ok();
     let pick =
         |v: &[f64]| -> Vec<f64> { (0..rows).filter(|&k| keep(k)).map(|k| v[k * m]).collect() };

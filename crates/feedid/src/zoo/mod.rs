@@ -9,7 +9,9 @@
 //! [`Zoo::small`] is the first 20 (every plant, command and feed-forward kind,
 //! two with glitches) for fast tests. Each [`ZooMember`] carries its
 //! [`MemberSpec`] (every parameter drawn, a label), the recording (time,
-//! command, measured position) and the truth (the noise-free position).
+//! command, measured position) and the truth (the noise-free position);
+//! [`MemberSpec::run_plant`] runs the same axis on any other command (an
+//! identification excitation, a compensated command).
 //!
 //! # What the zoo spans
 //!
@@ -51,6 +53,7 @@ mod defects;
 mod design;
 mod family;
 mod member;
+mod plant;
 mod servo;
 mod spec;
 
@@ -59,6 +62,7 @@ pub use family::{
     STANDARD_REGULAR, ZOO_SEED,
 };
 pub use member::ZooMember;
+pub use plant::PlantRun;
 pub use spec::{
     AxisClass, CommandSpec, Glitch, MemberSpec, PlantKind, RigSetup, ServoSetup, Stability,
 };

@@ -13,8 +13,10 @@
 //! | contour | R = A (sine axis) or A/2 (cosine axis) | feed `min(v, √(a·R), 2π·R·f_c)` with `f_c = min(10 Hz, rate/20)` turns per second, 0.5–10 turns |
 //!
 //! When a move does not fit, the recording is lengthened up to its sample
-//! cap, then the amplitude is reduced (the manifest records the amplitude
-//! actually commanded).
+//! cap; the zoo then lowers the recording rate (a trace buffer of fixed size
+//! records a long move at a lower rate, down to the lowest rate the loop
+//! allows), and only then is the amplitude reduced (the manifest records the
+//! amplitude actually commanded).
 
 use super::design::{Dim, Draws};
 use super::spec::CommandSpec;
@@ -69,8 +71,28 @@ pub(crate) struct Limits {
     pub max_duration: f64,
 }
 
-/// A planned command and the member's length \[s\].
-pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSpec, f64) {
+/// A planned command.
+pub(crate) struct Planned {
+    /// The command.
+    pub spec: CommandSpec,
+    /// The member's length \[s\].
+    pub duration: f64,
+    /// The length the command would need at the amplitude asked \[s\]
+    /// (above `max_duration` when the amplitude was reduced).
+    pub needed: f64,
+}
+
+/// Plan the command of a member (see the module doc).
+pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> Planned {
+    let (spec, duration, needed) = plan_kind(kind, lim, d);
+    Planned {
+        spec,
+        duration,
+        needed: needed.max(duration),
+    }
+}
+
+fn plan_kind(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSpec, f64, f64) {
     let rest = (10.0 / lim.rate).max(0.01);
     let v = lim.velocity * d.lin_in(Dim::CommandSpeed, (0.2, 0.8));
     let a = lim.acceleration * d.lin_in(Dim::CommandAcceleration, (0.2, 0.6));
@@ -93,7 +115,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                 velocity: speed,
                 rest,
             };
-            (CommandSpec::Ramp(ramp), t)
+            (CommandSpec::Ramp(ramp), t, needed)
         }
         CommandKind::Step => {
             let step = Step {
@@ -101,7 +123,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                 rise_time: 1.0 / lim.loop_rate,
                 rest,
             };
-            (CommandSpec::Step(step), t)
+            (CommandSpec::Step(step), t, t)
         }
         CommandKind::Scurve => {
             let sign = d.sign();
@@ -112,6 +134,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                 jerk,
                 rest,
             };
+            let needed = (rest + s.plan().duration()) / 0.8;
             loop {
                 let needed = (rest + s.plan().duration()) / 0.8;
                 if needed <= t {
@@ -123,7 +146,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                 }
                 s.distance *= 0.7;
             }
-            (CommandSpec::Scurve(s), t)
+            (CommandSpec::Scurve(s), t, needed)
         }
         CommandKind::Sweep => {
             let mut amp = amp.min(0.01);
@@ -153,7 +176,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                 taper: 0.1 * (t - rest),
                 rest,
             };
-            (CommandSpec::Sweep(chirp), t)
+            (CommandSpec::Sweep(chirp), t, t)
         }
         CommandKind::Square => {
             let lo = (16.0 / lim.kv).max(20.0 / lim.rate).max(0.05);
@@ -169,7 +192,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                 edge_time: 0.0,
                 rest,
             };
-            (CommandSpec::Square(sq), t)
+            (CommandSpec::Square(sq), t, t)
         }
         CommandKind::PointToPoint => {
             let dwell_min = d.log_uniform(0.02, 0.2);
@@ -184,6 +207,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                 min_move: 0.1,
                 rest,
             };
+            let mut needed = 0.0;
             loop {
                 // three moves over the whole range
                 let one = Scurve {
@@ -193,18 +217,21 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                     jerk,
                     rest: 0.0,
                 };
-                let needed = rest + 3.0 * (one.plan().duration() + dwell_max);
-                if needed <= t {
+                let need = rest + 3.0 * (one.plan().duration() + dwell_max);
+                if needed == 0.0 {
+                    needed = need;
+                }
+                if need <= t {
                     break;
                 }
-                if needed <= lim.max_duration {
-                    t = needed;
+                if need <= lim.max_duration {
+                    t = need;
                     break;
                 }
                 p.amplitude *= 0.7;
             }
             let seed = d.seed();
-            (CommandSpec::PointToPoint { program: p, seed }, t)
+            (CommandSpec::PointToPoint { program: p, seed }, t, needed)
         }
         CommandKind::Contour => {
             let axis = if d.rng_bool() {
@@ -219,6 +246,7 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
             // circles of at most 10 Hz and 20 rows per turn
             let turn_rate = (lim.rate / 20.0).min(10.0);
             let mut c;
+            let mut needed = 0.0;
             loop {
                 let feed = v.min((a * radius).sqrt()).min(two_pi * turn_rate * radius);
                 let turn = two_pi * radius / feed;
@@ -232,17 +260,20 @@ pub(crate) fn plan(kind: CommandKind, lim: &Limits, d: &mut Draws) -> (CommandSp
                     axis,
                     rest,
                 };
-                let needed = c.end_of_motion() / 0.9;
-                if needed <= t {
+                let need = c.end_of_motion() / 0.9;
+                if needed == 0.0 {
+                    needed = need;
+                }
+                if need <= t {
                     break;
                 }
-                if needed <= lim.max_duration {
-                    t = needed;
+                if need <= lim.max_duration {
+                    t = need;
                     break;
                 }
                 radius *= 0.7;
             }
-            (CommandSpec::Contour(c), t)
+            (CommandSpec::Contour(c), t, needed)
         }
     }
 }

@@ -61,7 +61,7 @@ mod tests {
     #[test]
     fn glitches_are_isolated_and_inside_the_recording() {
         for i in 0..50 {
-            let mut d = Draws::new(13, i);
+            let mut d = Draws::new(13, i, 210);
             let g = glitches(&mut d, 2000, 0.01);
             assert!((1..=3).contains(&g.len()));
             for w in g.windows(2) {
@@ -77,7 +77,7 @@ mod tests {
     #[test]
     fn dropped_rows_are_short_runs_in_the_middle() {
         for i in 0..50 {
-            let mut d = Draws::new(13, i);
+            let mut d = Draws::new(13, i, 210);
             let rows = dropped_rows(&mut d, 3000);
             assert!((1..=6).contains(&rows.len()), "{rows:?}");
             assert!(rows.iter().all(|&r| (600..2400).contains(&r)), "{rows:?}");

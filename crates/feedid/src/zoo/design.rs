@@ -15,17 +15,20 @@
 //! glitches      = i mod 12 = 5
 //! ```
 //!
-//! A continuous parameter `d` of member `i` is placed at the quantile
-//! `u_d(i) = frac(β_d + i·α_d)` of its range (an additive-recurrence / Weyl
-//! sequence), `α_d = frac(√p_d)` for the d-th prime `p_d` and offsets `β_d`
-//! from the zoo seed, stretched so that the outer 3 % of quantiles at each
-//! end sit exactly on the range's bounds. Rationally independent `α_d` make the points
-//! equidistributed in the unit cube (Kronecker), also on every residue class
-//! of `i`, so each axis class spans its ranges too. Minor choices (the
-//! direction of a move, the sweep law, targets of point-to-point moves, noise,
-//! glitch positions) come from a ChaCha8 generator seeded with the zoo seed
-//! on stream `i`.
+//! Each continuous parameter is drawn by Latin-hypercube sampling within
+//! the member's plant group (heavy, conventional and stiff rig, first- and
+//! second-order servo: 26–53 members each in the standard zoo): the `N_g`
+//! members of group `g` take the quantiles `(π(j) + ½)/N_g` of the range,
+//! `j` the member's place in its group and `π` a permutation seeded by the
+//! zoo seed, the dimension and the group, independent between dimensions.
+//! The quantiles are stretched so that the outer 3 % at each end sit exactly
+//! on the bounds: every group reaches both ends of each of its ranges, and
+//! member `i` depends only on the seed, `i` and the number of regular members.
+//! Minor choices (the direction of a move, the sweep law, targets of
+//! point-to-point moves, noise, glitch positions) come from a ChaCha8
+//! generator seeded with the zoo seed on stream `i`.
 
+use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -94,41 +97,51 @@ pub(crate) enum Dim {
 /// Number of design dimensions.
 const DIMS: usize = Dim::CommandAcceleration as usize + 1;
 
-/// The first primes, one per dimension (α_d = frac(√p_d)).
-const PRIMES: [u64; DIMS] = [
-    2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79, 83, 89, 97,
-    101, 103, 107,
-];
+/// Plant group of member `i`: 0 heavy, 1 conventional, 2 stiff rig,
+/// 3 first-order, 4 second-order servo (`i mod 8` as in the module doc).
+pub(crate) fn plant_group(i: usize) -> usize {
+    match i % 8 {
+        0 | 3 => 0,
+        1 | 4 => 1,
+        2 | 5 => 2,
+        6 => 3,
+        _ => 4,
+    }
+}
 
 /// The quantiles of one member and its own random stream.
+#[derive(Clone)]
 pub(crate) struct Draws {
-    index: usize,
-    offsets: [f64; DIMS],
-    /// The member's generator (ChaCha8, zoo seed, stream = index).
+    quantiles: [f64; DIMS],
+    /// The member's generator (ChaCha8, zoo seed, stream = index + 1).
     pub rng: ChaCha8Rng,
 }
 
 impl Draws {
-    /// Draws of member `index` of the zoo with `seed`.
-    pub fn new(seed: u64, index: usize) -> Self {
-        let mut offsets_rng = ChaCha8Rng::seed_from_u64(seed);
-        let offsets = std::array::from_fn(|_| offsets_rng.random::<f64>());
+    /// Draws of member `index` of a zoo with `seed` and `regular` regular
+    /// members (members past them only use the generator).
+    pub fn new(seed: u64, index: usize, regular: usize) -> Self {
+        let mut quantiles = [0.5; DIMS];
+        if index < regular {
+            let g = plant_group(index);
+            let place = (0..index).filter(|&k| plant_group(k) == g).count();
+            let size = (0..regular).filter(|&k| plant_group(k) == g).count();
+            for (d, q) in quantiles.iter_mut().enumerate() {
+                let mut perm: Vec<usize> = (0..size).collect();
+                let mut shuffle = ChaCha8Rng::seed_from_u64(seed);
+                shuffle.set_stream(1 << 32 | (d as u64) << 8 | g as u64);
+                perm.shuffle(&mut shuffle);
+                *q = (perm[place] as f64 + 0.5) / size as f64;
+            }
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(index as u64 + 1);
-        Self {
-            index,
-            offsets,
-            rng,
-        }
+        Self { quantiles, rng }
     }
 
-    /// Quantile `u_d(i) ∈ [0, 1)` of dimension `d`.
+    /// Quantile `u_d ∈ (0, 1)` of dimension `d` (before stretching).
     pub fn u(&self, d: Dim) -> f64 {
-        let k = d as usize;
-        let alpha = (PRIMES[k] as f64).sqrt().fract();
-        // i·α mod 1 computed without losing digits for large i
-        let step = (self.index as f64 * alpha).fract();
-        (self.offsets[k] + step).fract()
+        self.quantiles[d as usize]
     }
 
     /// Log-uniform value in `[lo, hi]` at the stretched quantile of `d`.
@@ -192,31 +205,43 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_dimension_spreads_evenly_over_two_hundred_members() {
-        // an equidistributed sequence: every tenth of [0, 1) gets 21 ± 4 of 210
+    fn every_group_takes_every_quantile_stratum_once_per_dimension() {
+        let regular = 210;
         for k in 0..DIMS {
-            let d: Dim = dim_at(k);
-            let mut bins = [0usize; 10];
-            for i in 0..210 {
-                let u = Draws::new(13, i).u(d);
-                assert!((0.0..1.0).contains(&u));
-                bins[(u * 10.0) as usize] += 1;
+            let d = dim_at(k);
+            for g in 0..5 {
+                let mut u: Vec<f64> = (0..regular)
+                    .filter(|&i| plant_group(i) == g)
+                    .map(|i| Draws::new(13, i, regular).u(d))
+                    .collect();
+                u.sort_by(f64::total_cmp);
+                let n = u.len() as f64;
+                for (j, v) in u.iter().enumerate() {
+                    assert!((v - (j as f64 + 0.5) / n).abs() < 1e-12, "{d:?} group {g}");
+                }
+                // the stretch puts both ends on the bounds
+                assert_eq!(stretch(u[0]), 0.0);
+                assert_eq!(stretch(u[u.len() - 1]), 1.0);
             }
-            assert!(
-                bins.iter().all(|&b| (17..=25).contains(&b)),
-                "{d:?} {bins:?}"
-            );
         }
     }
 
     #[test]
     fn the_same_seed_and_index_give_the_same_draws() {
-        let mut a = Draws::new(13, 42);
-        let mut b = Draws::new(13, 42);
+        let mut a = Draws::new(13, 42, 210);
+        let mut b = Draws::new(13, 42, 210);
         assert_eq!(a.u(Dim::Kv), b.u(Dim::Kv));
         assert_eq!(a.seed(), b.seed());
-        let mut c = Draws::new(13, 43);
-        assert_ne!(Draws::new(13, 42).seed(), c.seed());
+        let mut c = Draws::new(13, 43, 210);
+        assert_ne!(Draws::new(13, 42, 210).seed(), c.seed());
+        // dimensions are paired at random, not in lockstep
+        let same = (0..210)
+            .filter(|&i| {
+                let d = Draws::new(13, i, 210);
+                d.u(Dim::Kv) == d.u(Dim::Mass)
+            })
+            .count();
+        assert!(same < 10, "{same}");
     }
 
     fn dim_at(k: usize) -> Dim {

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use super::axis::{self, class_ranges, AxisInputs};
 use super::command::{self, CommandKind, Limits};
 use super::defects;
-use super::design::{log_lerp, Dim, Draws};
+use super::design::{log_lerp, plant_group, Dim, Draws};
 use super::member::ZooMember;
 use super::spec::{AxisClass, MemberSpec, PlantKind, ServoSetup};
 use super::{plant, servo};
@@ -58,8 +58,8 @@ impl Zoo {
         }
     }
 
-    /// A zoo with another seed or size (member `i` depends only on the seed
-    /// and `i`, not on the size; gapped members copy regular ones).
+    /// A zoo with another seed or size (member `i` depends on the seed, `i`
+    /// and the number of regular members; gapped members copy regular ones).
     pub fn new(seed: u64, regular: usize, gapped: usize) -> Result<Self> {
         if regular == 0 && gapped > 0 {
             return Err(Error::InvalidParameter {
@@ -140,11 +140,11 @@ impl Zoo {
             });
         }
         if index < self.regular {
-            return plan_regular(self.seed, index);
+            return plan_regular(self.seed, self.regular, index);
         }
         let source = self.gap_source(index - self.regular);
-        let mut plan = plan_regular(self.seed, source)?;
-        let mut d = Draws::new(self.seed, index);
+        let mut plan = plan_regular(self.seed, self.regular, source)?;
+        let mut d = Draws::new(self.seed, index, self.regular);
         let rows = defects::dropped_rows(&mut d, plan.rows);
         let s = &mut plan.spec;
         s.index = index;
@@ -169,11 +169,11 @@ struct Plan {
 
 /// Plant of member `i` (design.rs).
 fn plant_of(i: usize) -> PlantKind {
-    match i % 8 {
-        0 | 3 => PlantKind::Rig(AxisClass::Heavy),
-        1 | 4 => PlantKind::Rig(AxisClass::Conventional),
-        2 | 5 => PlantKind::Rig(AxisClass::Stiff),
-        6 => PlantKind::FirstOrder,
+    match plant_group(i) {
+        0 => PlantKind::Rig(AxisClass::Heavy),
+        1 => PlantKind::Rig(AxisClass::Conventional),
+        2 => PlantKind::Rig(AxisClass::Stiff),
+        3 => PlantKind::FirstOrder,
         _ => PlantKind::SecondOrder,
     }
 }
@@ -181,10 +181,28 @@ fn plant_of(i: usize) -> PlantKind {
 /// Range of Kv \[1/s\] of the servo members.
 const SERVO_KV: (f64, f64) = (10.0, 3000.0);
 
-fn plan_regular(seed: u64, i: usize) -> Result<Plan> {
-    let mut d = Draws::new(seed, i);
+/// What a member's design fixes before its rate is final.
+struct Fixed {
+    i: usize,
+    plant: PlantKind,
+    kind: CommandKind,
+    kv_asked: f64,
+    amplitude: f64,
+    resolution: f64,
+    noise_std: f64,
+    dead_time: usize,
+    kvff: f64,
+    kaff: f64,
+    wanted: f64,
+    friction_share: f64,
+    backlash: f64,
+    placed_mode_hz: Option<f64>,
+    zeta: f64,
+}
+
+fn plan_regular(seed: u64, regular: usize, i: usize) -> Result<Plan> {
+    let d = Draws::new(seed, i, regular);
     let plant = plant_of(i);
-    let kind = CommandKind::of(i);
     let (kv_range, amplitude_max) = match plant {
         PlantKind::Rig(c) => {
             let r = class_ranges(c);
@@ -195,65 +213,96 @@ fn plan_regular(seed: u64, i: usize) -> Result<Plan> {
     let kv_asked = d.log_in(Dim::Kv, kv_range);
     // recording rate: a loop of Kv·Δt ≤ 0.15 within 20 samples per row
     let rate_lo = (kv_asked / (0.15 * 20.0)).max(100.0);
-    let rate = d.log_in(Dim::Rate, (rate_lo, MAX_LOOP_RATE));
-    let loop_min = (kv_asked / 0.15).max(250.0);
+    let mut rate = d.log_in(Dim::Rate, (rate_lo, MAX_LOOP_RATE));
+    let resolution = d.log_in(Dim::Resolution, (1e-9, 2e-5));
+    let u_noise = d.u(Dim::Noise);
+    let ff_mode = (i / 7) % 3;
+    let is_rig = matches!(plant, PlantKind::Rig(_));
+    let fixed = Fixed {
+        i,
+        plant,
+        kind: CommandKind::of(i),
+        kv_asked,
+        amplitude: d.log_in(Dim::Amplitude, (1e-4, amplitude_max)),
+        resolution,
+        noise_std: if u_noise < 0.1 {
+            0.0
+        } else {
+            resolution * log_lerp(0.05, 3.0, (u_noise - 0.1) / 0.9)
+        },
+        dead_time: ((d.u(Dim::DeadTime) * 4.0) as usize).min(3),
+        kvff: if ff_mode > 0 {
+            d.lin_in(Dim::Kvff, (0.8, 1.0))
+        } else {
+            0.0
+        },
+        kaff: if ff_mode == 2 && is_rig {
+            d.lin_in(Dim::Kaff, (0.5, 1.0))
+        } else {
+            0.0
+        },
+        wanted: d.log_in(Dim::Duration, (1.0, 5.0)),
+        friction_share: if is_rig {
+            d.lin_in(Dim::Friction, (0.0, 0.1))
+        } else {
+            0.0
+        },
+        backlash: if is_rig && d.u(Dim::Backlash) < 0.35 {
+            d.lin_in(Dim::BacklashWidth, (1e-6, 2e-5))
+        } else {
+            0.0
+        },
+        placed_mode_hz: (is_rig && d.u(Dim::Resonance) < 0.3)
+            .then(|| d.log_in(Dim::ResonanceFrequency, (20.0, 300.0))),
+        zeta: d.lin_in(Dim::ServoDamping, (0.35, 1.2)),
+    };
+    // a move too long for the row cap is recorded at a lower rate (a trace
+    // buffer of fixed size), down to the lowest rate the loop allows; each
+    // attempt starts from the same draws, so the member is the single pass at
+    // the final rate
+    for _ in 0..4 {
+        let mut dd = d.clone();
+        let (plan, needed, max_duration) = attempt(&fixed, rate, &mut dd)?;
+        if needed <= max_duration * (1.0 + 1e-9) || rate <= rate_lo * (1.0 + 1e-9) {
+            return Ok(plan);
+        }
+        rate = (rate * max_duration / needed * 0.999).max(rate_lo);
+    }
+    let mut dd = d.clone();
+    Ok(attempt(&fixed, rate, &mut dd)?.0)
+}
+
+/// Plan a member at recording rate `rate`; also the length its command
+/// needs and the longest allowed \[s\].
+fn attempt(f: &Fixed, rate: f64, d: &mut Draws) -> Result<(Plan, f64, f64)> {
+    let loop_min = (f.kv_asked / 0.15).max(250.0);
     let mut decimation = ((loop_min / rate) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
     while decimation > 1 && rate * decimation as f64 > MAX_LOOP_RATE * (1.0 + 1e-12) {
         decimation -= 1;
     }
     let decimation = decimation.min(20);
     let loop_rate = rate * decimation as f64;
-    let amplitude = d.log_in(Dim::Amplitude, (1e-4, amplitude_max));
-    let resolution = d.log_in(Dim::Resolution, (1e-9, 2e-5));
-    let u_noise = d.u(Dim::Noise);
-    let noise_std = if u_noise < 0.1 {
-        0.0
-    } else {
-        resolution * log_lerp(0.05, 3.0, (u_noise - 0.1) / 0.9)
-    };
-    let dead_time = ((d.u(Dim::DeadTime) * 4.0) as usize).min(3);
-    let ff_mode = (i / 7) % 3;
-    let kvff = if ff_mode > 0 {
-        d.lin_in(Dim::Kvff, (0.8, 1.0))
-    } else {
-        0.0
-    };
-    let kaff = if ff_mode == 2 && matches!(plant, PlantKind::Rig(_)) {
-        d.lin_in(Dim::Kaff, (0.5, 1.0))
-    } else {
-        0.0
-    };
     let max_rows = MAX_ROWS.min(MAX_LOOP_SAMPLES / decimation);
-    let wanted = d.log_in(Dim::Duration, (1.0, 5.0));
-    let rows0 = ((wanted * rate).round() as usize).clamp(MIN_ROWS, max_rows);
+    let rows0 = ((f.wanted * rate).round() as usize).clamp(MIN_ROWS, max_rows);
     let loop_dt = 1.0 / loop_rate;
-
-    let mut friction_share = 0.0;
-    let mut backlash = 0.0;
     let (kv, velocity_bandwidth, velocity, acceleration, rig, servo_setup, mass, mode, placed);
     let stability;
-    match plant {
+    match f.plant {
         PlantKind::Rig(class) => {
-            friction_share = d.lin_in(Dim::Friction, (0.0, 0.1));
-            if d.u(Dim::Backlash) < 0.35 {
-                backlash = d.lin_in(Dim::BacklashWidth, (1e-6, 2e-5));
-            }
-            let placed_mode_hz = (d.u(Dim::Resonance) < 0.3)
-                .then(|| d.log_in(Dim::ResonanceFrequency, (20.0, 300.0)));
             let a = axis::build(
-                &mut d,
+                d,
                 &AxisInputs {
                     class,
-                    kv: kv_asked,
-                    stroke: amplitude,
-                    kvff,
-                    kaff,
-                    friction_share,
-                    backlash,
-                    placed_mode_hz,
-                    resolution,
-                    noise_std,
-                    dead_time: dead_time * decimation,
+                    kv: f.kv_asked,
+                    stroke: f.amplitude,
+                    kvff: f.kvff,
+                    kaff: f.kaff,
+                    friction_share: f.friction_share,
+                    backlash: f.backlash,
+                    placed_mode_hz: f.placed_mode_hz,
+                    resolution: f.resolution,
+                    noise_std: f.noise_std,
+                    dead_time: f.dead_time * decimation,
                     loop_dt,
                 },
             )?;
@@ -269,14 +318,13 @@ fn plan_regular(seed: u64, i: usize) -> Result<Plan> {
             stability = a.stability;
         }
         PlantKind::FirstOrder | PlantKind::SecondOrder => {
-            let zeta = d.lin_in(Dim::ServoDamping, (0.35, 1.2));
             let s = ServoSetup {
-                kv: kv_asked,
-                velocity_bandwidth: (plant == PlantKind::SecondOrder)
-                    .then_some(4.0 * zeta * zeta * kv_asked),
-                kvff,
+                kv: f.kv_asked,
+                velocity_bandwidth: (f.plant == PlantKind::SecondOrder)
+                    .then_some(4.0 * f.zeta * f.zeta * f.kv_asked),
+                kvff: f.kvff,
             };
-            kv = kv_asked;
+            kv = f.kv_asked;
             velocity_bandwidth = s.velocity_bandwidth;
             velocity = d.log_in(Dim::Velocity, (0.05, 2.0));
             acceleration = d.log_in(Dim::Acceleration, (2.0, 50.0));
@@ -288,53 +336,53 @@ fn plan_regular(seed: u64, i: usize) -> Result<Plan> {
             placed = false;
         }
     }
-
+    let max_duration = max_rows as f64 / rate;
     let limits = Limits {
-        amplitude,
+        amplitude: f.amplitude,
         velocity,
         acceleration,
         kv,
         rate,
         loop_rate,
         duration: rows0 as f64 / rate,
-        max_duration: max_rows as f64 / rate,
+        max_duration,
     };
-    let (command_spec, duration) = command::plan(kind, &limits, &mut d);
-    let rows = ((duration * rate).round() as usize).clamp(2, max_rows);
-    let command = command::sample(&command_spec, loop_rate, (rows - 1) * decimation + 1)?;
+    let planned = command::plan(f.kind, &limits, d);
+    let rows = ((planned.duration * rate).round() as usize).clamp(2, max_rows);
+    let command = command::sample(&planned.spec, loop_rate, (rows - 1) * decimation + 1)?;
     let amplitude_m = command
         .iter()
         .step_by(decimation)
         .fold(0.0f64, |m, v| m.max(v.abs()));
-    let glitches = if i % 12 == 5 {
-        defects::glitches(&mut d, rows, amplitude_m)
+    let glitches = if f.i % 12 == 5 {
+        defects::glitches(d, rows, amplitude_m)
     } else {
         Vec::new()
     };
     let noise_seed = d.seed();
     let two_pi = 2.0 * std::f64::consts::PI;
     let mut spec = MemberSpec {
-        index: i,
+        index: f.i,
         label: String::new(),
-        plant,
+        plant: f.plant,
         rate_hz: rate,
         loop_rate_hz: loop_rate,
         samples: rows,
         duration_s: rows as f64 / rate,
         kv,
         velocity_bandwidth_hz: velocity_bandwidth.map(|w| w / two_pi),
-        kvff,
-        kaff,
+        kvff: f.kvff,
+        kaff: f.kaff,
         mass_kg: mass,
         axial_mode_hz: mode,
         resonance_placed: placed,
-        friction_share,
-        backlash_m: backlash,
-        dead_time_samples: dead_time,
-        resolution_m: resolution,
-        noise_std_m: noise_std,
+        friction_share: f.friction_share,
+        backlash_m: f.backlash,
+        dead_time_samples: f.dead_time,
+        resolution_m: f.resolution,
+        noise_std_m: f.noise_std,
         amplitude_m,
-        command: command_spec,
+        command: planned.spec,
         glitches,
         dropped_rows: Vec::new(),
         gap_source: None,
@@ -344,12 +392,16 @@ fn plan_regular(seed: u64, i: usize) -> Result<Plan> {
         servo: servo_setup,
     };
     spec.label = spec.make_label();
-    Ok(Plan {
-        spec,
-        command,
-        decimation,
-        rows,
-    })
+    Ok((
+        Plan {
+            spec,
+            command,
+            decimation,
+            rows,
+        },
+        planned.needed,
+        max_duration,
+    ))
 }
 
 /// Simulate a planned member.

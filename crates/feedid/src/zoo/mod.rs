@@ -4,7 +4,7 @@
 //!
 //! [`Zoo::standard`] holds 220 members: 210 regular recordings (every one a
 //! file `feedid identify` reads) and 10 with dropped rows. Member `i` depends
-//! only on the zoo seed and `i`, so a test or a task can make member `i`
+//! only on the zoo seed, `i` and the zoo's size, so a test or a task can make member `i`
 //! alone ([`Zoo::member`]); [`Zoo::members`] makes many in parallel.
 //! [`Zoo::small`] is the first 20 (every plant, command and feed-forward kind,
 //! two with glitches) for fast tests. Each [`ZooMember`] carries its

@@ -208,9 +208,9 @@ fn baseline_arx220(u: &[f64], y: &[f64]) -> Predictions {
 /// rms and max of `y − ŷ` over the samples where `mask` holds.
 fn stats(y: &[f64], p: &Predictions, mask: impl Fn(usize) -> bool) -> Option<(f64, f64, usize)> {
     let (mut sse, mut max, mut n) = (0.0, 0.0f64, 0usize);
-    for k in 0..y.len() {
+    for (k, (&yk, &pk)) in y.iter().zip(&p.value).enumerate() {
         if p.has[k] && mask(k) {
-            let e = y[k] - p.value[k];
+            let e = yk - pk;
             sse += e * e;
             max = max.max(e.abs());
             n += 1;
@@ -312,7 +312,7 @@ fn score(m: &ZooMember) -> Vec<Row> {
             for b in BASELINES.iter().filter(|&&b| b != p.name) {
                 if let Some((a, r)) = shared_rms(y, p, by_name[b], &scored) {
                     let q = a / r;
-                    if q.is_finite() && worst.is_none_or(|(_, w)| q > w) {
+                    if q.is_finite() && worst.map_or(true, |(_, w)| q > w) {
                         worst = Some((b, q));
                     }
                 }
@@ -568,8 +568,8 @@ mod tests {
         }
         let p = baseline_arx220(&u, &y);
         assert!(!p.has[101] && p.has[102] && p.has[n - 1]);
-        for k in 102..n {
-            assert!((p.value[k] - y[k]).abs() < 1e-9, "k {k}");
+        for (k, (pk, yk)) in p.value.iter().zip(&y).enumerate().skip(102) {
+            assert!((pk - yk).abs() < 1e-9, "k {k}");
         }
     }
 

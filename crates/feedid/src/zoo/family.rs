@@ -413,7 +413,7 @@ fn simulate(plan: Plan) -> Result<ZooMember> {
         rows,
     } = plan;
     let (measured, truth) = plant::run_loop(&spec, &command, spec.noise_seed)?;
-    let keep = |k: usize| !spec.dropped_rows.binary_search(&k).is_ok();
+    let keep = |k: usize| spec.dropped_rows.binary_search(&k).is_err();
     let pick =
         |v: &[f64]| -> Vec<f64> { (0..rows).filter(|&k| keep(k)).map(|k| v[k * m]).collect() };
     let time: Vec<f64> = (0..rows)

@@ -199,8 +199,14 @@ fn ramp_following_error_is_one_minus_kvff_times_v_over_kv() {
         for pl in [PositionLoop::Sampled, PositionLoop::Interpolated] {
             let out = linear_with(p, pl).simulate(&cmd, RATE).unwrap();
             // steady part of the ramp: 0.3 s … 0.6 s
-            for k in 1500..3000 {
-                let e = cmd[k] - out.true_position[k];
+            for (k, (c, x)) in cmd
+                .iter()
+                .zip(&out.true_position)
+                .enumerate()
+                .take(3000)
+                .skip(1500)
+            {
+                let e = c - x;
                 assert!(
                     (e - expected).abs() < 1e-8,
                     "kvff {kvff} {pl:?} k={k}: {e} vs {expected}"

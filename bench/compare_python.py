@@ -204,7 +204,7 @@ def feedid_predictions(np, feedid, rec, solver, workdir, n):
     with open(rec) as f:
         text = f.read()
     t0 = time.perf_counter()
-    s = subprocess.run([str(feedid), "stream", "--solver", solver, "--window", str(W),
+    s = subprocess.run([str(feedid), "stream", "--method", "paper", "--solver", solver, "--window", str(W),
                         "--horizon", str(H)], input=text, capture_output=True, text=True, check=True)
     wall = time.perf_counter() - t0
     t_rec = np.loadtxt(rec, delimiter=",", skiprows=1, usecols=0, ndmin=1)

@@ -10,7 +10,9 @@
 #![no_main]
 
 use feedid::ident::engine::{run, EngineConfig};
-use feedid::ident::{MethodKind, MethodSpec, PredictionMode, Solver, Streamer, TimeOrigin};
+use feedid::ident::{
+    ArxOrders, Method, PaperConfig, PredictionMode, Solver, Streamer, TimeOrigin,
+};
 use feedid::Recording;
 use libfuzzer_sys::fuzz_target;
 
@@ -19,34 +21,43 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     let (head, body) = data.split_at(5);
-    let kind = [
-        MethodKind::Paper,
-        MethodKind::Arx,
-        MethodKind::Rls,
-        MethodKind::Oe,
-    ][usize::from(head[0] & 3)];
-    let mut spec = MethodSpec::new(kind);
     let opt = head[4];
-    spec.paper.time_origin = if opt & 1 != 0 {
-        TimeOrigin::Window
-    } else {
-        TimeOrigin::Motion
+    let paper = PaperConfig {
+        time_origin: if opt & 1 != 0 {
+            TimeOrigin::Window
+        } else {
+            TimeOrigin::Motion
+        },
+        prediction: if opt & 2 != 0 {
+            PredictionMode::TransferFunction
+        } else {
+            PredictionMode::Polynomial
+        },
+        solver: if opt & 4 != 0 {
+            Solver::Simplex
+        } else {
+            Solver::Qr
+        },
+        ..PaperConfig::default()
     };
-    spec.paper.prediction = if opt & 2 != 0 {
-        PredictionMode::TransferFunction
-    } else {
-        PredictionMode::Polynomial
+    let mut spec = match head[0] & 3 {
+        0 => Method::Paper(paper),
+        1 => Method::Arx(Default::default()),
+        2 => Method::Rls(Default::default()),
+        _ => Method::Oe(Default::default()),
     };
-    if opt & 4 != 0 {
-        spec.paper.solver = Solver::Simplex;
+    if opt & 8 != 0 && spec.orders().is_some() {
+        let orders = ArxOrders::new(
+            usize::from(head[0] >> 4) % 5 + 1,
+            usize::from(head[0] >> 2) % 5 + 1,
+            usize::from(opt >> 6),
+        );
+        if spec.set_orders(orders).is_err() {
+            return;
+        }
     }
-    if opt & 8 != 0 {
-        spec.arx.orders.na = usize::from(head[0] >> 4) % 5 + 1;
-        spec.arx.orders.nb = usize::from(head[0] >> 2) % 5 + 1;
-        spec.arx.orders.nk = usize::from(opt >> 6);
-        spec.rls.orders = spec.arx.orders;
-    }
-    let max_window = if kind == MethodKind::Oe { 32 } else { 256 };
+    let is_oe = matches!(spec, Method::Oe(_));
+    let max_window = if is_oe { 32 } else { 256 };
     let cfg = EngineConfig {
         window: usize::from(head[1]) % max_window + 1,
         horizon: usize::from(head[2]) % 32 + 1,
@@ -72,9 +83,9 @@ fuzz_target!(|data: &[u8]| {
     }
     // Bound the work per input (the simplex and OE iterate per window):
     // a few hundred samples reach every code path.
-    let cap = match kind {
-        MethodKind::Oe => 80,
-        MethodKind::Paper if spec.paper.solver == Solver::Simplex => 120,
+    let cap = match &spec {
+        Method::Oe(_) => 80,
+        Method::Paper(p) if p.solver == Solver::Simplex => 120,
         _ => 200,
     };
     u.truncate(cap);

@@ -148,25 +148,27 @@ pub struct SimulateArgs {
     pub output: PathBuf,
 }
 
-/// Method options shared by identify and stream.
+/// The per-method options of every subcommand that takes a method
+/// (identify, stream, report, sweep), flattened into each; turned into
+/// [`feedid::ident::Method`]s by `cmd::method`. An option given for a method
+/// that does not have it is refused, never ignored.
 #[derive(Debug, Clone, Args)]
-pub struct MethodArgs {
-    /// Identification method: auto (validated choice of model, order and memory), paper, arx, rls, oe.
-    #[arg(long, default_value = "auto", value_name = "NAME")]
-    pub method: String,
-    /// Solver of the paper method: qr (exact least squares) or simplex (Nelder–Mead, as in the paper).
-    #[arg(long, default_value = "qr", value_name = "NAME")]
-    pub solver: String,
-    /// Time origin of the paper method: motion (start of motion) or window (each window's first sample).
-    #[arg(long, default_value = "motion", value_name = "NAME")]
-    pub time_origin: String,
-    /// Prediction of the paper method: polynomial (fitted output continued) or tf (identified Tf on the next command).
-    #[arg(long, default_value = "polynomial", value_name = "NAME")]
-    pub prediction: String,
-    /// ARX/RLS orders `na,nb,nk` (poles, input terms, input delay in samples) [default: 8,8,1].
-    #[arg(long, value_name = "NA,NB,NK")]
+pub struct MethodOptions {
+    /// paper: solver, qr (exact least squares) or simplex (Nelder–Mead, as in the paper) [default: qr].
+    #[arg(long, value_name = "NAME")]
+    pub solver: Option<String>,
+    /// paper: time origin, motion (start of motion) or window (each window's first sample) [default: motion].
+    #[arg(long, value_name = "NAME")]
+    pub time_origin: Option<String>,
+    /// paper: prediction, polynomial (fitted output continued) or tf (identified Tf on the next command) [default: polynomial].
+    #[arg(long, value_name = "NAME")]
+    pub prediction: Option<String>,
+    /// arx, rls, auto (its long-memory candidate): ARX orders `na,nb,nk`
+    /// (poles, input terms, input delay in samples), or `auto` (chosen from
+    /// the recording by BIC; identify only) [default: 8,8,1].
+    #[arg(long, value_name = "NA,NB,NK|auto")]
     pub order: Option<String>,
-    /// RLS forgetting factor λ (memory ≈ 1/(1−λ) samples) [default: 0.999].
+    /// rls: forgetting factor λ (memory ≈ 1/(1−λ) samples) [default: 0.999].
     #[arg(long, value_name = "LAMBDA")]
     pub lambda: Option<f64>,
     /// auto: emit a prediction only when the chosen model's recent rms error
@@ -178,8 +180,8 @@ pub struct MethodArgs {
 /// Sliding-window options.
 #[derive(Debug, Clone, Args)]
 pub struct WindowArgs {
-    /// Window length W [samples]; default: auto 50, paper 20, arx 200, rls 100, oe 200.
-    #[arg(long)]
+    /// Window length W [samples] [default: the method's, see below].
+    #[arg(long, long_help = window_help())]
     pub window: Option<usize>,
     /// Prediction horizon H [samples].
     #[arg(long, default_value_t = 10)]
@@ -187,6 +189,26 @@ pub struct WindowArgs {
     /// Shift between windows [samples]; default: the horizon.
     #[arg(long)]
     pub hop: Option<usize>,
+}
+
+/// `--window`'s help, with every method's default window.
+fn window_help() -> String {
+    let defaults: Vec<String> = feedid::ident::Method::all()
+        .iter()
+        .map(|m| format!("{} {}", m.name(), m.default_window()))
+        .collect();
+    format!(
+        "Window length W [samples]; default: the method's ({})",
+        defaults.join(", ")
+    )
+}
+
+/// `--method`'s help, with every method's name.
+fn method_help() -> String {
+    format!(
+        "Identification method: {} (auto: validated choice of model, order and memory)",
+        feedid::ident::METHOD_NAMES
+    )
 }
 
 /// `feedid identify`.
@@ -198,9 +220,12 @@ pub struct IdentifyArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Method.
+    /// Identification method.
+    #[arg(long, default_value = "auto", value_name = "NAME", help = method_help())]
+    pub method: String,
+    /// Options of the method.
     #[command(flatten)]
-    pub method: MethodArgs,
+    pub options: MethodOptions,
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
@@ -288,41 +313,18 @@ pub struct OrderArgs {
 /// `feedid stream`.
 #[derive(Debug, Args)]
 pub struct StreamArgs {
-    /// Method.
+    /// Identification method.
+    #[arg(long, default_value = "auto", value_name = "NAME", help = method_help())]
+    pub method: String,
+    /// Options of the method.
     #[command(flatten)]
-    pub method: MethodArgs,
+    pub options: MethodOptions,
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
     /// Sampling rate [Hz] when lines are `command,position` without a time.
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
-}
-
-/// Several methods and the per-method options of `identify` (report, sweep).
-#[derive(Debug, Clone, Args)]
-pub struct MethodListArgs {
-    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: report paper,arx,rls,oe,auto; sweep paper,arx].
-    #[arg(long, value_name = "LIST")]
-    pub methods: Option<String>,
-    /// Solver of the paper method: qr (exact least squares) or simplex (Nelder–Mead, as in the paper).
-    #[arg(long, default_value = "qr", value_name = "NAME")]
-    pub solver: String,
-    /// Time origin of the paper method: motion or window.
-    #[arg(long, default_value = "motion", value_name = "NAME")]
-    pub time_origin: String,
-    /// Prediction of the paper method: polynomial or tf.
-    #[arg(long, default_value = "polynomial", value_name = "NAME")]
-    pub prediction: String,
-    /// ARX/RLS orders `na,nb,nk` [default: 8,8,1].
-    #[arg(long, value_name = "NA,NB,NK")]
-    pub order: Option<String>,
-    /// RLS forgetting factor λ [default: 0.999].
-    #[arg(long, value_name = "LAMBDA")]
-    pub lambda: Option<f64>,
-    /// auto: largest recent rms error of an emitted prediction [µm] [default: 5].
-    #[arg(long, value_name = "UM")]
-    pub tolerance: Option<f64>,
 }
 
 /// `feedid report`.
@@ -333,9 +335,12 @@ pub struct ReportArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Methods.
+    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: paper,arx,rls,oe,auto].
+    #[arg(long, value_name = "LIST")]
+    pub methods: Option<String>,
+    /// Options of the methods (each goes to the methods that have it).
     #[command(flatten)]
-    pub methods: MethodListArgs,
+    pub options: MethodOptions,
     /// Windows (one --window applies to every method).
     #[command(flatten)]
     pub windows: WindowArgs,
@@ -358,9 +363,12 @@ pub struct SweepArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Methods.
+    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: paper,arx].
+    #[arg(long, value_name = "LIST")]
+    pub methods: Option<String>,
+    /// Options of the methods (each goes to the methods that have it).
     #[command(flatten)]
-    pub methods: MethodListArgs,
+    pub options: MethodOptions,
     /// Window lengths W [samples], comma-separated.
     #[arg(long, value_name = "LIST", default_value = "10,20,40,80,160")]
     pub windows: String,

@@ -45,12 +45,33 @@ fn main() -> ExitCode {
             Err(e) => stdout_failed(&e),
         },
         Err(e) => {
-            // The library's messages already carry their causes (file, line,
-            // column, value): print the outermost one, on one line.
-            eprintln!("error: {}", e.to_string().replace('\n', " "));
+            eprintln!("error: {}", one_line(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// An error with its whole cause chain on one line, `outer: cause: root`
+/// (as anyhow's `{:#}`), except that a cause whose text its parent already
+/// shows is not repeated: the library's messages embed the error they wrap
+/// (`bad.csv: line 3, column …: <cause>`) and also expose it as their
+/// source.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    let mut previous = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string().replace(['\n', '\r'], " ");
+        if !out.is_empty() && previous.contains(&text) {
+            previous = text;
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+        previous = text;
+    }
+    out
 }
 
 /// Write to standard output (see the macros above).

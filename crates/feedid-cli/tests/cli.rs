@@ -270,6 +270,8 @@ fn identify_simplex_agrees_with_qr_on_the_ramp() {
         let o = feedid(&[
             "identify",
             input.to_str().unwrap(),
+            "--method",
+            "paper",
             "--solver",
             solver,
             "-o",
@@ -712,4 +714,115 @@ fn summary_has_the_free_run_fit_of_the_global_model_except_for_paper() {
             assert!(v["sim_fit_percent"].is_null());
         }
     }
+}
+
+#[test]
+fn order_changes_auto_and_is_refused_by_methods_without_orders() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let predictions = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "identify",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = feedid(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (h, rows) = read_csv(&out);
+        column(&h, &rows, "predicted_m")
+    };
+    // auto takes the orders for its long-memory RLS candidate: a different result
+    let default = predictions(&["--method", "auto"], "a.csv");
+    let low = predictions(&["--method", "auto", "--order", "2,2,1"], "b.csv");
+    let differ = default
+        .iter()
+        .zip(&low)
+        .filter(|(a, b)| a.is_some() && b.is_some() && a != b)
+        .count();
+    assert!(differ > 100, "{differ} samples differ");
+    // the same orders given explicitly change nothing
+    assert_eq!(
+        predictions(&["--method", "auto", "--order", "8,8,1"], "c.csv"),
+        default
+    );
+    // methods without ARX orders refuse them, naming the flag and who takes it
+    for (method, order) in [("paper", "2,2,1"), ("oe", "2,2,1"), ("paper", "auto")] {
+        let out = dir.path().join("refused.csv");
+        let o = feedid(&[
+            "identify",
+            input.to_str().unwrap(),
+            "--method",
+            method,
+            "--order",
+            order,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        common::assert_fails(&o, &["--order", method, "arx, rls, auto"]);
+        assert!(!out.exists());
+    }
+    // so do other options given to a method without them
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--method",
+        "arx",
+        "--solver",
+        "simplex",
+        "-o",
+        dir.path().join("x.csv").to_str().unwrap(),
+    ]);
+    common::assert_fails(&o, &["--solver", "arx", "paper"]);
+}
+
+#[test]
+fn error_lines_carry_their_cause_and_name_the_file_once() {
+    let dir = tempfile::tempdir().unwrap();
+    // a command that never moves: nothing to choose orders from
+    let flat = dir.path().join("flat.csv");
+    let mut text = String::from("time_s,command_m,position_m\n");
+    for k in 0..200 {
+        text += &format!("{},0.001,0.001\n", k as f64 * 1e-3);
+    }
+    std::fs::write(&flat, text).unwrap();
+    let out = dir.path().join("p.csv");
+    let o = feedid(&[
+        "identify",
+        flat.to_str().unwrap(),
+        "--method",
+        "arx",
+        "--order",
+        "auto",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    common::assert_fails(&o, &["order selection: "]);
+    let err = stderr(&o);
+    let line = err.lines().find(|l| l.starts_with("error:")).unwrap();
+    // the reason follows the stage: `…: order selection: <why>`
+    let why = line.split("order selection: ").nth(1).unwrap_or("");
+    assert!(why.len() > 5, "no cause in `{line}`");
+    assert_eq!(line.matches("flat.csv").count(), 1, "{line}");
+    assert!(!out.exists());
+
+    // a batch names each bad file once
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, "time_s,command_m,position_m\n0,0,0\n0.001,0,x\n").unwrap();
+    let o = feedid(&[
+        "identify",
+        bad.to_str().unwrap(),
+        "--out-dir",
+        dir.path().join("batch").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    let line = err
+        .lines()
+        .find(|l| l.contains("bad.csv"))
+        .unwrap_or_else(|| panic!("{err}"));
+    assert_eq!(line.matches("bad.csv").count(), 1, "{line}");
+    assert!(line.contains("line 3") && line.contains("`x`"), "{line}");
 }

@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::engine::run;
-use feedid::ident::{EngineConfig, MethodKind, MethodSpec, PaperConfig, Solver};
+use feedid::ident::{EngineConfig, Method, PaperConfig, Solver};
 use feedid::signal::Scenario;
 use feedid::Recording;
 
@@ -137,7 +137,7 @@ fn stream_output_equals_the_batch_engine_predictions() {
         );
     }
     // the default method, auto: the same predictions as the batch engine
-    let spec = MethodSpec::new(MethodKind::Auto);
+    let spec = Method::default();
     let cfg = EngineConfig {
         window: spec.default_window(),
         ..EngineConfig::default()

@@ -15,7 +15,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::engine::run;
-use feedid::ident::{EngineConfig, Estimator, MethodKind, MethodSpec, Signals};
+use feedid::ident::{EngineConfig, Estimator, Method, Signals};
 use std::time::{Duration, Instant};
 
 const RATE: f64 = 5000.0;
@@ -72,11 +72,11 @@ fn hour(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(1))
         .measurement_time(Duration::from_secs(1))
         .throughput(Throughput::Elements(n as u64));
-    for (kind, label) in [
-        (MethodKind::Auto, "auto_engine_one_hour_5khz"),
-        (MethodKind::Paper, "paper_qr_engine_one_hour_5khz"),
+    for (name, label) in [
+        ("auto", "auto_engine_one_hour_5khz"),
+        ("paper", "paper_qr_engine_one_hour_5khz"),
     ] {
-        let spec = MethodSpec::new(kind);
+        let spec: Method = name.parse().unwrap_or_else(|e| panic!("{e}"));
         let cfg = EngineConfig {
             window: spec.default_window(),
             ..EngineConfig::default()

@@ -8,7 +8,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::engine::run;
-use feedid::ident::{EngineConfig, MethodKind, MethodSpec};
+use feedid::ident::{EngineConfig, Method};
 use feedid::signal::Scenario;
 use feedid::Recording;
 
@@ -28,13 +28,8 @@ fn methods(c: &mut Criterion) {
     let rec = recording();
     let signals = rec.signals();
     let mut group = c.benchmark_group("methods");
-    for kind in [
-        MethodKind::Arx,
-        MethodKind::Oe,
-        MethodKind::Rls,
-        MethodKind::Auto,
-    ] {
-        let spec = MethodSpec::new(kind);
+    for name in ["arx", "oe", "rls", "auto"] {
+        let spec: Method = name.parse().unwrap_or_else(|e| panic!("{e}"));
         let cfg = EngineConfig {
             window: spec.default_window(),
             ..EngineConfig::default()
@@ -42,13 +37,13 @@ fn methods(c: &mut Criterion) {
         let windows = cfg.windows(rec.len(), 0).count() as u64;
         let mut est = spec.build().unwrap_or_else(|e| panic!("{e}"));
         // per window for arx/oe, per sample for rls and auto (sample-driven)
-        let (label, n) = if matches!(kind, MethodKind::Rls | MethodKind::Auto) {
+        let (label, n) = if matches!(spec, Method::Rls(_) | Method::Auto(_)) {
             ("per_sample", rec.len() as u64)
         } else {
             ("per_window", windows)
         };
         group.throughput(Throughput::Elements(n));
-        group.bench_function(format!("{}_{label}", kind.name()), |b| {
+        group.bench_function(format!("{}_{label}", spec.name()), |b| {
             b.iter(|| {
                 let r = run(est.as_mut(), &signals, &cfg).unwrap_or_else(|e| panic!("{e}"));
                 black_box(r.stats.rms)

@@ -6,23 +6,17 @@
 //! `cargo run --release -p feedid --example method_table`
 
 use feedid::drive::{RigParams, VirtualRig};
-use feedid::ident::{engine, EngineConfig, MethodKind, MethodSpec, Signals};
+use feedid::ident::{engine, EngineConfig, Method, Signals};
 use feedid::io::{read_recording, ChannelRef, ReadOptions};
 use feedid::signal::Scenario;
 use feedid::Recording;
 
-const METHODS: [MethodKind; 5] = [
-    MethodKind::Paper,
-    MethodKind::Arx,
-    MethodKind::Rls,
-    MethodKind::Oe,
-    MethodKind::Auto,
-];
+const METHODS: [&str; 5] = ["paper", "arx", "rls", "oe", "auto"];
 
 fn row(name: &str, s: &Signals<'_>) -> feedid::Result<String> {
     let mut line = format!("| {name} |");
-    for kind in METHODS {
-        let spec = MethodSpec::new(kind);
+    for name in METHODS {
+        let spec: Method = name.parse()?;
         let mut est = spec.build()?;
         let cfg = EngineConfig {
             window: spec.default_window(),
@@ -31,7 +25,7 @@ fn row(name: &str, s: &Signals<'_>) -> feedid::Result<String> {
             warm_up: 0,
         };
         let r = engine::run(&mut est, s, &cfg)?;
-        let cov = 100.0 * r.stats.samples as f64 / s.time.len() as f64;
+        let cov = 100.0 * r.stats.samples as f64 / s.len() as f64;
         line += &format!(
             " {:.3} / {:.2} ({:.0} %) |",
             r.stats.rms * 1e6,

@@ -105,7 +105,7 @@ fn report(
     let fallbacks = res
         .windows
         .iter()
-        .filter(|w| w.fit.termination == feedid::solve::Termination::Fallback)
+        .filter(|w| w.outcome == feedid::ident::WindowOutcome::Fallback)
         .count();
     println!(
         "{:<10} {:>9} {:>10.4} {:>10.3} {:>10.4} {:>8} {:>6}",

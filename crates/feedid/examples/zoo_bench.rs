@@ -42,7 +42,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use feedid::ident::{engine, EngineConfig, MethodSpec};
+use feedid::ident::{engine, EngineConfig, Method};
 use feedid::zoo::{Zoo, ZooMember};
 use feedid::Recording;
 use nalgebra::{DMatrix, DVector};
@@ -86,7 +86,7 @@ fn run_library_methods(rec: &Recording) -> Vec<Predictions> {
         .map(|&name| {
             let t = Instant::now();
             let run = || -> feedid::Result<(Vec<f64>, Vec<bool>)> {
-                let spec = MethodSpec::new(name.parse()?);
+                let spec: Method = name.parse()?;
                 let mut est = spec.build()?;
                 let cfg = EngineConfig {
                     window: spec.default_window(),

@@ -59,6 +59,18 @@ pub enum Error {
         expected: &'static str,
     },
 
+    /// A setting was given for a method that has no such setting (it is
+    /// refused, never silently ignored).
+    #[error("{setting}: not applicable to the {method} method (only to {applies_to})")]
+    NotApplicable {
+        /// The setting, e.g. `"ARX orders (na,nb,nk)"`.
+        setting: &'static str,
+        /// The method it was given for.
+        method: &'static str,
+        /// The methods that take it, comma separated.
+        applies_to: &'static str,
+    },
+
     /// A rig parameter file could not be parsed (unknown key, wrong type, ...).
     #[error("{}: {message}", display_path(path))]
     ParamsFile {
@@ -191,21 +203,6 @@ pub enum Error {
         iterations: usize,
     },
 
-    /// A method declined to predict (its model is not validated for this horizon).
-    #[error("prediction withheld: {reason}")]
-    PredictionWithheld {
-        /// Why.
-        reason: &'static str,
-    },
-
-    // --- plot
-    /// A figure could not be rendered.
-    #[error("cannot render figure: {reason}")]
-    Plot {
-        /// Renderer message.
-        reason: String,
-    },
-
     // --- io
     /// An error found in a recording file, with the place it was found: the
     /// wrapped error (e.g. [`Error::NonFinite`], [`Error::NonMonotoneTime`])
@@ -217,6 +214,18 @@ pub enum Error {
         /// Where in the file, e.g. ``"line 7, column `position_m`"``; may be empty.
         location: String,
         /// The underlying error.
+        #[source]
+        source: Box<Error>,
+    },
+
+    // --- pipeline
+    /// A stage of a run failed; the wrapped error says why (e.g.
+    /// `order selection: too few samples for …`).
+    #[error("{stage}: {source}")]
+    Stage {
+        /// The stage, e.g. `"order selection"`, `"global model"`.
+        stage: &'static str,
+        /// Why it failed.
         #[source]
         source: Box<Error>,
     },
@@ -279,10 +288,11 @@ pub enum Error {
 }
 
 impl Error {
-    /// The innermost error: the wrapped one for [`Error::InFile`], else `self`.
+    /// The innermost error: the wrapped one for [`Error::InFile`] and
+    /// [`Error::Stage`], else `self`.
     pub fn root(&self) -> &Error {
         match self {
-            Error::InFile { source, .. } => source.root(),
+            Error::InFile { source, .. } | Error::Stage { source, .. } => source.root(),
             other => other,
         }
     }

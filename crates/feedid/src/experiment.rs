@@ -12,8 +12,8 @@ use std::fmt::Write as _;
 
 use crate::drive::{RigEffects, RigParams, VirtualRig};
 use crate::error::Result;
-use crate::ident::{identify, EngineConfig, Identification, PaperConfig, Solver};
-use crate::plot::{LineChart, Series};
+use crate::ident::{EngineConfig, Method, PaperConfig, Solver};
+use crate::pipeline::{Identification, Pipeline};
 use crate::recording::Recording;
 use crate::signal::Scenario;
 use crate::stats::ErrorStats;
@@ -110,17 +110,17 @@ pub fn run_experiment(scenario: Scenario, cfg: &PaperExperimentConfig) -> Result
 
     let mut runs = Vec::with_capacity(2);
     for solver in [Solver::Qr, Solver::Simplex] {
-        let mut est = PaperConfig {
+        let method = Method::Paper(PaperConfig {
             solver,
             ..PaperConfig::default()
-        }
-        .build()?;
-        runs.push(identify(
-            &recording,
-            &mut est,
-            &cfg.engine,
-            Some(&cfg.params),
-        )?);
+        });
+        runs.push(
+            Pipeline::new(method)
+                .engine(cfg.engine)
+                .method_global_model(false)
+                .nominal(cfg.params)
+                .run(&recording)?,
+        );
     }
     let errors = |id: &Identification, curve: &dyn Fn(usize) -> Option<f64>| {
         let y = recording.position();
@@ -164,115 +164,12 @@ pub fn run_experiment(scenario: Scenario, cfg: &PaperExperimentConfig) -> Result
 }
 
 impl ExperimentResult {
-    fn zoom_indices(&self) -> Vec<usize> {
+    /// Indices of the samples in the zoom window after the motion start.
+    pub fn zoom_indices(&self) -> Vec<usize> {
         let t = self.recording.time();
         (0..t.len())
             .filter(|&k| t[k] >= self.motion_start && t[k] <= self.motion_start + self.zoom)
             .collect()
-    }
-
-    /// Measurement, simulation model and identified model over the zoom window
-    /// (paper figures 5 and 7), in ms and µm.
-    pub fn response_chart(&self) -> LineChart {
-        let idx = self.zoom_indices();
-        let t = self.recording.time();
-        let ms: Vec<f64> = idx
-            .iter()
-            .map(|&k| 1e3 * (t[k] - self.motion_start))
-            .collect();
-        let um = |f: &dyn Fn(usize) -> Option<f64>| -> Vec<f64> {
-            idx.iter()
-                .map(|&k| f(k).map_or(f64::NAN, |v| 1e6 * v))
-                .collect()
-        };
-        let id = &self.identification;
-        let mut c = LineChart::new(
-            &format!(
-                "{}: measurement, simulation model and identified model (first {:.0} ms)",
-                self.name,
-                1e3 * self.zoom
-            ),
-            "time since motion start [ms]",
-            "table position [µm]",
-        );
-        c.push(
-            Series::new(
-                "command",
-                ms.clone(),
-                um(&|k| Some(self.recording.command()[k])),
-            )
-            .dashed()
-            .with_color(5),
-        );
-        c.push(
-            Series::new(
-                "measurement (virtual rig)",
-                ms.clone(),
-                um(&|k| Some(self.recording.position()[k])),
-            )
-            .with_color(0),
-        );
-        c.push(
-            Series::new(
-                "simulation model",
-                ms.clone(),
-                um(&|k| id.simulated.as_ref().and_then(|s| s.get(k).copied())),
-            )
-            .with_color(1),
-        );
-        c.push(
-            Series::new(
-                &format!("identified model (paper LSM, {})", self.solver.label()),
-                ms,
-                um(&|k| id.sliding.prediction(k)),
-            )
-            .with_color(2),
-        );
-        c
-    }
-
-    /// Error of the identified and of the simulation model against the
-    /// measurement over the zoom window (paper figures 6 and 8), in µm.
-    pub fn error_chart(&self) -> LineChart {
-        let idx = self.zoom_indices();
-        let t = self.recording.time();
-        let y = self.recording.position();
-        let ms: Vec<f64> = idx
-            .iter()
-            .map(|&k| 1e3 * (t[k] - self.motion_start))
-            .collect();
-        let id = &self.identification;
-        let err = |f: &dyn Fn(usize) -> Option<f64>| -> Vec<f64> {
-            idx.iter()
-                .map(|&k| f(k).map_or(f64::NAN, |v| 1e6 * (y[k] - v)))
-                .collect()
-        };
-        let mut c = LineChart::new(
-            &format!(
-                "{}: model error against measurement (first {:.0} ms)",
-                self.name,
-                1e3 * self.zoom
-            ),
-            "time since motion start [ms]",
-            "measurement − model [µm]",
-        );
-        c.push(
-            Series::new(
-                "simulation model error",
-                ms.clone(),
-                err(&|k| id.simulated.as_ref().and_then(|s| s.get(k).copied())),
-            )
-            .with_color(1),
-        );
-        c.push(
-            Series::new(
-                "identified model (LSM) error",
-                ms,
-                err(&|k| id.sliding.prediction(k)),
-            )
-            .with_color(2),
-        );
-        c
     }
 }
 
@@ -363,8 +260,6 @@ mod tests {
         assert!(r.qr.whole.rms.is_finite());
         // the nominal model on the nonlinear rig is off by tens of µm at most
         assert!(r.simulation.whole.rms < 50e-6, "{:?}", r.simulation);
-        let svg = r.response_chart().to_svg().unwrap();
-        assert!(svg.contains("identified model"));
         let md = summary_markdown(&[r], &cfg);
         assert!(md.contains("| ramp | paper LSM, QR |"));
     }

@@ -4,10 +4,14 @@
 //! physical model of a ball-screw axis under P / PI / PI cascade control
 //! ([`drive`]), linear-system tools ([`lti`]), a nonlinear virtual rig and
 //! test commands ([`drive`], [`signal`]), the windowed identification methods
-//! and the sliding prediction engine ([`ident`]), solvers ([`solve`]) and
-//! file input ([`io`]); physical parameters from data ([`greybox`]) and
-//! model-based compensation of the command ([`compensate`]); the drive zoo,
-//! a generated family of recordings to benchmark on ([`zoo`]).
+//! and the sliding prediction engine ([`ident`]), one identification run end
+//! to end ([`pipeline`]), solvers ([`solve`]) and file input ([`io`]);
+//! physical parameters from data ([`greybox`]) and model-based compensation
+//! of the command ([`compensate`]); the drive zoo, a generated family of
+//! recordings to benchmark on ([`zoo`]).
+//!
+//! Figures and HTML reports are in the separate crate `feedid-report`, so
+//! this numerical core builds without a plotting library.
 //!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
 //! Identification of Feed Drive Systems using Nonlinear Least Squares Method".
@@ -25,13 +29,13 @@ pub mod greybox;
 pub mod ident;
 pub mod io;
 pub mod lti;
-pub mod plot;
+pub mod pipeline;
 pub mod recording;
-pub mod report;
 pub mod signal;
 pub mod solve;
 pub mod stats;
 pub mod zoo;
 
 pub use error::{Error, Result};
+pub use pipeline::Pipeline;
 pub use recording::Recording;

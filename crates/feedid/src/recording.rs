@@ -18,7 +18,6 @@
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::ident::Signals;
 
 /// Default relative tolerance on sampling-interval deviation (1 %).
 pub const DEFAULT_JITTER_TOLERANCE: f64 = 0.01;
@@ -151,6 +150,20 @@ impl Recording {
         Ok(self)
     }
 
+    /// The first `n` samples (all of them if `n` is larger) as a recording
+    /// of its own, without the further channels; the sampling was checked
+    /// when this recording was built, so no jitter tolerance applies again.
+    /// Errors: `n < 2`.
+    pub fn head(&self, n: usize) -> Result<Self> {
+        let n = n.min(self.len());
+        Self::with_tolerance(
+            self.time[..n].to_vec(),
+            self.command[..n].to_vec(),
+            self.position[..n].to_vec(),
+            f64::INFINITY,
+        )
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.time.len()
@@ -266,17 +279,6 @@ impl Recording {
                 }
             })
             .collect()
-    }
-
-    /// The whole recording as an estimator view.
-    pub fn signals(&self) -> Signals<'_> {
-        Signals::new(
-            &self.time,
-            &self.command,
-            &self.position,
-            self.dt,
-            self.motion_start_time(),
-        )
     }
 }
 

@@ -154,6 +154,28 @@ impl InformationCriteria {
     }
 }
 
+/// A value with three significant digits for text and figure labels
+/// (`1234.5` → `1235`, `0.01234` → `0.0123`; no exponent below 1e6;
+/// `–` for a non-finite value).
+pub fn sig3(v: f64) -> String {
+    let a = v.abs();
+    if !v.is_finite() {
+        "–".to_string()
+    } else if a >= 1e6 {
+        format!("{v:.2e}")
+    } else if a >= 100.0 {
+        format!("{v:.0}")
+    } else if a >= 10.0 {
+        format!("{v:.1}")
+    } else if a >= 1.0 {
+        format!("{v:.2}")
+    } else if a >= 0.01 || a == 0.0 {
+        format!("{v:.3}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -27,7 +27,7 @@ fn run_auto(s: &Signals<'_>) -> (ErrorStats, f64) {
     };
     let r = engine::run(&mut est, s, &cfg).unwrap();
     assert!(r.predicted.iter().all(|v| v.is_finite()));
-    let coverage = r.stats.samples as f64 / s.time.len() as f64;
+    let coverage = r.stats.samples as f64 / s.len() as f64;
     (r.stats, coverage)
 }
 

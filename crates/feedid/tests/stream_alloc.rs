@@ -8,7 +8,7 @@ use std::cell::Cell;
 
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::stream::Streamer;
-use feedid::ident::{EngineConfig, MethodKind, MethodSpec, PaperConfig, Solver};
+use feedid::ident::{EngineConfig, Method, PaperConfig, Solver};
 use feedid::signal::Scenario;
 
 struct Counting;
@@ -118,8 +118,8 @@ fn steady_state_pushes_allocate_nothing_for_the_default_and_linear_methods() {
         .with_seed(3)
         .simulate(&command, rate)
         .unwrap();
-    for kind in [MethodKind::Auto, MethodKind::Rls, MethodKind::Arx] {
-        let spec = MethodSpec::new(kind);
+    for name in ["auto", "rls", "arx"] {
+        let spec: Method = name.parse().unwrap();
         let cfg = EngineConfig {
             window: spec.default_window(),
             ..EngineConfig::default()
@@ -143,7 +143,7 @@ fn steady_state_pushes_allocate_nothing_for_the_default_and_linear_methods() {
                 }
             }
         });
-        assert!(predictions >= 150, "{kind}: {predictions}");
-        assert_eq!(n, 0, "{kind}: {n} allocations in steady state");
+        assert!(predictions >= 150, "{name}: {predictions}");
+        assert_eq!(n, 0, "{name}: {n} allocations in steady state");
     }
 }

@@ -1,86 +1,47 @@
-//! `feedid identify`: sliding-window identification and prediction of a recording.
+//! `feedid identify`: sliding-window identification and prediction of a
+//! recording — arguments, one library pipeline call per recording
+//! ([`feedid::pipeline::Pipeline`]), the output files and the printed summary.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use feedid::drive::RigParams;
-use feedid::ident::{
-    fit_global_model, global_model_for, identify, select_order, ArxOrders, EngineConfig,
-    GlobalModelKind, MethodKind, MethodSpec, OrderSearch, PaperConfig, SHIFT_AMPLIFICATION_WARNING,
-};
+use feedid::ident::{GlobalModelKind, OrderSearch};
 use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
+use feedid::pipeline::Pipeline;
 use rayon::prelude::*;
 
-use crate::args::{IdentifyArgs, MethodArgs, WindowArgs};
+use crate::args::{IdentifyArgs, RecordingArgs};
+use crate::cmd::method::OrderOption;
 use crate::cmd::{check_distinct, load_params, recording, Outputs};
-
-/// The method named on the command line with its options.
-pub fn method_spec(m: &MethodArgs) -> Result<MethodSpec> {
-    let mut spec = MethodSpec::new(m.method.parse()?);
-    spec.paper = PaperConfig {
-        solver: m.solver.parse()?,
-        time_origin: m.time_origin.parse()?,
-        prediction: m.prediction.parse()?,
-        ..spec.paper
-    };
-    if let Some(o) = m
-        .order
-        .as_deref()
-        .filter(|o| !o.eq_ignore_ascii_case("auto"))
-    {
-        let orders = parse_orders(o)?;
-        spec.arx.orders = orders;
-        spec.rls.orders = orders;
-    }
-    if let Some(l) = m.lambda {
-        spec.rls.lambda = l;
-    }
-    if let Some(t) = m.tolerance {
-        spec.auto.tolerance = t * 1e-6;
-    }
-    Ok(spec)
-}
-
-/// `na,nb,nk` → orders.
-fn parse_orders(s: &str) -> Result<ArxOrders> {
-    let v: Vec<&str> = s.split(',').map(str::trim).collect();
-    let parse = |x: &str| -> Result<usize> {
-        x.parse()
-            .map_err(|_| anyhow::anyhow!("invalid order `{s}`: expected na,nb,nk (e.g. 8,8,1)"))
-    };
-    if v.len() != 3 {
-        anyhow::bail!("invalid order `{s}`: expected na,nb,nk (e.g. 8,8,1)");
-    }
-    Ok(ArxOrders {
-        na: parse(v[0])?,
-        nb: parse(v[1])?,
-        nk: parse(v[2])?,
-    })
-}
-
-/// Engine settings from the command line (window defaulting to the method's).
-pub fn engine_config(w: &WindowArgs, spec: &MethodSpec) -> EngineConfig {
-    EngineConfig {
-        window: w.window.unwrap_or_else(|| spec.default_window()),
-        horizon: w.horizon,
-        hop: w.hop,
-        warm_up: 0,
-    }
-}
 
 /// Output paths of one recording.
 struct OutputPaths {
     predictions: PathBuf,
     coefficients: Option<PathBuf>,
     summary: Option<PathBuf>,
+    model: Option<PathBuf>,
 }
 
 /// Identify, write the outputs, print a short summary (one file, or a batch with --out-dir).
 pub fn run(a: &IdentifyArgs) -> Result<()> {
-    let spec = method_spec(&a.method)?;
-    let cfg = engine_config(&a.windows, &spec);
+    let method = a.options.method(&a.method)?;
     let params = load_params(a.params.as_deref())?;
+    let mut pipeline = Pipeline::new(method)
+        .window_or_default(a.windows.window)
+        .horizon(a.windows.horizon)
+        .hop(a.windows.hop)
+        .nominal(params);
+    if a.options.order_option()? == Some(OrderOption::Select) {
+        pipeline = pipeline.select_orders(OrderSearch::default());
+    }
+    if a.model_out.is_some() {
+        let name = a.model_kind.as_deref().unwrap_or("auto");
+        let kind = match &a.model_order {
+            Some(order) => GlobalModelKind::with_orders(name, order)?,
+            None => GlobalModelKind::default_for(name)?,
+        };
+        pipeline = pipeline.extra_model(kind);
+    }
     match (&a.out_dir, a.inputs.as_slice()) {
         (None, [input]) => {
             let paths = OutputPaths {
@@ -90,14 +51,16 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
                     .ok_or_else(|| anyhow::anyhow!("missing -o predictions.csv"))?,
                 coefficients: a.coefficients.clone(),
                 summary: a.summary.clone(),
+                model: a.model_out.clone(),
             };
             let mut ins = vec![input.as_path()];
             ins.extend(a.params.as_deref());
             let mut outs = vec![paths.predictions.as_path()];
             outs.extend(paths.coefficients.as_deref());
             outs.extend(paths.summary.as_deref());
+            outs.extend(paths.model.as_deref());
             check_distinct(&ins, &outs)?;
-            let text = identify_file(input, a, &spec, &cfg, &params, &paths)?;
+            let text = identify_file(input, &a.recording, &pipeline, &paths)?;
             print!("{text}");
             Ok(())
         }
@@ -118,7 +81,7 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             }
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("{}: cannot create directory", dir.display()))?;
-            let results: Vec<(PathBuf, Result<String>)> = inputs
+            let results: Vec<Result<String>> = inputs
                 .par_iter()
                 .map(|input| {
                     let stem = output_stem(input);
@@ -126,22 +89,19 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
                         predictions: dir.join(format!("{stem}.predictions.csv")),
                         coefficients: Some(dir.join(format!("{stem}.coefficients.csv"))),
                         summary: Some(dir.join(format!("{stem}.summary.json"))),
+                        model: None,
                     };
-                    let r = identify_file(input, a, &spec, &cfg, &params, &paths);
-                    (input.clone(), r)
+                    identify_file(input, &a.recording, &pipeline, &paths)
                 })
                 .collect();
             let mut failed = 0;
-            for (input, r) in &results {
+            for r in &results {
                 match r {
                     Ok(text) => print!("{text}"),
                     Err(e) => {
+                        // the error names its file (see identify_file)
                         failed += 1;
-                        eprintln!(
-                            "error: {}: {}",
-                            input.display(),
-                            e.to_string().replace('\n', " ")
-                        );
+                        eprintln!("error: {}", crate::one_line(e));
                     }
                 }
             }
@@ -162,62 +122,20 @@ fn output_stem(input: &Path) -> String {
 }
 
 /// Read, identify and write one recording; returns the human-readable summary.
+/// Every error names the file once: reading errors carry it from the
+/// library, later ones get it here.
 fn identify_file(
     input: &Path,
-    a: &IdentifyArgs,
-    spec: &MethodSpec,
-    cfg: &EngineConfig,
-    params: &RigParams,
+    read: &RecordingArgs,
+    pipeline: &Pipeline<'_>,
     paths: &OutputPaths,
 ) -> Result<String> {
-    let global_kind = match (&a.model_out, &a.model_kind, &a.model_order) {
-        (None, _, _) => None,
-        (Some(_), kind, Some(order)) => Some(GlobalModelKind::with_orders(
-            kind.as_deref().unwrap_or("auto"),
-            order,
-        )?),
-        (Some(_), kind, None) => Some(GlobalModelKind::default_for(
-            kind.as_deref().unwrap_or("auto"),
-        )?),
-    };
-    let rec = recording::load(input, &a.recording)?;
-    let mut spec = spec.clone();
-    let mut chosen_order = None;
-    if a.method
-        .order
-        .as_deref()
-        .is_some_and(|o| o.eq_ignore_ascii_case("auto"))
-    {
-        let sel = select_order(
-            rec.command(),
-            rec.position(),
-            rec.dt(),
-            &OrderSearch::default(),
-        )
-        .with_context(|| format!("{}: order selection", input.display()))?;
-        spec.arx.orders = sel.chosen;
-        spec.rls.orders = sel.chosen;
-        spec.auto.long.orders = sel.chosen;
-        chosen_order = Some((sel.chosen, sel.criterion));
-    }
-    if spec.kind == MethodKind::Paper {
-        let g = spec.paper.worst_shift_amplification(&rec.signals(), cfg);
-        if g > SHIFT_AMPLIFICATION_WARNING {
-            eprintln!(
-                "warning: {}: paper method: windows lie far from the time origin; the \
-                 coefficients N, D lose about {:.0} of their 16 digits (amplification {g:.1e}); \
-                 predictions are not affected (--time-origin window keeps the coefficients accurate)",
-                input.display(),
-                g.log10().min(16.0)
-            );
-        }
-    }
-    let mut est = spec.build()?;
-    let mut run = identify(&rec, est.as_mut(), cfg, Some(params))?;
-    let mut global_note = None;
-    match global_model_for(&rec, &spec) {
-        Ok(g) => run.global = g,
-        Err(e) => global_note = Some(format!("  global model: not fitted ({e})")),
+    let rec = recording::load(input, read)?;
+    let run = pipeline
+        .run(&rec)
+        .with_context(|| input.display().to_string())?;
+    for w in &run.warnings {
+        eprintln!("warning: {}: {w}", input.display());
     }
     let summary = run.summary();
 
@@ -239,14 +157,13 @@ fn identify_file(
         let json = serde_json::to_string_pretty(&summary)?;
         outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
     }
-    let mut global_line = None;
-    if let (Some(p), Some(kind)) = (&a.model_out, &global_kind) {
-        let mut file = fit_global_model(&rec, kind)
-            .map_err(|e| anyhow::anyhow!("{}: global model: {e}", input.display()))?;
+    let mut model_line = None;
+    if let (Some(p), Some(model)) = (&paths.model, &run.model) {
+        let mut file = model.clone();
         if let Some(prov) = file.identified_by.as_mut() {
             prov.source = Some(input.display().to_string());
-            global_line = Some(format!(
-                "  global model: {} {}, free-run fit {:.3} % (rms {:.3} µm) -> {}",
+            model_line = Some(format!(
+                "  global model: {} {}, free-run fit {:.3} % (rms {:.3} µm) -> {}\n",
                 prov.method,
                 prov.orders,
                 prov.fit_percent,
@@ -259,72 +176,9 @@ fn identify_file(
         })?;
     }
     outputs.commit();
-
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "{}: {} samples at {:.2} Hz, method {}, window {}, horizon {}, hop {}",
+    Ok(format!(
+        "{}: {summary}{}",
         input.display(),
-        summary.samples,
-        summary.rate_hz,
-        summary.method,
-        summary.window,
-        summary.horizon,
-        summary.hop
-    );
-    if let Some((o, c)) = chosen_order {
-        let _ = writeln!(
-            t,
-            "  order auto ({}): na {}, nb {}, nk {}",
-            c.label(),
-            o.na,
-            o.nb,
-            o.nk
-        );
-    }
-    let _ = writeln!(
-        t,
-        "  {} windows ({} failed, {} fallback, {} withheld), {} samples predicted ({:.1} %)",
-        summary.windows,
-        summary.failed_windows,
-        summary.fallback_windows,
-        summary.withheld_windows,
-        summary.samples_predicted,
-        summary.coverage_percent
-    );
-    let _ = writeln!(
-        t,
-        "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %",
-        1e6 * summary.rms_error_m,
-        1e6 * summary.max_abs_error_m,
-        summary.fit_percent
-    );
-    if let Some(p) = run.global.as_ref().and_then(|g| g.identified_by.as_ref()) {
-        let _ = writeln!(
-            t,
-            "  global model of the method ({} {}): free-run fit {:.3} %",
-            p.method, p.orders, p.fit_percent
-        );
-    }
-    if let Some(n) = global_note {
-        let _ = writeln!(t, "{n}");
-    }
-    if let (Some(r), Some(m)) = (summary.sim_rms_error_m, summary.sim_max_abs_error_m) {
-        let _ = writeln!(
-            t,
-            "  simulation model:  rms {:.3} µm, max {:.3} µm",
-            1e6 * r,
-            1e6 * m
-        );
-    }
-    let _ = writeln!(
-        t,
-        "  time: {:.3} ms identification and prediction, {:.2} µs per window",
-        1e3 * summary.identification_seconds,
-        summary.per_window_us
-    );
-    if let Some(line) = global_line {
-        let _ = writeln!(t, "{line}");
-    }
-    Ok(t)
+        model_line.unwrap_or_default()
+    ))
 }

@@ -2,6 +2,7 @@
 
 mod identify;
 mod info;
+mod method;
 mod model;
 mod order;
 mod recording;

@@ -1,39 +1,22 @@
 //! `feedid report`: a self-contained HTML report of one recording.
 
 use anyhow::{bail, Result};
-use feedid::ident::MethodSpec;
+use feedid::ident::EngineConfig;
 use feedid::io::write_string_atomic;
-use feedid::report::{recording_report, RecordingAnalysis, ReportOptions};
+use feedid_report::{recording_report, RecordingAnalysis, ReportOptions};
 
-use crate::args::{MethodArgs, MethodListArgs, ReportArgs};
-use crate::cmd::identify::{engine_config, method_spec};
+use crate::args::ReportArgs;
+use crate::cmd::method::OrderOption;
 use crate::cmd::{load_params, params_error, recording, Outputs};
-
-/// The methods of `--methods` (or `default`), each with the shared per-method options.
-pub fn method_specs(m: &MethodListArgs, default: &str) -> Result<Vec<MethodSpec>> {
-    let list = m.methods.as_deref().unwrap_or(default);
-    let mut out = Vec::new();
-    for name in list.split(',').map(str::trim) {
-        if name.is_empty() {
-            bail!("invalid --methods `{list}`: empty method name");
-        }
-        let args = MethodArgs {
-            method: name.to_string(),
-            solver: m.solver.clone(),
-            time_origin: m.time_origin.clone(),
-            prediction: m.prediction.clone(),
-            order: m.order.clone(),
-            lambda: m.lambda,
-            tolerance: m.tolerance,
-        };
-        out.push(method_spec(&args)?);
-    }
-    Ok(out)
-}
 
 /// Identify with every method, build the page, write it atomically.
 pub fn run(a: &ReportArgs) -> Result<()> {
-    let specs = method_specs(&a.methods, "paper,arx,rls,oe,auto")?;
+    if a.options.order_option()? == Some(OrderOption::Select) {
+        bail!("--order auto is for `feedid identify`; give the orders (na,nb,nk; `feedid order` chooses them)");
+    }
+    let methods = a
+        .options
+        .methods(a.methods.as_deref(), "paper,arx,rls,oe,auto")?;
     if !(a.zoom.is_finite() && a.zoom > 0.0) {
         bail!(
             "invalid --zoom {}: must be a positive number of milliseconds",
@@ -42,11 +25,16 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     }
     let params = load_params(a.params.as_deref())?;
     let rec = recording::load(&a.input, &a.recording)?;
-    let methods = specs
+    let methods = methods
         .into_iter()
-        .map(|s| {
-            let cfg = engine_config(&a.windows, &s);
-            (s, cfg)
+        .map(|m| {
+            let cfg = EngineConfig {
+                window: a.windows.window.unwrap_or_else(|| m.default_window()),
+                horizon: a.windows.horizon,
+                hop: a.windows.hop,
+                warm_up: 0,
+            };
+            (m, cfg)
         })
         .collect();
     let mut opts = ReportOptions::new(methods);
@@ -60,13 +48,14 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         || a.input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| {
+    let analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| match e {
         // extreme but valid parameters can give no usable nominal model: say which file
-        if matches!(e.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() {
-            params_error(a.params.as_deref(), e)
-        } else {
-            e.into()
+        feedid_report::Error::Core(core)
+            if matches!(core.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() =>
+        {
+            params_error(a.params.as_deref(), core)
         }
+        other => other.into(),
     })?;
     let page = recording_report(&analysis)?;
     let html = page.to_html();

@@ -2,10 +2,11 @@
 
 use anyhow::{Context, Result};
 use feedid::experiment::{run_experiment, summary_markdown, PaperExperimentConfig};
-use feedid::ident::{MethodKind, MethodSpec};
+use feedid::ident::Method;
 use feedid::io::write_string_atomic;
-use feedid::report::paper_report;
 use feedid::signal::Scenario;
+use feedid_report::experiment::{error_chart, response_chart};
+use feedid_report::paper_report;
 
 use crate::args::ReproduceArgs;
 use crate::cmd::{load_params, Outputs};
@@ -26,9 +27,9 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
     for r in &results {
         files.push((
             format!("{}_response.svg", r.name),
-            r.response_chart().to_svg()?,
+            response_chart(r).to_svg()?,
         ));
-        files.push((format!("{}_error.svg", r.name), r.error_chart().to_svg()?));
+        files.push((format!("{}_error.svg", r.name), error_chart(r).to_svg()?));
     }
     let md = summary_markdown(&results, &cfg);
     files.push(("summary.md".to_string(), md.clone()));
@@ -37,7 +38,7 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
         .split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty() && *s != "none")
-        .map(|s| Ok(MethodSpec::new(s.parse::<MethodKind>()?)))
+        .map(|s| Ok(s.parse::<Method>()?))
         .collect::<Result<Vec<_>>>()?;
     let page = paper_report(&results, &cfg, &others)?;
     files.push(("report.html".to_string(), page.to_html()));

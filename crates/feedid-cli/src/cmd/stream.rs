@@ -18,10 +18,10 @@
 use std::io::{BufRead, ErrorKind, Read, Write};
 
 use anyhow::{bail, Result};
-use feedid::ident::{Prediction, Streamer};
+use feedid::ident::{EngineConfig, Prediction, Streamer};
 
 use crate::args::StreamArgs;
-use crate::cmd::identify::{engine_config, method_spec};
+use crate::cmd::method::OrderOption;
 
 /// Run on the process's standard streams.
 pub fn run(a: &StreamArgs) -> Result<()> {
@@ -55,10 +55,17 @@ fn run_on<R: BufRead, W: Write, E: Write>(
             bail!("--rate must be a positive number of Hz, got {rate}");
         }
     }
-    let spec = method_spec(&a.method)?;
-    let estimator = spec.build()?;
-    let config = engine_config(&a.windows, &spec);
-    let mut streamer = Streamer::new(estimator, config)?;
+    if a.options.order_option()? == Some(OrderOption::Select) {
+        bail!("--order auto chooses the orders from a whole recording; a stream needs them given (na,nb,nk; `feedid order` chooses them)");
+    }
+    let method = a.options.method(&a.method)?;
+    let config = EngineConfig {
+        window: a.windows.window.unwrap_or_else(|| method.default_window()),
+        horizon: a.windows.horizon,
+        hop: a.windows.hop,
+        warm_up: 0,
+    };
+    let mut streamer = Streamer::new(method.build()?, config)?;
     let fields = if a.rate.is_some() { 2 } else { 3 };
     let layout = if a.rate.is_some() {
         "command,position"

@@ -4,13 +4,13 @@
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 
-use anyhow::{bail, Result};
-use feedid::ident::{sweep, ArxOrders, SweepConfig, SweepResult};
+use anyhow::{bail, Context, Result};
+use feedid::ident::{sweep, SweepConfig, SweepResult};
 use feedid::io::write_string_atomic;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::SweepArgs;
-use crate::cmd::report::method_specs;
+use crate::cmd::method::{parse_orders, OrderOption};
 use crate::cmd::{recording, Outputs};
 
 /// A comma-separated list of sample counts ≥ 1 (duplicates dropped, order kept).
@@ -30,19 +30,6 @@ fn parse_counts(flag: &str, s: &str) -> Result<Vec<usize>> {
         }
     }
     Ok(out)
-}
-
-/// `na,nb,nk`.
-fn parse_order(s: &str) -> Result<ArxOrders> {
-    let err = || anyhow::anyhow!("invalid --orders value `{s}`: expected na,nb,nk (e.g. 4,4,1)");
-    let v: Vec<usize> = s
-        .split(',')
-        .map(|x| x.trim().parse().map_err(|_| err()))
-        .collect::<Result<_>>()?;
-    match v.as_slice() {
-        [na, nb, nk] => Ok(ArxOrders::new(*na, *nb, *nk)),
-        _ => Err(err()),
-    }
 }
 
 /// A progress bar on standard error when it is a terminal; hidden otherwise (pipes, CI).
@@ -97,13 +84,16 @@ fn table(res: &SweepResult) -> String {
 
 /// Parse, sweep in parallel, write CSV (and SVG), print the table and the best choice.
 pub fn run(a: &SweepArgs) -> Result<()> {
-    let methods = method_specs(&a.methods, "paper,arx")?;
+    if a.options.order_option()? == Some(OrderOption::Select) {
+        bail!("--order auto is for `feedid identify`; sweep orders with --orders (na,nb,nk …)");
+    }
+    let methods = a.options.methods(a.methods.as_deref(), "paper,arx")?;
     let windows = parse_counts("--windows", &a.windows)?;
     let horizons = parse_counts("--horizons", &a.horizons)?;
     let orders = a
         .orders
         .iter()
-        .map(|o| parse_order(o))
+        .map(|o| parse_orders(o).context("--orders"))
         .collect::<Result<Vec<_>>>()?;
     if a.hop == Some(0) {
         bail!("invalid --hop 0: must be at least 1 sample");
@@ -133,7 +123,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     }
     let csv = res.to_csv();
     let svg = match &a.plot {
-        Some(_) => Some(res.heat_map().to_svg()?),
+        Some(_) => Some(feedid_report::sweep_heat_map(&res).to_svg()?),
         None => None,
     };
     let mut outputs = Outputs::default();
@@ -164,6 +154,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use feedid::ident::ArxOrders;
 
     #[test]
     fn lists_are_parsed_and_bad_values_named() {
@@ -176,8 +167,8 @@ mod tests {
         let e = parse_counts("--windows", "10,abc").unwrap_err().to_string();
         assert!(e.contains("`abc`") && e.contains("--windows"), "{e}");
         assert!(parse_counts("--horizons", "").is_err());
-        assert_eq!(parse_order("4, 4,1").unwrap(), ArxOrders::new(4, 4, 1));
-        assert!(parse_order("4,4")
+        assert_eq!(parse_orders("4, 4,1").unwrap(), ArxOrders::new(4, 4, 1));
+        assert!(parse_orders("4,4")
             .unwrap_err()
             .to_string()
             .contains("`4,4`"));

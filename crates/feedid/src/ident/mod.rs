@@ -3,44 +3,40 @@
 //! Every method implements [`Estimator`]; the [`engine`] slides a window of
 //! `W` samples over a recording, fits, predicts the next `H` samples, and
 //! shifts by a hop. The [`stream`] module does the same one sample at a time.
+//!
+//! Folders follow the data flow: [`engine`] (the estimator trait, the
+//! signals view, the sliding engine, the streamer, batches), `methods` (one
+//! module per method), `select` (model orders, window sweeps), `model`
+//! (global models of a whole recording), `analysis` (residuals).
 
-mod arx;
-mod auto;
-pub mod batch;
-mod companion;
+mod analysis;
 pub mod engine;
-mod estimator;
-mod global;
-mod identify;
 mod method;
+mod methods;
 mod model;
-mod oe;
-mod order;
-mod paper;
-mod residuals;
-mod rls;
-mod srivc;
-pub mod stream;
-mod sweep;
+mod select;
 
-pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, MAX_ARX_ORDER};
-pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
-pub use engine::{EngineConfig, SlidingResult, WindowRecord};
-pub use estimator::{Estimator, Signals, WindowFit};
-pub use global::{fit_global_model, global_model_for, GlobalModelKind, ModelFile, ModelProvenance};
-pub use identify::{identify, Identification, IdentifySummary, RESIDUAL_LAGS};
-pub use method::{MethodKind, MethodSpec, METHOD_NAMES};
-pub use model::LinearModel;
-pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit};
-pub use order::{
-    frols, order_table, select_order, Criterion, FrolsConfig, FrolsResult, FrolsTerm, OrderRow,
-    OrderSearch, OrderSelection, OrderTable, TermKind,
+pub use analysis::{
+    prediction_errors, prediction_residuals, ResidualAnalysis, RESIDUAL_LAGS, RESIDUAL_SAMPLES,
+    Z_99,
 };
-pub use paper::{
-    coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
-    PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin, SHIFT_AMPLIFICATION_WARNING,
+pub use engine::{
+    batch, stream, EngineConfig, Estimator, FitStatus, PredictStatus, Prediction, Samples, Signals,
+    SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit, WindowOutcome, WindowRecord,
 };
-pub use residuals::{ResidualAnalysis, Z_99};
-pub use rls::{RlsConfig, RlsEstimator};
-pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};
-pub use sweep::{sweep, SweepConfig, SweepResult, SweepRow, PAPER_WINDOW};
+pub use method::{Method, METHOD_NAMES};
+pub use methods::{
+    coefficients_from_polynomials, fit_arx, fit_oe, polynomials_from_coefficients, ArxConfig,
+    ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, OeConfig,
+    OeEstimator, OeFit, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig,
+    RlsEstimator, SimplexSettings, Solver, TimeOrigin, AUTO_CANDIDATES, MAX_ARX_ORDER,
+    SHIFT_AMPLIFICATION_WARNING,
+};
+pub use model::{
+    fit_global_model, GlobalModelKind, LinearModel, ModelFile, ModelProvenance, GLOBAL_FIT_SAMPLES,
+};
+pub use select::{
+    frols, order_table, select_order, sweep, Criterion, FrolsConfig, FrolsResult, FrolsTerm,
+    OrderRow, OrderSearch, OrderSelection, OrderTable, SweepConfig, SweepResult, SweepRow,
+    TermKind, PAPER_WINDOW,
+};

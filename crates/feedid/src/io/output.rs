@@ -109,9 +109,9 @@ pub fn write_coefficients_csv(path: &Path, time: &[f64], result: &SlidingResult)
                 i,
                 cell(start),
                 cell(end),
-                cell(Some(rec.fit.residual_rms)),
-                rec.fit.iterations,
-                rec.fit.termination.label()
+                cell(Some(rec.residual_rms)),
+                rec.iterations,
+                rec.outcome.label()
             )?;
             for c in result.window_coefficients(i) {
                 write!(w, ",{}", cell(Some(*c)))?;

@@ -1,0 +1,430 @@
+//! The analysis behind a recording's report: every method's run, the
+//! nominal simulation, the global models, and the helpers the figures share.
+
+use rayon::prelude::*;
+
+use crate::error::Result;
+use crate::html::{Figure, HtmlReport, Section};
+use crate::plot::{decimate_minmax, LineChart, Series};
+use feedid::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
+use feedid::ident::{
+    fit_global_model, prediction_errors, EngineConfig, GlobalModelKind, LinearModel, Method,
+    OeConfig, ResidualAnalysis, GLOBAL_FIT_SAMPLES,
+};
+use feedid::lti::TransferFunction;
+use feedid::pipeline::{Identification, Pipeline};
+use feedid::stats::ErrorStats;
+use feedid::Recording;
+
+/// Palette colours of the methods (0 = measurement, 5 = simulation model, 8 = command).
+pub(super) const METHOD_COLORS: [usize; 6] = [1, 2, 3, 4, 6, 7];
+pub(super) const MEASUREMENT: usize = 0;
+pub(super) const SIMULATION: usize = 5;
+pub(super) const COMMAND: usize = 8;
+
+pub(super) fn method_color(i: usize) -> usize {
+    METHOD_COLORS[i % METHOD_COLORS.len()]
+}
+
+/// What to analyse and how to draw it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReportOptions {
+    /// Methods with their sliding-window settings.
+    pub methods: Vec<(Method, EngineConfig)>,
+    /// Rig parameters of the nominal model; default: the default rig.
+    pub params: RigParams,
+    /// Where the parameters came from (shown in the header); default "the built-in default rig".
+    pub params_source: String,
+    /// Zoom after the motion start \[s\]; default 0.06 (the paper's figures 5 and 7).
+    pub zoom_s: f64,
+    /// Points per curve after min/max decimation; default 3000 (coefficient
+    /// curves, up to 16 per figure, get a fifth of it).
+    pub max_points: usize,
+    /// Largest lag of the residual analysis \[samples\]; default 30.
+    pub max_lag: usize,
+    /// Fit and plot the global models (Bode figure); default true.
+    pub global_models: bool,
+}
+
+impl ReportOptions {
+    /// Defaults with the given methods.
+    pub fn new(methods: Vec<(Method, EngineConfig)>) -> Self {
+        Self {
+            methods,
+            params: RigParams::default(),
+            params_source: "the built-in default rig".to_string(),
+            zoom_s: 0.06,
+            max_points: 3000,
+            max_lag: 30,
+            global_models: true,
+        }
+    }
+}
+
+/// One method's sliding identification and its diagnostics.
+#[derive(Debug, Clone)]
+pub struct MethodRun {
+    /// Label for legends and tables (method and its main settings).
+    pub label: String,
+    /// Short id for element ids.
+    pub slug: String,
+    /// The method as it ran.
+    pub method: Method,
+    /// The run.
+    pub identification: Identification,
+    /// Errors over the zoom window after the motion start.
+    pub zoom_stats: ErrorStats,
+    /// Residual analysis of the prediction errors (`None` if too few predictions).
+    pub residuals: Option<ResidualAnalysis>,
+}
+
+/// A model fitted over the whole recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlobalModel {
+    /// Label (structure and orders).
+    pub label: String,
+    /// The model.
+    pub model: LinearModel,
+    /// Errors of its free-run simulation against the measurement.
+    pub simulation: ErrorStats,
+}
+
+/// The analysis behind one recording's report.
+#[derive(Debug, Clone)]
+pub struct RecordingAnalysis {
+    /// Display name (file name).
+    pub name: String,
+    /// The recording.
+    pub recording: Recording,
+    /// One run per method, in the order given.
+    pub runs: Vec<MethodRun>,
+    /// Nominal model driven by the measured command \[m\].
+    pub simulated: Vec<f64>,
+    /// Errors of the nominal model over the whole recording.
+    pub simulation_stats: ErrorStats,
+    /// Errors of the nominal model over the zoom window.
+    pub simulation_zoom: ErrorStats,
+    /// The nominal closed-loop transfer function.
+    pub nominal: TransferFunction,
+    /// Global models that could be fitted.
+    pub global: Vec<GlobalModel>,
+    /// Why a global model is missing (one line each).
+    pub notes: Vec<String>,
+    /// Motion start \[s\].
+    pub motion_start: f64,
+    /// Options used.
+    pub options: ReportOptions,
+}
+
+impl RecordingAnalysis {
+    /// Identify `recording` with every method (in parallel, each through
+    /// the library's identification [`Pipeline`]), analyse the residuals of
+    /// every predicted sample up to [`ReportOptions::max_lag`] (shortened
+    /// for short series), simulate the nominal model and fit the global
+    /// models.
+    pub fn run(name: &str, recording: Recording, opts: &ReportOptions) -> Result<Self> {
+        let dt = recording.dt();
+        let simulated = simulate_nominal(&opts.params, recording.command(), dt)?;
+        let nominal =
+            closed_loop_coefficients(&opts.params, D1Variant::Corrected).transfer_function()?;
+        let motion_start = recording.motion_start_time();
+        let t = recording.time();
+        let y = recording.position();
+        let in_zoom = |k: usize| t[k] >= motion_start && t[k] <= motion_start + opts.zoom_s;
+
+        let runs: Vec<feedid::Result<Identification>> = opts
+            .methods
+            .par_iter()
+            .map(|(method, cfg)| {
+                Pipeline::new(method.clone())
+                    .engine(*cfg)
+                    .method_global_model(false)
+                    .residuals(None)
+                    .run(&recording)
+            })
+            .collect();
+        let mut out_runs = Vec::with_capacity(runs.len());
+        for (i, r) in runs.into_iter().enumerate() {
+            let identification = r?;
+            let s = &identification.sliding;
+            let zoom_stats = ErrorStats::from_pairs(
+                (0..y.len())
+                    .filter(|&k| in_zoom(k))
+                    .filter_map(|k| s.prediction(k).map(|p| (y[k], p))),
+            );
+            // every predicted sample, the lag shortened to fit a short series
+            let (uu, ee) = prediction_errors(s, recording.command(), y, usize::MAX);
+            let lag = opts.max_lag.min(ee.len().saturating_sub(2));
+            let residuals = if lag >= 1 {
+                ResidualAnalysis::new(&uu, &ee, lag).ok()
+            } else {
+                None
+            };
+            let method = identification.method.clone();
+            out_runs.push(MethodRun {
+                label: format!("{} (W={})", method.label(), identification.config.window),
+                slug: format!("{}{}", method.name(), i + 1),
+                method,
+                identification,
+                zoom_stats,
+                residuals,
+            });
+        }
+        let simulation_stats =
+            ErrorStats::from_pairs(y.iter().copied().zip(simulated.iter().copied()));
+        let simulation_zoom = ErrorStats::from_pairs(
+            (0..y.len())
+                .filter(|&k| in_zoom(k))
+                .map(|k| (y[k], simulated[k])),
+        );
+        let (global, notes) = if opts.global_models {
+            global_models(&recording, opts)
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        Ok(Self {
+            name: name.to_string(),
+            recording,
+            runs: out_runs,
+            simulated,
+            simulation_stats,
+            simulation_zoom,
+            nominal,
+            global,
+            notes,
+            motion_start,
+            options: opts.clone(),
+        })
+    }
+
+    /// Header facts: samples, rate, duration, motion, methods, parameters.
+    pub fn facts(&self) -> Vec<(String, String)> {
+        let r = &self.recording;
+        let c = r.command();
+        let (lo, hi) = c
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        vec![
+            ("recording".into(), self.name.clone()),
+            ("samples".into(), format!("{}", r.len())),
+            (
+                "sampling rate".into(),
+                format!("{:.2} Hz (Δt = {:.4} ms)", r.rate_hz(), 1e3 * r.dt()),
+            ),
+            ("duration".into(), format!("{:.4} s", r.duration())),
+            (
+                "motion start".into(),
+                format!(
+                    "{:.2} ms after the first sample",
+                    1e3 * (self.motion_start - r.time()[0])
+                ),
+            ),
+            (
+                "command range".into(),
+                format!("{:.3} mm … {:.3} mm", 1e3 * lo, 1e3 * hi),
+            ),
+            (
+                "methods".into(),
+                self.runs
+                    .iter()
+                    .map(|m| m.label.clone())
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            ),
+            (
+                "prediction horizon".into(),
+                self.runs.first().map_or("–".into(), |m| {
+                    let h = m.identification.config.horizon;
+                    format!("H = {h} samples ({:.2} ms)", 1e3 * h as f64 * r.dt())
+                }),
+            ),
+            ("nominal model".into(), self.options.params_source.clone()),
+        ]
+    }
+
+    /// The report's sections for this recording; element ids start with `prefix`.
+    pub fn sections(&self, prefix: &str) -> Result<Vec<Section>> {
+        Ok(vec![
+            self.overview_section(prefix)?,
+            self.response_section(prefix)?,
+            self.error_section(prefix)?,
+            self.coefficient_section(prefix)?,
+            self.residual_section(prefix)?,
+            self.bode_section(prefix)?,
+            self.summary_section(prefix),
+        ])
+    }
+
+    // ------------------------------------------------------------ helpers
+
+    pub(super) fn time_axis(&self) -> (f64, &'static str) {
+        if self.recording.duration() <= 10.0 {
+            (1e3, "time [ms]")
+        } else {
+            (1.0, "time [s]")
+        }
+    }
+
+    pub(super) fn position_unit(&self) -> (f64, &'static str) {
+        let c = self.recording.command();
+        let (lo, hi) = c
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        if hi - lo >= 5e-3 {
+            (1e3, "mm")
+        } else {
+            (1e6, "µm")
+        }
+    }
+
+    /// Decimated series over the whole recording.
+    pub(super) fn whole(
+        &self,
+        label: &str,
+        f: &dyn Fn(usize) -> Option<f64>,
+        scale: f64,
+    ) -> Series {
+        let t = self.recording.time();
+        let (tf, _) = self.time_axis();
+        let x: Vec<f64> = t.iter().map(|&v| tf * (v - t[0])).collect();
+        let y: Vec<f64> = (0..t.len())
+            .map(|k| f(k).map_or(f64::NAN, |v| scale * v))
+            .collect();
+        let (x, y) = decimate_minmax(&x, &y, self.options.max_points);
+        Series::new(label, x, y)
+    }
+
+    pub(super) fn zoom_indices(&self) -> Vec<usize> {
+        let t = self.recording.time();
+        (0..t.len())
+            .filter(|&k| {
+                t[k] >= self.motion_start && t[k] <= self.motion_start + self.options.zoom_s
+            })
+            .collect()
+    }
+
+    /// Series over the zoom window, time in ms since the motion start.
+    pub(super) fn zoomed(
+        &self,
+        label: &str,
+        f: &dyn Fn(usize) -> Option<f64>,
+        scale: f64,
+    ) -> Series {
+        let idx = self.zoom_indices();
+        let t = self.recording.time();
+        let x: Vec<f64> = idx
+            .iter()
+            .map(|&k| 1e3 * (t[k] - self.motion_start))
+            .collect();
+        let y: Vec<f64> = idx
+            .iter()
+            .map(|&k| f(k).map_or(f64::NAN, |v| scale * v))
+            .collect();
+        let (x, y) = decimate_minmax(&x, &y, self.options.max_points);
+        Series::new(label, x, y)
+    }
+
+    pub(super) fn zoom_ms(&self) -> f64 {
+        1e3 * self.options.zoom_s
+    }
+
+    pub(super) fn figure(
+        id: String,
+        title: &str,
+        chart: &LineChart,
+        caption: &str,
+    ) -> Result<Figure> {
+        Ok(Figure::new(&id, title, &chart.to_svg()?, caption))
+    }
+}
+
+/// The global models of the Bode figure, through the library's one
+/// global-model path ([`fit_global_model`], at most
+/// [`GLOBAL_FIT_SAMPLES`] samples): ARX with the orders of the first method
+/// whose global model is ARX (`arx`, `rls`; else 8,8,1) and continuous OE
+/// with the poles and zeros of the first `oe` method (else 3 poles, 1
+/// zero); a model that cannot be fitted is a note, not an error.
+fn global_models(recording: &Recording, opts: &ReportOptions) -> (Vec<GlobalModel>, Vec<String>) {
+    let kinds: Vec<GlobalModelKind> = opts
+        .methods
+        .iter()
+        .filter_map(|(m, _)| m.global_model())
+        .collect();
+    let orders = kinds
+        .iter()
+        .find_map(|k| match k {
+            GlobalModelKind::Arx(o) => Some(*o),
+            _ => None,
+        })
+        .unwrap_or_default();
+    let default_oe = OeConfig::default();
+    let (poles, zeros) = kinds
+        .iter()
+        .find_map(|k| match k {
+            GlobalModelKind::Oe { poles, zeros } => Some((*poles, *zeros)),
+            _ => None,
+        })
+        .unwrap_or((default_oe.poles, default_oe.zeros));
+    let plural = |n: usize, what: &str| {
+        if n == 1 {
+            format!("1 {what}")
+        } else {
+            format!("{n} {what}s")
+        }
+    };
+    let arx_label = format!("global ARX {},{},{}", orders.na, orders.nb, orders.nk);
+    let oe_label = format!(
+        "global OE {}, {}",
+        plural(poles, "pole"),
+        plural(zeros, "zero")
+    );
+    let (arx, oe) = rayon::join(
+        || fit_global_model(recording, &GlobalModelKind::Arx(orders)),
+        || fit_global_model(recording, &GlobalModelKind::Oe { poles, zeros }),
+    );
+    let (mut global, mut notes) = (Vec::new(), Vec::new());
+    let n = recording.len().min(GLOBAL_FIT_SAMPLES);
+    let (u, y, dt) = (
+        &recording.command()[..n],
+        &recording.position()[..n],
+        recording.dt(),
+    );
+    for (label, fit) in [(arx_label, arx), (oe_label, oe)] {
+        match fit {
+            Ok(file) => match file.model.simulate_at(u, dt) {
+                Ok(sim) if sim.iter().all(|v| v.is_finite()) => global.push(GlobalModel {
+                    label,
+                    simulation: ErrorStats::from_pairs(
+                        y.iter().copied().zip(sim.iter().copied()),
+                    ),
+                    model: file.model,
+                }),
+                _ => notes.push(format!(
+                    "{label}: fitted, but its free-run simulation diverges (unstable model); not shown."
+                )),
+            },
+            Err(e) => notes.push(format!("{label}: could not be fitted ({e}); not shown.")),
+        }
+    }
+    (global, notes)
+}
+
+/// The stand-alone report of one recording.
+pub fn recording_report(a: &RecordingAnalysis) -> Result<HtmlReport> {
+    let mut page = HtmlReport::new(&format!("feedid report — {}", a.name));
+    page.facts = a.facts();
+    page.intro.push(
+        "How to read this report: the recording is identified in short sliding windows by each method; every \
+         window's model predicts the next H samples, which are compared with what was then measured. The \
+         figures go from the raw data to the predictions, their errors, the identified coefficients, the \
+         whiteness of the errors, and the frequency response; the summary table at the end has the numbers. \
+         Units: time in ms (s for long recordings), positions in µm or mm as labelled on each axis."
+            .into(),
+    );
+    page.sections = a.sections("rec")?;
+    Ok(page)
+}

@@ -1,0 +1,17 @@
+//! The estimator trait and what drives it: the sliding-window engine over a
+//! whole recording, the streaming engine fed one sample at a time, and
+//! batches of recordings on all cores.
+
+pub mod batch;
+mod estimator;
+mod signals;
+mod sliding;
+pub mod stream;
+
+pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
+pub use signals::{Samples, Signals};
+pub(crate) use sliding::fit_and_predict;
+pub use sliding::{
+    run, run_with_progress, EngineConfig, Progress, SlidingResult, WindowIter, WindowRecord,
+};
+pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};

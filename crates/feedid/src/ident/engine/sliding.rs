@@ -1,0 +1,586 @@
+//! The sliding prediction engine, generic over [`Estimator`]s.
+//!
+//! Windows of `W` samples start at `s = warm_up + estimator.warm_up()` and
+//! advance by `hop` samples: window `[s, s+W)`, horizon `[s+W, s+W+H)`
+//! (shortened at the end of the recording). For each window the estimator
+//! fits, then predicts the horizon. With `hop = H` (the paper's setting) every
+//! sample after the first window is predicted exactly once; with `hop < H`
+//! horizons overlap and the most recent prediction of a sample is kept.
+//!
+//! Each window ends with a [`WindowOutcome`] — predicted (with the
+//! solver's termination), fallback (the last good model predicted),
+//! withheld by the method, or failed — a value, apart from how a solver
+//! stopped. A window whose fit or prediction fails (singular problem,
+//! non-finite result) gives no prediction and is recorded as
+//! [`WindowOutcome::Failed`]; no NaN ever reaches the prediction series.
+//!
+//! ```
+//! # use feedid::ident::{engine::{run, EngineConfig}, Estimator, PredictStatus, Signals, WindowFit};
+//! # use feedid::solve::Termination;
+//! /// Predicts the last measured value (a "hold" estimator).
+//! struct Hold;
+//! impl Estimator for Hold {
+//!     fn name(&self) -> &'static str { "hold" }
+//!     fn coefficient_names(&self) -> Vec<String> { vec![] }
+//!     fn fit(&mut self, _: &Signals<'_>, _: std::ops::Range<usize>, _: &mut [f64]) -> feedid::Result<WindowFit> {
+//!         Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+//!     }
+//!     fn predict(&mut self, s: &Signals<'_>, w: std::ops::Range<usize>, _: std::ops::Range<usize>, out: &mut [f64]) -> feedid::Result<PredictStatus> {
+//!         out.fill(s.window(w.end - 1..w.end, 0, "hold")?.position[0]);
+//!         Ok(PredictStatus::Predicted)
+//!     }
+//! }
+//! let t: Vec<f64> = (0..100).map(|k| k as f64 * 1e-3).collect();
+//! let y = vec![1.0; 100];
+//! let res = run(&mut Hold, &Signals::new(&t, &y, &y, 1e-3, 0.0), &EngineConfig::default()).unwrap();
+//! assert_eq!(res.stats.rms, 0.0);
+//! assert_eq!(res.stats.samples, 80);
+//! ```
+
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+use crate::error::{Error, Result};
+use crate::ident::{Estimator, PredictStatus, Signals, WindowOutcome};
+use crate::stats::{ErrorAccumulator, ErrorStats};
+
+/// How often [`run_with_progress`] reports over a recording.
+const PROGRESS_REPORTS: usize = 500;
+
+/// Sliding-window settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EngineConfig {
+    /// Window length W \[samples\]; default 20 (4 ms at 5 kHz, the paper's).
+    pub window: usize,
+    /// Prediction horizon H \[samples\]; default 10 (2 ms at 5 kHz).
+    pub horizon: usize,
+    /// Shift between windows \[samples\]; `None` = the horizon (default).
+    pub hop: Option<usize>,
+    /// Samples skipped before the first window (in addition to the estimator's own); default 0.
+    pub warm_up: usize,
+}
+
+impl Default for EngineConfig {
+    fn default() -> Self {
+        Self {
+            window: 20,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        }
+    }
+}
+
+impl EngineConfig {
+    /// The effective hop.
+    pub fn hop(&self) -> usize {
+        self.hop.unwrap_or(self.horizon)
+    }
+
+    /// Check the settings against a recording of `n` samples and an estimator warm-up.
+    pub fn validate(&self, n: usize, estimator_warm_up: usize) -> Result<()> {
+        for (name, v) in [
+            ("window", self.window),
+            ("horizon", self.horizon),
+            ("hop", self.hop()),
+        ] {
+            if v == 0 {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: 0.0,
+                    reason: "must be at least 1 sample",
+                });
+            }
+        }
+        // saturating: lengths come from the user (`--window 18446744073709551615`)
+        let needed = self
+            .warm_up
+            .saturating_add(estimator_warm_up)
+            .saturating_add(self.window)
+            .saturating_add(self.horizon);
+        if n < needed {
+            return Err(Error::TooFewSamples {
+                what: "warm-up + window + horizon",
+                needed,
+                actual: n,
+            });
+        }
+        Ok(())
+    }
+
+    /// The window and horizon ranges visited over `n` samples.
+    pub fn windows(&self, n: usize, estimator_warm_up: usize) -> WindowIter {
+        WindowIter {
+            next: self.warm_up.saturating_add(estimator_warm_up),
+            window: self.window,
+            horizon: self.horizon,
+            hop: self.hop().max(1),
+            n,
+        }
+    }
+}
+
+/// Iterator over `(window, horizon)` ranges.
+#[derive(Debug, Clone)]
+pub struct WindowIter {
+    next: usize,
+    window: usize,
+    horizon: usize,
+    hop: usize,
+    n: usize,
+}
+
+impl Iterator for WindowIter {
+    type Item = (Range<usize>, Range<usize>);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let s = self.next;
+        let we = s.checked_add(self.window)?;
+        if we >= self.n {
+            return None;
+        }
+        let he = we.saturating_add(self.horizon).min(self.n);
+        self.next = s.saturating_add(self.hop);
+        Some((s..we, we..he))
+    }
+}
+
+/// One visited window.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WindowRecord {
+    /// Samples fitted.
+    pub window: Range<usize>,
+    /// Samples predicted.
+    pub horizon: Range<usize>,
+    /// RMS of the fit residual over the window \[m\] (0 if the fit failed).
+    pub residual_rms: f64,
+    /// Solver iterations (0 if the fit or the prediction failed).
+    pub iterations: usize,
+    /// What became of the window.
+    pub outcome: WindowOutcome,
+}
+
+/// Everything a sliding run produces.
+#[derive(Debug, Clone)]
+pub struct SlidingResult {
+    /// Method name.
+    pub method: &'static str,
+    /// Coefficient names (columns of [`SlidingResult::coefficients`]).
+    pub coefficient_names: Vec<String>,
+    /// Per-window coefficients, row-major `windows.len() × coefficient_names.len()`.
+    pub coefficients: Vec<f64>,
+    /// Visited windows.
+    pub windows: Vec<WindowRecord>,
+    /// Predicted position per sample \[m\]; meaningful only where `has_prediction`.
+    pub predicted: Vec<f64>,
+    /// Whether sample k was predicted.
+    pub has_prediction: Vec<bool>,
+    /// Error statistics over all predicted samples.
+    pub stats: ErrorStats,
+    /// Wall time of identification and prediction only (no I/O).
+    pub elapsed: Duration,
+}
+
+impl SlidingResult {
+    /// Prediction at sample `k`, if there is one.
+    pub fn prediction(&self, k: usize) -> Option<f64> {
+        match self.has_prediction.get(k) {
+            Some(true) => self.predicted.get(k).copied(),
+            _ => None,
+        }
+    }
+
+    /// Coefficients of window `w`.
+    pub fn window_coefficients(&self, w: usize) -> &[f64] {
+        let n = self.coefficient_names.len();
+        &self.coefficients[w * n..(w + 1) * n]
+    }
+
+    /// Number of windows whose fit or prediction failed.
+    pub fn failed_windows(&self) -> usize {
+        self.windows
+            .iter()
+            .filter(|w| w.outcome == WindowOutcome::Failed)
+            .count()
+    }
+
+    /// Number of windows whose prediction the method withheld (`auto`).
+    pub fn withheld_windows(&self) -> usize {
+        self.windows
+            .iter()
+            .filter(|w| w.outcome == WindowOutcome::Withheld)
+            .count()
+    }
+
+    /// Mean wall time per window \[µs\].
+    pub fn per_window_us(&self) -> f64 {
+        if self.windows.is_empty() {
+            0.0
+        } else {
+            self.elapsed.as_secs_f64() * 1e6 / self.windows.len() as f64
+        }
+    }
+}
+
+/// Slide `estimator` over `signals` (offset 0) and collect predictions and statistics.
+pub fn run<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    config: &EngineConfig,
+) -> Result<SlidingResult> {
+    run_with_progress(estimator, signals, config, None)
+}
+
+/// A progress hook: `progress(done, total)` in samples (called from the
+/// thread that runs the engine).
+pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
+
+/// [`run`], reporting `progress(done, total)` in samples: about 500 times
+/// over a recording (never per window on long ones), and `(n, n)` at the end.
+pub fn run_with_progress<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    config: &EngineConfig,
+    progress: Option<Progress<'_>>,
+) -> Result<SlidingResult> {
+    signals.check_lengths()?;
+    let n = signals.len();
+    let est_warm = estimator.warm_up();
+    config.validate(n, est_warm)?;
+    let names = estimator.coefficient_names();
+    let nc = names.len();
+    let windows_expected = config.windows(n, est_warm).count();
+
+    let mut coefficients = vec![0.0; windows_expected * nc];
+    let mut windows = Vec::with_capacity(windows_expected);
+    let mut predicted = vec![0.0; n];
+    let mut has_prediction = vec![false; n];
+    let mut buf = vec![0.0; config.horizon];
+
+    estimator.reset();
+    let total = n as u64;
+    let step = (n / PROGRESS_REPORTS).max(1);
+    let mut next_report = 0;
+    if let Some(p) = progress {
+        p(0, total);
+    }
+    let start = Instant::now();
+    for (w, (window, horizon)) in config.windows(n, est_warm).enumerate() {
+        if let Some(p) = progress {
+            if horizon.start >= next_report {
+                p(horizon.start as u64, total);
+                next_report = horizon.start.saturating_add(step);
+            }
+        }
+        let coef = &mut coefficients[w * nc..(w + 1) * nc];
+        let out = &mut buf[..horizon.len()];
+        let record = fit_and_predict(estimator, signals, window, horizon, coef, out);
+        if record.outcome.predicted() {
+            predicted[record.horizon.clone()].copy_from_slice(out);
+            has_prediction[record.horizon.clone()].fill(true);
+        }
+        windows.push(record);
+    }
+    let elapsed = start.elapsed();
+    if let Some(p) = progress {
+        p(total, total);
+    }
+
+    let mut acc = ErrorAccumulator::default();
+    let y = signals.all().position;
+    for k in 0..n {
+        if has_prediction[k] {
+            acc.push(y[k], predicted[k]);
+        }
+    }
+    Ok(SlidingResult {
+        method: estimator.name(),
+        coefficient_names: names,
+        coefficients,
+        windows,
+        predicted,
+        has_prediction,
+        stats: acc.finish(),
+        elapsed,
+    })
+}
+
+/// Fit one window and predict its horizon into `out`, the one place where
+/// the outcome is decided for the batch engine and the streaming path: a
+/// prediction counts only if it is finite; a withheld prediction is
+/// [`WindowOutcome::Withheld`], an error or a non-finite prediction
+/// [`WindowOutcome::Failed`]; non-finite coefficients are zeroed.
+pub(crate) fn fit_and_predict<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    window: Range<usize>,
+    horizon: Range<usize>,
+    coef: &mut [f64],
+    out: &mut [f64],
+) -> WindowRecord {
+    let (residual_rms, iterations, outcome) = match estimator.fit(signals, window.clone(), coef) {
+        Ok(fit) => match estimator.predict(signals, window.clone(), horizon.clone(), out) {
+            Ok(p @ PredictStatus::Withheld { .. }) => (
+                fit.residual_rms,
+                fit.iterations,
+                WindowOutcome::of(fit.status, p),
+            ),
+            Ok(p) if out.iter().all(|v| v.is_finite()) => (
+                fit.residual_rms,
+                fit.iterations,
+                WindowOutcome::of(fit.status, p),
+            ),
+            _ => (finite_or_zero(fit.residual_rms), 0, WindowOutcome::Failed),
+        },
+        Err(_) => (0.0, 0, WindowOutcome::Failed),
+    };
+    if !coef.iter().all(|c| c.is_finite()) {
+        coef.fill(0.0);
+    }
+    WindowRecord {
+        window,
+        horizon,
+        residual_rms,
+        iterations,
+        outcome,
+    }
+}
+
+fn finite_or_zero(v: f64) -> f64 {
+    if v.is_finite() {
+        v
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ident::WindowFit;
+    use crate::solve::Termination;
+
+    /// Predicts a straight line through the last two samples of the window;
+    /// writes [last value, slope] as coefficients.
+    struct Linear {
+        calls: usize,
+    }
+
+    impl Estimator for Linear {
+        fn name(&self) -> &'static str {
+            "linear"
+        }
+        fn coefficient_names(&self) -> Vec<String> {
+            vec!["last".into(), "slope".into()]
+        }
+        fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, coef: &mut [f64]) -> Result<WindowFit> {
+            self.calls += 1;
+            let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
+            coef[0] = y[1];
+            coef[1] = y[1] - y[0];
+            Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+        }
+        fn predict(
+            &mut self,
+            s: &Signals<'_>,
+            w: Range<usize>,
+            h: Range<usize>,
+            out: &mut [f64],
+        ) -> Result<PredictStatus> {
+            let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
+            assert_eq!(h.start, w.end);
+            for (j, o) in out.iter_mut().enumerate() {
+                *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);
+            }
+            Ok(PredictStatus::Predicted)
+        }
+    }
+
+    /// Fails on every other window and returns NaN predictions on the rest.
+    struct Broken {
+        k: usize,
+    }
+
+    impl Estimator for Broken {
+        fn name(&self) -> &'static str {
+            "broken"
+        }
+        fn coefficient_names(&self) -> Vec<String> {
+            vec!["c".into()]
+        }
+        fn fit(&mut self, _: &Signals<'_>, _: Range<usize>, coef: &mut [f64]) -> Result<WindowFit> {
+            self.k += 1;
+            coef[0] = f64::NAN;
+            if self.k % 2 == 0 {
+                Err(Error::Singular { context: "test" })
+            } else {
+                Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+            }
+        }
+        fn predict(
+            &mut self,
+            _: &Signals<'_>,
+            _: Range<usize>,
+            _: Range<usize>,
+            out: &mut [f64],
+        ) -> Result<PredictStatus> {
+            out.fill(f64::NAN);
+            Ok(PredictStatus::Predicted)
+        }
+    }
+
+    fn ramp(n: usize) -> (Vec<f64>, Vec<f64>) {
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 2e-4).collect();
+        let y: Vec<f64> = t.iter().map(|&t| 0.05 * t).collect();
+        (t, y)
+    }
+
+    #[test]
+    fn linear_estimator_predicts_a_ramp_exactly() {
+        let (t, y) = ramp(105);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let mut est = Linear { calls: 0 };
+        let r = run(&mut est, &s, &EngineConfig::default()).unwrap();
+        // windows at 0,10,...,80 (window end 20..100 < 105) → 9 windows
+        assert_eq!(r.windows.len(), 9);
+        assert_eq!(est.calls, 9);
+        assert_eq!(r.stats.samples, 85);
+        assert!(r.stats.rms < 1e-15);
+        assert!(r.prediction(19).is_none());
+        assert!(r.prediction(20).is_some());
+        assert!(r.prediction(104).is_some());
+        // last window's horizon is shortened
+        assert_eq!(r.windows[8].horizon, 100..105);
+        assert!((r.window_coefficients(0)[1] - 0.05 * 2e-4).abs() < 1e-18);
+    }
+
+    #[test]
+    fn every_sample_after_first_window_is_predicted_once_with_hop_equal_horizon() {
+        let cfg = EngineConfig {
+            window: 7,
+            horizon: 3,
+            hop: None,
+            warm_up: 2,
+        };
+        let mut count = [0; 50];
+        for (_, h) in cfg.windows(50, 1) {
+            for k in h {
+                count[k] += 1;
+            }
+        }
+        assert!(count[..10].iter().all(|&c| c == 0));
+        assert!(count[10..].iter().all(|&c| c == 1));
+    }
+
+    #[test]
+    fn overlapping_horizons_keep_the_latest_prediction() {
+        let (t, y) = ramp(60);
+        // position quadratic so predictions from different windows differ
+        let yq: Vec<f64> = t.iter().map(|&t| t * t).collect();
+        let s = Signals::new(&t, &y, &yq, 2e-4, 0.0);
+        let cfg = EngineConfig {
+            window: 10,
+            horizon: 5,
+            hop: Some(1),
+            warm_up: 0,
+        };
+        let r = run(&mut Linear { calls: 0 }, &s, &cfg).unwrap();
+        // sample 30 was last predicted by the window ending at 30 (one step ahead)
+        let y1 = yq[29];
+        let y0 = yq[28];
+        assert!((r.prediction(30).unwrap() - (2.0 * y1 - y0)).abs() < 1e-18);
+    }
+
+    #[test]
+    fn failed_windows_give_no_prediction_and_no_nan() {
+        let (t, y) = ramp(100);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let r = run(&mut Broken { k: 0 }, &s, &EngineConfig::default()).unwrap();
+        assert_eq!(r.failed_windows(), r.windows.len());
+        assert_eq!(r.stats.samples, 0);
+        assert!(r.coefficients.iter().all(|c| c.is_finite()));
+        assert!((0..100).all(|k| r.prediction(k).is_none()));
+    }
+
+    #[test]
+    fn too_short_recording_is_an_error() {
+        let (t, y) = ramp(29);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let e = run(&mut Linear { calls: 0 }, &s, &EngineConfig::default()).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::TooFewSamples {
+                needed: 30,
+                actual: 29,
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn zero_window_is_rejected() {
+        let cfg = EngineConfig {
+            window: 0,
+            ..EngineConfig::default()
+        };
+        assert!(cfg.validate(100, 0).is_err());
+    }
+
+    #[test]
+    fn huge_window_horizon_or_hop_is_too_few_samples_not_an_overflow() {
+        let (t, y) = ramp(100);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        for (window, horizon) in [(usize::MAX, 10), (20, usize::MAX), (usize::MAX, usize::MAX)] {
+            let cfg = EngineConfig {
+                window,
+                horizon,
+                warm_up: 3,
+                ..EngineConfig::default()
+            };
+            let e = run(&mut Linear { calls: 0 }, &s, &cfg).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    Error::TooFewSamples {
+                        needed: usize::MAX,
+                        actual: 100,
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+        }
+        // a hop beyond the data visits one window
+        let cfg = EngineConfig {
+            hop: Some(usize::MAX),
+            warm_up: 3,
+            ..EngineConfig::default()
+        };
+        assert_eq!(cfg.windows(100, 2).count(), 1);
+        let r = run(&mut Linear { calls: 0 }, &s, &cfg).unwrap();
+        assert_eq!(r.windows.len(), 1);
+    }
+
+    #[test]
+    fn progress_is_reported_from_zero_to_the_total_and_does_not_change_the_result() {
+        let (t, y) = ramp(5000);
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let calls = std::sync::Mutex::new(Vec::new());
+        let hook = |d: u64, n: u64| calls.lock().unwrap().push((d, n));
+        let with = run_with_progress(
+            &mut Linear { calls: 0 },
+            &s,
+            &EngineConfig::default(),
+            Some(&hook),
+        )
+        .unwrap();
+        let without = run(&mut Linear { calls: 0 }, &s, &EngineConfig::default()).unwrap();
+        assert_eq!(with.predicted, without.predicted);
+        let calls = calls.into_inner().unwrap();
+        assert_eq!(calls.first(), Some(&(0, 5000)));
+        assert_eq!(calls.last(), Some(&(5000, 5000)));
+        assert!(calls.windows(2).all(|w| w[0].0 <= w[1].0), "monotone");
+        // throttled to about 500 reports (here about one per window)
+        assert!(calls.len() > 100 && calls.len() <= 502, "{}", calls.len());
+    }
+}

@@ -1,0 +1,22 @@
+//! The identification methods, one module each: the paper's windowed
+//! polynomial least squares, windowed ARX, recursive least squares,
+//! continuous-time output error, and `auto`; the ARX regressor they share.
+
+mod arx;
+mod auto;
+mod oe;
+mod paper;
+mod regressor;
+mod rls;
+
+pub(crate) use arx::fit_arx_rows;
+pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit};
+pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
+pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit};
+pub use paper::{
+    coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
+    PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin, SHIFT_AMPLIFICATION_WARNING,
+};
+pub(crate) use regressor::regressor;
+pub use regressor::{ArxOrders, MAX_ARX_ORDER};
+pub use rls::{RlsConfig, RlsEstimator};

@@ -1,0 +1,583 @@
+//! The paper's method as an [`Estimator`]: per window, the output and input
+//! polynomials fitted by QR or the simplex in the scaled basis, mapped to
+//! `N`, `D`, and the prediction over the horizon.
+
+use std::ops::Range;
+
+use super::basis::{affine_to_monomial, legendre_monomials, normalise, LEGENDRE_A, LEGENDRE_B};
+use super::config::{shift_amplification, PaperConfig, PredictionMode, Solver, TimeOrigin};
+use super::polynomials::{coefficients_from_polynomials, NAMES, NC, NP, NQ};
+use super::simplex::simplex_fit;
+use crate::error::{Error, Result};
+use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::lti::TransferFunction;
+use crate::solve::{lstsq_in_place, LstsqInfo, LstsqOptions, NelderMead, QrWorkspace, Termination};
+
+/// Per-window diagnostics of the last fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PaperDiagnostics {
+    /// QR information of the output fit (`None` with the simplex solver).
+    pub output_qr: Option<LstsqInfo>,
+    /// QR information of the input fit (`None` with the simplex solver).
+    pub input_qr: Option<LstsqInfo>,
+    /// Growth factor `(1 + |τ_c|/h)⁷` of the change from the window basis to
+    /// monomial coefficients in `τ`: roughly, the relative accuracy of `P`,
+    /// `Q` (hence `N`, `D`) is this times the fit's relative accuracy.
+    pub shift_amplification: f64,
+    /// Relative rms of the input (command) fit residual `‖r_u‖/‖u‖`.
+    pub input_residual_rel: f64,
+    /// The last transfer-function prediction of this window fell back to the
+    /// polynomial (identified `Tf` unusable: unstable, non-finite, improper).
+    pub tf_fallback: bool,
+}
+
+/// State of the last window fit, in the scaled basis.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LastFit {
+    /// Time origin used for `τ` \[s\].
+    pub(super) origin: f64,
+    /// `T = max |τ|` over the window \[s\].
+    pub(super) t_scale: f64,
+    /// Centre `τ_c` and half width `h` of the window in `τ` \[s\].
+    pub(super) centre: f64,
+    pub(super) half: f64,
+    /// Output coefficients of `(τ/T)⁵·L_k(s)` (unnormalised basis).
+    pub(super) out: [f64; NP],
+    /// Input coefficients of `L_k(s)` (unnormalised basis).
+    pub(super) inp: [f64; NQ],
+    /// Identified `[N2, N1, N0, D7, …, D0]`.
+    pub(super) coef: [f64; NC],
+    /// Rest position and command subtracted before fitting (0 for window-local time).
+    pub(super) y_ref: f64,
+    pub(super) u_ref: f64,
+}
+
+/// The paper's identification method as an [`Estimator`] (name `"paper"`).
+///
+/// Build with [`PaperConfig::build`]. Buffers are sized by the first window
+/// and grown once if a longer window comes; fitting allocates nothing after that.
+#[derive(Debug, Clone)]
+pub struct PaperMethod {
+    pub(super) config: PaperConfig,
+    /// Held position of the last window if it was a rest window.
+    pub(super) rest_hold: Option<f64>,
+    pub(super) legendre: [[f64; NQ]; NQ],
+    pub(super) cap: usize,
+    pub(super) tau: Vec<f64>,
+    pub(super) data: Vec<f64>,
+    pub(super) design_out: Vec<f64>,
+    pub(super) design_in: Vec<f64>,
+    pub(super) work: Vec<f64>,
+    pub(super) rhs: Vec<f64>,
+    pub(super) resid: Vec<f64>,
+    pub(super) qr: QrWorkspace,
+    pub(super) nm_out: NelderMead,
+    pub(super) nm_in: NelderMead,
+    pub(super) last: Option<LastFit>,
+    /// Rest position at the motion start, fixed by the first motion window.
+    pub(super) reference: Option<f64>,
+    pub(super) diagnostics: Option<PaperDiagnostics>,
+    pub(super) tf_fallbacks: usize,
+    pub(super) du: Vec<f64>,
+    pub(super) ysim: Vec<f64>,
+}
+
+impl PaperMethod {
+    pub(super) fn new(config: PaperConfig) -> Self {
+        Self {
+            config,
+            rest_hold: None,
+            legendre: legendre_monomials(),
+            cap: 0,
+            tau: Vec::new(),
+            data: Vec::new(),
+            design_out: Vec::new(),
+            design_in: Vec::new(),
+            work: Vec::new(),
+            rhs: Vec::new(),
+            resid: Vec::new(),
+            qr: QrWorkspace::new(NQ),
+            nm_out: NelderMead::new(NP),
+            nm_in: NelderMead::new(NQ),
+            last: None,
+            reference: None,
+            diagnostics: None,
+            tf_fallbacks: 0,
+            du: Vec::new(),
+            ysim: Vec::new(),
+        }
+    }
+
+    /// The configuration this estimator was built from.
+    pub fn config(&self) -> &PaperConfig {
+        &self.config
+    }
+
+    /// Diagnostics of the last successful fit (`None` before the first fit).
+    pub fn diagnostics(&self) -> Option<&PaperDiagnostics> {
+        self.diagnostics.as_ref()
+    }
+
+    /// Number of transfer-function predictions that fell back to the
+    /// polynomial since construction or [`Estimator::reset`].
+    pub fn tf_fallbacks(&self) -> usize {
+        self.tf_fallbacks
+    }
+
+    /// The last window's fitted output polynomial `P(τ)` at time `t` \[s\]
+    /// (`None` before the first fit and after a rest window).
+    pub fn fitted_position(&self, t: f64) -> Option<f64> {
+        self.last
+            .as_ref()
+            .map(|fit| fit.y_ref + Self::eval_output(fit, t))
+    }
+
+    /// The last window's fitted input polynomial `Q(τ)` at time `t` \[s\]
+    /// (`None` before the first fit).
+    pub fn fitted_command(&self, t: f64) -> Option<f64> {
+        self.last
+            .as_ref()
+            .map(|fit| fit.u_ref + Self::eval_input(fit, t))
+    }
+
+    /// A window entirely at rest (see the module doc): coefficients 0, hold the last position.
+    fn rest_window(&mut self, pos: &[f64], coef: &mut [f64]) -> WindowFit {
+        let hold = pos.last().copied().unwrap_or(0.0);
+        coef.fill(0.0);
+        self.rest_hold = Some(hold);
+        self.last = None;
+        self.diagnostics = None;
+        let sse: f64 = pos.iter().map(|y| (y - hold) * (y - hold)).sum();
+        WindowFit::fallback((sse / pos.len().max(1) as f64).sqrt(), 0)
+    }
+
+    fn ensure_capacity(&mut self, w: usize) {
+        if w > self.cap {
+            self.tau.resize(w, 0.0);
+            self.data.resize(w, 0.0);
+            self.design_out.resize(NP * w, 0.0);
+            self.design_in.resize(NQ * w, 0.0);
+            self.work.resize(NQ * w, 0.0);
+            self.rhs.resize(w, 0.0);
+            self.resid.resize(w, 0.0);
+            self.cap = w;
+        }
+    }
+
+    /// Input polynomial at time `t` from a fit (Legendre series via the three-term recurrence).
+    fn eval_input(fit: &LastFit, t: f64) -> f64 {
+        let s = ((t - fit.origin) - fit.centre) / fit.half;
+        let mut lm1 = 1.0;
+        let mut l = s;
+        let mut acc = fit.inp[0] + fit.inp[1] * s;
+        for (k, ak) in fit.inp.iter().enumerate().skip(2) {
+            let km = (k - 1) as f64;
+            let next = ((2.0 * km + 1.0) * s * l - km * lm1) / (km + 1.0);
+            lm1 = l;
+            l = next;
+            acc += ak * l;
+        }
+        acc
+    }
+
+    /// Polynomial prediction at time `t` from a fit (evaluated in the fit's basis).
+    fn eval_output(fit: &LastFit, t: f64) -> f64 {
+        let tau = t - fit.origin;
+        let s = (tau - fit.centre) / fit.half;
+        let l1 = s;
+        let l2 = 1.5 * s * s - 0.5;
+        let w = (tau / fit.t_scale).powi(5);
+        w * (fit.out[0] + fit.out[1] * l1 + fit.out[2] * l2)
+    }
+}
+
+pub(super) fn first_non_finite(v: &[f64], offset: usize, channel: &str) -> Result<()> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(Error::NonFinite {
+            channel: channel.to_string(),
+            index: offset + i,
+            value: v[i],
+        }),
+        None => Ok(()),
+    }
+}
+
+impl Estimator for PaperMethod {
+    fn name(&self) -> &'static str {
+        "paper"
+    }
+
+    fn uses_future_command(&self) -> bool {
+        self.config.prediction != PredictionMode::Polynomial
+    }
+
+    fn coefficient_names(&self) -> Vec<String> {
+        NAMES.iter().map(|s| s.to_string()).collect()
+    }
+
+    fn reset(&mut self) {
+        self.rest_hold = None;
+        self.last = None;
+        self.reference = None;
+        self.diagnostics = None;
+        self.tf_fallbacks = 0;
+    }
+
+    fn fit(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        coef: &mut [f64],
+    ) -> Result<WindowFit> {
+        if coef.len() != NC {
+            return Err(Error::LengthMismatch {
+                what: "paper coefficients",
+                expected: NC,
+                actual: coef.len(),
+            });
+        }
+        let w = window.len();
+        if w < NQ {
+            return Err(Error::TooFewSamples {
+                what: "paper window (8 input coefficients)",
+                needed: NQ,
+                actual: w,
+            });
+        }
+        let samples = signals.window(window.clone(), 0, "paper window")?;
+        let (time, pos, cmd) = (samples.time, samples.position, samples.command);
+        first_non_finite(time, window.start, "time")?;
+        first_non_finite(pos, window.start, "position")?;
+        first_non_finite(cmd, window.start, "command")?;
+        if self.config.time_origin == TimeOrigin::Motion && time[w - 1] <= signals.motion_start() {
+            return Ok(self.rest_window(pos, coef));
+        }
+        self.rest_hold = None;
+        self.ensure_capacity(w);
+
+        // --- rest windows and the rest reference (motion time origin)
+        let (y_ref, u_ref) = match self.config.time_origin {
+            TimeOrigin::Window => (0.0, 0.0),
+            TimeOrigin::Motion => {
+                // The output model has no constant term, so positions are
+                // measured from the rest position at the motion start. The
+                // input model has one (Q0 = D7), so the command is fitted as
+                // given, as in the paper.
+                // The reference is fixed by the first motion window, which
+                // holds the motion-start sample when windows overlap or touch
+                // (hop ≤ W), in batch and streaming alike. If the recording
+                // starts in motion (no sample at or before the motion start),
+                // positions are taken as given.
+                let y_ref = *self.reference.get_or_insert_with(|| {
+                    let all = signals.all();
+                    all.time
+                        .iter()
+                        .rposition(|&t| t <= signals.motion_start())
+                        .map_or(0.0, |k| all.position[k])
+                });
+                (y_ref, 0.0)
+            }
+        };
+
+        // --- time scaling
+        let origin = match self.config.time_origin {
+            TimeOrigin::Motion => signals.motion_start(),
+            TimeOrigin::Window => time[0],
+        };
+        if !origin.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "motion_start",
+                value: origin,
+                reason: "must be finite",
+            });
+        }
+        let tau = &mut self.tau[..w];
+        for (ti, t) in tau.iter_mut().zip(time) {
+            *ti = t - origin;
+        }
+        let t_first = tau[0];
+        let t_last = tau[w - 1];
+        let centre = 0.5 * (t_first + t_last);
+        let half = 0.5 * (t_last - t_first);
+        let t_scale = tau.iter().fold(0.0f64, |a, t| a.max(t.abs()));
+        if !(half > 0.0 && t_scale > 0.0 && half.is_finite() && t_scale.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "window time span",
+                value: half,
+                reason: "time must increase over the window",
+            });
+        }
+
+        // --- bases (column-major), columns normalised to unit norm
+        let mut norm_out = [0.0; NP];
+        let mut norm_in = [0.0; NQ];
+        {
+            let g_out = &mut self.design_out[..NP * w];
+            let g_in = &mut self.design_in[..NQ * w];
+            // multiplications by reciprocals: no division in the per-sample loop
+            let (inv_half, inv_t) = (1.0 / half, 1.0 / t_scale);
+            for i in 0..w {
+                let s = (tau[i] - centre) * inv_half;
+                let wt = (tau[i] * inv_t).powi(5);
+                // Legendre recurrence L_{k+1} = ((2k+1) s L_k − k L_{k−1})/(k+1)
+                let mut lm1 = 1.0;
+                let mut l = s;
+                g_in[i] = 1.0;
+                g_in[i + w] = s;
+                for k in 1..NQ - 1 {
+                    let next = LEGENDRE_A[k] * s * l - LEGENDRE_B[k] * lm1;
+                    lm1 = l;
+                    l = next;
+                    g_in[i + (k + 1) * w] = l;
+                }
+                for k in 0..NP {
+                    g_out[i + k * w] = wt * g_in[i + k * w];
+                }
+            }
+            for (k, nk) in norm_out.iter_mut().enumerate() {
+                let col = &mut g_out[k * w..(k + 1) * w];
+                *nk = normalise(col);
+            }
+            for (k, nk) in norm_in.iter_mut().enumerate() {
+                let col = &mut g_in[k * w..(k + 1) * w];
+                *nk = normalise(col);
+            }
+        }
+
+        // --- solve both problems in the normalised basis
+        let mut z_out = [0.0; NP];
+        let mut z_in = [0.0; NQ];
+        let (out_sse, in_sse, iterations, termination, out_info, in_info);
+        match self.config.solver {
+            Solver::Qr => {
+                let opts = LstsqOptions::default();
+                self.work[..NP * w].copy_from_slice(&self.design_out[..NP * w]);
+                for (r, p) in self.rhs[..w].iter_mut().zip(pos) {
+                    *r = p - y_ref;
+                }
+                let io = lstsq_in_place(
+                    w,
+                    NP,
+                    &mut self.work[..NP * w],
+                    &mut self.rhs[..w],
+                    &mut z_out,
+                    &mut self.qr,
+                    &opts,
+                )?;
+                self.work[..NQ * w].copy_from_slice(&self.design_in[..NQ * w]);
+                for (r, c) in self.rhs[..w].iter_mut().zip(cmd) {
+                    *r = c - u_ref;
+                }
+                let ii = lstsq_in_place(
+                    w,
+                    NQ,
+                    &mut self.work[..NQ * w],
+                    &mut self.rhs[..w],
+                    &mut z_in,
+                    &mut self.qr,
+                    &opts,
+                )?;
+                out_sse = io.residual_norm * io.residual_norm;
+                in_sse = ii.residual_norm * ii.residual_norm;
+                iterations = 0;
+                termination = Termination::Exact;
+                out_info = Some(io);
+                in_info = Some(ii);
+            }
+            Solver::Simplex => {
+                let settings = self.config.simplex;
+                let mut steps = [0.0; NQ];
+                for (r, p) in self.data[..w].iter_mut().zip(pos) {
+                    *r = p - y_ref;
+                }
+                let (fo, it_o, term_o) = simplex_fit(
+                    &mut self.nm_out,
+                    &self.design_out[..NP * w],
+                    &self.data[..w],
+                    &mut self.resid[..w],
+                    &mut z_out,
+                    &settings,
+                    &mut steps[..NP],
+                )?;
+                for (r, c) in self.data[..w].iter_mut().zip(cmd) {
+                    *r = c - u_ref;
+                }
+                let (fi, it_i, term_i) = simplex_fit(
+                    &mut self.nm_in,
+                    &self.design_in[..NQ * w],
+                    &self.data[..w],
+                    &mut self.resid[..w],
+                    &mut z_in,
+                    &settings,
+                    &mut steps,
+                )?;
+                out_sse = fo;
+                in_sse = fi;
+                iterations = it_o + it_i;
+                termination = if term_o == Termination::MaxIterations
+                    || term_i == Termination::MaxIterations
+                {
+                    Termination::MaxIterations
+                } else {
+                    Termination::Converged
+                };
+                out_info = None;
+                in_info = None;
+            }
+        }
+
+        // --- back to the unnormalised Legendre basis, then to monomials in τ
+        let mut a_out = [0.0; NP];
+        let mut a_in = [0.0; NQ];
+        for k in 0..NP {
+            a_out[k] = z_out[k] / norm_out[k];
+        }
+        for k in 0..NQ {
+            a_in[k] = z_in[k] / norm_in[k];
+        }
+        let mut ms = [0.0; NQ];
+        for (ak, lk) in a_out.iter().zip(&self.legendre) {
+            for (mj, lkj) in ms.iter_mut().zip(lk).take(NP) {
+                *mj += ak * lkj;
+            }
+        }
+        let mut r = [0.0; NQ];
+        affine_to_monomial(&ms[..NP], centre, half, &mut r[..NP]);
+        let t5 = t_scale.powi(5);
+        let p = [r[0] / t5, r[1] / t5, r[2] / t5];
+        let mut ms = [0.0; NQ];
+        for (ak, lk) in a_in.iter().zip(&self.legendre) {
+            for (mj, lkj) in ms.iter_mut().zip(lk) {
+                *mj += ak * lkj;
+            }
+        }
+        let mut q = [0.0; NQ];
+        affine_to_monomial(&ms, centre, half, &mut q);
+        let c = coefficients_from_polynomials(p, q);
+        if let Some(i) = c.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                channel: format!("paper coefficient {}", NAMES[i]),
+                index: window.start,
+                value: c[i],
+            });
+        }
+        coef.copy_from_slice(&c);
+
+        let in_norm = cmd
+            .iter()
+            .map(|v| (v - u_ref) * (v - u_ref))
+            .sum::<f64>()
+            .sqrt();
+        self.last = Some(LastFit {
+            origin,
+            t_scale,
+            centre,
+            half,
+            out: a_out,
+            inp: a_in,
+            coef: c,
+            y_ref,
+            u_ref,
+        });
+        self.diagnostics = Some(PaperDiagnostics {
+            output_qr: out_info,
+            input_qr: in_info,
+            shift_amplification: shift_amplification(t_first, t_last),
+            tf_fallback: false,
+            input_residual_rel: if in_norm > 0.0 {
+                in_sse.max(0.0).sqrt() / in_norm
+            } else {
+                0.0
+            },
+        });
+        Ok(WindowFit::identified(
+            (out_sse.max(0.0) / w as f64).sqrt(),
+            iterations,
+            termination,
+        ))
+    }
+
+    fn predict(
+        &mut self,
+        signals: &Signals<'_>,
+        _window: Range<usize>,
+        horizon: Range<usize>,
+        out: &mut [f64],
+    ) -> Result<PredictStatus> {
+        if out.len() != horizon.len() {
+            return Err(Error::LengthMismatch {
+                what: "paper prediction",
+                expected: horizon.len(),
+                actual: out.len(),
+            });
+        }
+        let hz = signals.window(horizon.clone(), 0, "paper horizon")?;
+        if let Some(hold) = self.rest_hold {
+            out.fill(hold);
+            return Ok(PredictStatus::Predicted);
+        }
+        let fit = self.last.ok_or(Error::InvalidModel {
+            reason: "paper: predict called before a successful fit",
+        })?;
+        let time = hz.time;
+        for (o, &t) in out.iter_mut().zip(time) {
+            *o = fit.y_ref + Self::eval_output(&fit, t);
+        }
+        if self.config.prediction == PredictionMode::TransferFunction {
+            let h = horizon.len();
+            if self.du.len() < h {
+                self.du.resize(h, 0.0);
+                self.ysim.resize(h, 0.0);
+            }
+            let cmd = hz.command;
+            for ((d, &u), &t) in self.du.iter_mut().zip(cmd).zip(time) {
+                *d = u - fit.u_ref - Self::eval_input(&fit, t);
+            }
+            let ok = tf_response(&fit.coef, signals.dt(), &self.du[..h], &mut self.ysim[..h])
+                .is_ok()
+                && out
+                    .iter()
+                    .zip(&self.ysim[..h])
+                    .all(|(o, y)| (o + y).is_finite());
+            if ok {
+                for (o, y) in out.iter_mut().zip(&self.ysim[..h]) {
+                    *o += y;
+                }
+            } else {
+                self.tf_fallbacks += 1;
+                if let Some(d) = self.diagnostics.as_mut() {
+                    d.tf_fallback = true;
+                }
+            }
+        }
+        if let Some(i) = out.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                channel: "paper prediction".to_string(),
+                index: horizon.start + i,
+                value: out[i],
+            });
+        }
+        Ok(PredictStatus::Predicted)
+    }
+}
+
+/// Response of the identified `N(s)/D(s)` (coefficients `[N2, N1, N0, D7 … D0]`)
+/// to the sampled input `du` (zero-order hold, interval `dt`), from the zero state.
+pub(super) fn tf_response(coef: &[f64; NC], dt: f64, du: &[f64], y: &mut [f64]) -> Result<()> {
+    let tf = TransferFunction::new(coef[..NP].to_vec(), coef[NP..].to_vec())?;
+    let sys = tf.to_state_space()?.discretize_zoh(dt)?;
+    if !sys.is_stable()? {
+        return Err(Error::InvalidModel {
+            reason: "identified transfer function is unstable",
+        });
+    }
+    let n = sys.order();
+    let mut x = [0.0; NQ];
+    let mut scratch = [0.0; NQ];
+    if n > NQ {
+        return Err(Error::InvalidModel {
+            reason: "identified transfer function has order > 7",
+        });
+    }
+    sys.simulate_into(du, &mut x[..n], y, &mut scratch[..n])
+}

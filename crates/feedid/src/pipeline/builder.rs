@@ -1,0 +1,444 @@
+//! The pipeline's settings (a builder) and the run itself.
+
+use crate::drive::{simulate_nominal, RigParams};
+use crate::error::{Error, Result};
+use crate::ident::engine::{run_with_progress, Progress};
+use crate::ident::{
+    fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind, Method,
+    OrderSearch, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
+};
+use crate::pipeline::{Identification, OrderChoice, Warning};
+use crate::recording::Recording;
+use crate::stats::ErrorStats;
+
+/// One identification run's settings: the method, the windows, and what to
+/// compute besides the predictions. Build with [`Pipeline::new`] and the
+/// setters, then [`Pipeline::run`] on a recording (as often as you like).
+///
+/// Defaults: the method's own window ([`Method::default_window`]), horizon
+/// 10, hop = horizon; no order selection; the method's global model
+/// ([`Method::global_model`]) fitted for the summary; residual analysis up
+/// to lag [`RESIDUAL_LAGS`]; no nominal simulation; no extra model; no
+/// progress hook.
+#[derive(Clone)]
+pub struct Pipeline<'a> {
+    method: Method,
+    window: Option<usize>,
+    horizon: usize,
+    hop: Option<usize>,
+    warm_up: usize,
+    order_search: Option<OrderSearch>,
+    method_global_model: bool,
+    extra_model: Option<GlobalModelKind>,
+    residual_lags: Option<usize>,
+    nominal: Option<RigParams>,
+    progress: Option<Progress<'a>>,
+}
+
+impl std::fmt::Debug for Pipeline<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pipeline")
+            .field("method", &self.method)
+            .field("window", &self.window)
+            .field("horizon", &self.horizon)
+            .field("hop", &self.hop)
+            .field("warm_up", &self.warm_up)
+            .field("order_search", &self.order_search)
+            .field("method_global_model", &self.method_global_model)
+            .field("extra_model", &self.extra_model)
+            .field("residual_lags", &self.residual_lags)
+            .field("nominal", &self.nominal.is_some())
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
+}
+
+impl<'a> Pipeline<'a> {
+    /// A run of `method` with the defaults (see [`Pipeline`]).
+    pub fn new(method: Method) -> Self {
+        Self {
+            method,
+            window: None,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+            order_search: None,
+            method_global_model: true,
+            extra_model: None,
+            residual_lags: Some(RESIDUAL_LAGS),
+            nominal: None,
+            progress: None,
+        }
+    }
+
+    /// The method (with its settings).
+    pub fn method(&self) -> &Method {
+        &self.method
+    }
+
+    /// Window length W \[samples\]; default: the method's ([`Method::default_window`]).
+    pub fn window(mut self, window: usize) -> Self {
+        self.window = Some(window);
+        self
+    }
+
+    /// Window length, or `None` for the method's default.
+    pub fn window_or_default(mut self, window: Option<usize>) -> Self {
+        self.window = window;
+        self
+    }
+
+    /// Prediction horizon H \[samples\]; default 10.
+    pub fn horizon(mut self, horizon: usize) -> Self {
+        self.horizon = horizon;
+        self
+    }
+
+    /// Shift between windows \[samples\]; `None` (default) = the horizon.
+    pub fn hop(mut self, hop: Option<usize>) -> Self {
+        self.hop = hop;
+        self
+    }
+
+    /// Window, horizon, hop and warm-up from an engine configuration.
+    pub fn engine(mut self, config: EngineConfig) -> Self {
+        self.warm_up = config.warm_up;
+        self.window(config.window)
+            .horizon(config.horizon)
+            .hop(config.hop)
+    }
+
+    /// Choose the method's ARX orders from the recording first
+    /// ([`select_order`], e.g. `OrderSearch::default()`: BIC over
+    /// na 1…8, nb 1…8, nk 0…2). Refused for a method without orders.
+    pub fn select_orders(mut self, search: OrderSearch) -> Self {
+        self.order_search = Some(search);
+        self
+    }
+
+    /// Fit the method's global model ([`Method::global_model`]) for the
+    /// summary's free-run fit; default true. A model that cannot be fitted
+    /// is a note in the summary, not an error.
+    pub fn method_global_model(mut self, fit: bool) -> Self {
+        self.method_global_model = fit;
+        self
+    }
+
+    /// Also fit a global model of this kind (`feedid identify --model-out`);
+    /// a failure is an error of the run. The method's own global model is
+    /// reused when it is the same kind.
+    pub fn extra_model(mut self, kind: GlobalModelKind) -> Self {
+        self.extra_model = Some(kind);
+        self
+    }
+
+    /// Residual analysis up to this lag (`None`: none); default
+    /// [`RESIDUAL_LAGS`].
+    pub fn residuals(mut self, max_lag: Option<usize>) -> Self {
+        self.residual_lags = max_lag;
+        self
+    }
+
+    /// Simulate the nominal physical model of these rig parameters driven
+    /// by the measured command (the paper's simulation model); default none.
+    pub fn nominal(mut self, params: RigParams) -> Self {
+        self.nominal = Some(params);
+        self
+    }
+
+    /// Report progress of the sliding identification as `(done, total)`
+    /// samples (about 500 calls per run; the global-model fits after it are
+    /// not counted). Called from the thread that runs the pipeline.
+    pub fn progress(mut self, progress: Progress<'a>) -> Self {
+        self.progress = Some(progress);
+        self
+    }
+
+    /// The engine settings this pipeline uses with `method`.
+    fn engine_config(&self, method: &Method) -> EngineConfig {
+        EngineConfig {
+            window: self.window.unwrap_or_else(|| method.default_window()),
+            horizon: self.horizon,
+            hop: self.hop,
+            warm_up: self.warm_up,
+        }
+    }
+
+    /// Identify time \[s\], command \[m\] and measured position \[m\]
+    /// (copied into a checked [`Recording`]).
+    pub fn run_slices(
+        &self,
+        time: &[f64],
+        command: &[f64],
+        position: &[f64],
+    ) -> Result<Identification> {
+        let rec = Recording::new(time.to_vec(), command.to_vec(), position.to_vec())?;
+        self.run(&rec)
+    }
+
+    /// Identify `recording`.
+    ///
+    /// Errors: invalid settings; orders asked of a method without them
+    /// ([`Error::NotApplicable`]); a failed order selection, simulation or
+    /// extra model ([`Error::Stage`], with the reason); a recording too
+    /// short for the windows.
+    pub fn run(&self, recording: &Recording) -> Result<Identification> {
+        let mut method = self.method.clone();
+        method.validate()?;
+        let order_choice = match &self.order_search {
+            None => None,
+            Some(search) => {
+                if method.orders().is_none() {
+                    return Err(Error::NotApplicable {
+                        setting: "order selection",
+                        method: method.name(),
+                        applies_to: "arx, rls, auto",
+                    });
+                }
+                let sel = select_order(
+                    recording.command(),
+                    recording.position(),
+                    recording.dt(),
+                    search,
+                )
+                .map_err(|e| Error::Stage {
+                    stage: "order selection",
+                    source: Box::new(e),
+                })?;
+                method.set_orders(sel.chosen)?;
+                Some(OrderChoice {
+                    orders: sel.chosen,
+                    criterion: sel.criterion,
+                })
+            }
+        };
+        let config = self.engine_config(&method);
+        let signals = recording.signals();
+        let mut warnings = Vec::new();
+        if let Method::Paper(paper) = &method {
+            let g = paper.worst_shift_amplification(&signals, &config);
+            if g > SHIFT_AMPLIFICATION_WARNING {
+                warnings.push(Warning::PaperCoefficientAccuracy { amplification: g });
+            }
+        }
+
+        let mut estimator = method.build()?;
+        let sliding = run_with_progress(estimator.as_mut(), &signals, &config, self.progress)?;
+
+        let simulated = match &self.nominal {
+            Some(p) => Some(
+                simulate_nominal(p, recording.command(), recording.dt()).map_err(|e| {
+                    Error::Stage {
+                        stage: "nominal simulation",
+                        source: Box::new(e),
+                    }
+                })?,
+            ),
+            None => None,
+        };
+        // over the predicted samples (all samples if nothing was predicted)
+        let simulation_stats = simulated.as_ref().map(|sim| {
+            let y = recording.position();
+            let any = sliding.stats.samples > 0;
+            ErrorStats::from_pairs(
+                (0..y.len())
+                    .filter(|&k| !any || sliding.has_prediction[k])
+                    .map(|k| (y[k], sim[k])),
+            )
+        });
+        let residuals = self.residual_lags.and_then(|lags| {
+            prediction_residuals(&sliding, recording.command(), recording.position(), lags)
+        });
+
+        let method_kind = method.global_model().filter(|_| self.method_global_model);
+        let (global, global_note) = match &method_kind {
+            None => (None, None),
+            Some(kind) => match fit_global_model(recording, kind) {
+                Ok(g) => (Some(g), None),
+                Err(e) => (None, Some(format!("not fitted ({e})"))),
+            },
+        };
+        let model = match &self.extra_model {
+            None => None,
+            Some(kind) if Some(kind) == method_kind.as_ref() && global.is_some() => global.clone(),
+            Some(kind) => Some(fit_global_model(recording, kind).map_err(|e| Error::Stage {
+                stage: "global model",
+                source: Box::new(e),
+            })?),
+        };
+        Ok(Identification {
+            method,
+            config,
+            samples: recording.len(),
+            rate_hz: recording.rate_hz(),
+            order_choice,
+            sliding,
+            simulated,
+            simulation_stats,
+            residuals,
+            global,
+            global_note,
+            model,
+            warnings,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::VirtualRig;
+    use crate::ident::{engine, ArxOrders};
+    use crate::signal::Scenario;
+
+    fn ramp() -> Recording {
+        let cmd = Scenario::Ramp.command(5000.0, 0.15, 1).unwrap();
+        let out = VirtualRig::new(RigParams::default())
+            .with_seed(3)
+            .simulate(&cmd, 5000.0)
+            .unwrap();
+        Recording::new(out.time, out.command, out.position).unwrap()
+    }
+
+    #[test]
+    fn pipeline_and_its_results_can_cross_threads() {
+        fn send<T: Send>() {}
+        send::<Pipeline<'static>>();
+        send::<Identification>();
+        send::<Method>();
+        send::<crate::pipeline::IdentifySummary>();
+    }
+
+    #[test]
+    fn predictions_are_those_of_the_engine_and_the_summary_counts_them() {
+        let rec = ramp();
+        for name in ["paper", "arx", "auto"] {
+            let method: Method = name.parse().unwrap();
+            let run = Pipeline::new(method.clone())
+                .method_global_model(false)
+                .run(&rec)
+                .unwrap();
+            let cfg = EngineConfig {
+                window: method.default_window(),
+                ..EngineConfig::default()
+            };
+            let alone =
+                engine::run(method.build().unwrap().as_mut(), &rec.signals(), &cfg).unwrap();
+            assert_eq!(run.sliding.predicted, alone.predicted, "{name}");
+            assert_eq!(run.sliding.has_prediction, alone.has_prediction, "{name}");
+            assert_eq!(run.sliding.coefficients, alone.coefficients, "{name}");
+            let s = run.summary();
+            assert_eq!(s.samples_predicted, alone.stats.samples);
+            assert_eq!(s.rms_error_m, alone.stats.rms);
+            assert_eq!(s.window, method.default_window());
+            assert!(s.global_model.is_none() && s.sim_rms_error_m.is_none());
+            let json = serde_json::to_value(&s).unwrap();
+            assert!(json.get("global_model").is_none(), "absent, not null");
+            assert!(s.to_string().starts_with(&format!(
+                "{} samples at 5000.00 Hz, method {name}, window {}",
+                rec.len(),
+                method.default_window()
+            )));
+        }
+    }
+
+    #[test]
+    fn slices_progress_nominal_model_and_extra_model_are_what_they_say() {
+        let rec = ramp();
+        let calls = std::sync::Mutex::new(Vec::new());
+        let hook = |d: u64, n: u64| calls.lock().unwrap().push((d, n));
+        let p = Pipeline::new("arx".parse().unwrap())
+            .nominal(RigParams::default())
+            .extra_model(GlobalModelKind::Arx(ArxOrders::default()))
+            .progress(&hook);
+        let a = p.run(&rec).unwrap();
+        let b = p
+            .run_slices(rec.time(), rec.command(), rec.position())
+            .unwrap();
+        assert_eq!(a.sliding.predicted, b.sliding.predicted);
+        let calls = calls.into_inner().unwrap();
+        assert_eq!(calls.last(), Some(&(rec.len() as u64, rec.len() as u64)));
+        // the nominal model over the predicted samples
+        let sim = a.simulated.as_ref().unwrap();
+        let expect = ErrorStats::from_pairs(
+            (0..rec.len())
+                .filter(|&k| a.sliding.has_prediction[k])
+                .map(|k| (rec.position()[k], sim[k])),
+        );
+        assert_eq!(a.simulation_stats, Some(expect));
+        // the extra model of the method's own kind is the method's global model
+        assert!(a.global.is_some());
+        assert_eq!(a.model, a.global);
+        let s = a.summary();
+        assert_eq!(s.global_model.as_deref(), Some("arx 8,8,1"));
+        assert!(s
+            .to_string()
+            .contains("global model of the method (arx 8,8,1)"));
+    }
+
+    #[test]
+    fn orders_are_chosen_for_regressor_methods_and_refused_for_the_others() {
+        let rec = ramp();
+        let search = OrderSearch::default();
+        let sel = select_order(rec.command(), rec.position(), rec.dt(), &search).unwrap();
+        let run = Pipeline::new("rls".parse().unwrap())
+            .select_orders(search)
+            .method_global_model(false)
+            .run(&rec)
+            .unwrap();
+        assert_eq!(run.method.orders(), Some(sel.chosen));
+        assert!(run
+            .summary()
+            .to_string()
+            .contains("  order auto (bic): na "));
+        let e = Pipeline::new("paper".parse().unwrap())
+            .select_orders(search)
+            .run(&rec)
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::NotApplicable {
+                    method: "paper",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // a failed selection says why, under its stage
+        let flat = Recording::from_rate(1000.0, vec![1e-3; 300], vec![1e-3; 300]).unwrap();
+        let e = Pipeline::new("arx".parse().unwrap())
+            .select_orders(OrderSearch::default())
+            .run(&flat)
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::Stage {
+                    stage: "order selection",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().len() > "order selection: ".len() + 5, "{e}");
+        assert!(!matches!(e.root(), Error::Stage { .. }));
+    }
+
+    #[test]
+    fn paper_windows_far_from_the_time_origin_warn() {
+        // the motion starts at 0 and the recording lasts 25 s: windows far from it
+        let n = 2000;
+        let t: Vec<f64> = (0..n).map(|k| 25.0 + k as f64 * 1e-3).collect();
+        let u: Vec<f64> = (0..n).map(|k| 1e-3 * (k as f64 * 0.01).sin()).collect();
+        let rec = Recording::new(t, u.clone(), u).unwrap();
+        let run = Pipeline::new("paper".parse().unwrap()).run(&rec).unwrap();
+        assert!(matches!(
+            run.warnings.as_slice(),
+            [Warning::PaperCoefficientAccuracy { .. }]
+        ));
+        assert!(run.warnings[0].to_string().contains("lose about"));
+        let run = Pipeline::new("arx".parse().unwrap()).run(&rec).unwrap();
+        assert!(run.warnings.is_empty());
+    }
+}

@@ -1,0 +1,149 @@
+//! The summary of a run: `summary.json` (serde) and the text
+//! `feedid identify` prints (`Display`).
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::ident::ResidualAnalysis;
+use crate::pipeline::OrderChoice;
+
+/// The machine-readable summary of a run (`summary.json`) and, as
+/// `Display`, the text `feedid identify` prints after the file name
+/// (`"{file}: {summary}"`). Optional values that do not apply (no nominal
+/// model, no global model, too few predictions for the residual analysis)
+/// are left out of the JSON, so a `null` never stands for a number.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct IdentifySummary {
+    /// Method name.
+    pub method: String,
+    /// Samples in the recording.
+    pub samples: usize,
+    /// Sampling rate \[Hz\].
+    pub rate_hz: f64,
+    /// Window W \[samples\].
+    pub window: usize,
+    /// Horizon H \[samples\].
+    pub horizon: usize,
+    /// Hop \[samples\].
+    pub hop: usize,
+    /// Windows visited.
+    pub windows: usize,
+    /// Windows whose fit or prediction failed (no prediction).
+    pub failed_windows: usize,
+    /// Windows that kept the previous model (not informative).
+    pub fallback_windows: usize,
+    /// Windows whose prediction the method withheld (not validated; `auto`).
+    pub withheld_windows: usize,
+    /// Samples with a prediction.
+    pub samples_predicted: usize,
+    /// Share of the recording's samples with a prediction \[%\].
+    pub coverage_percent: f64,
+    /// RMS prediction error \[m\].
+    pub rms_error_m: f64,
+    /// Largest absolute prediction error \[m\].
+    pub max_abs_error_m: f64,
+    /// NRMSE fit of the k-step (k = horizon) predictions \[%\].
+    pub fit_percent: f64,
+    /// NRMSE fit of the free-run simulation of the method's global model
+    /// over the samples it was fitted on \[%\] (`None` without one, e.g.
+    /// `paper`, or when it is not finite).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sim_fit_percent: Option<f64>,
+    /// Structure of the global model (e.g. `"arx 8,8,1"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub global_model: Option<String>,
+    /// RMS error of the nominal simulation model over the predicted samples \[m\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sim_rms_error_m: Option<f64>,
+    /// Largest absolute error of the nominal simulation model \[m\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sim_max_abs_error_m: Option<f64>,
+    /// NRMSE fit of the nominal simulation model \[%\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal_fit_percent: Option<f64>,
+    /// Wall time of identification and prediction only (no I/O) \[s\].
+    pub identification_seconds: f64,
+    /// Mean wall time per window \[µs\].
+    pub per_window_us: f64,
+    /// Residual analysis of the prediction errors `y − ŷ` over the predicted
+    /// samples (at most the last 200 000) against the command, lags 0 … 25
+    /// (`None` when fewer than 52 samples were predicted). The k-step
+    /// errors of one horizon share the state they were predicted from, so
+    /// `r_ee` is expected to be positive for lags below the horizon.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals: Option<ResidualAnalysis>,
+    /// Orders chosen from the recording, if asked (text only).
+    #[serde(skip)]
+    pub order_choice: Option<OrderChoice>,
+    /// The global model's free-run fit as computed, finite or not (text only).
+    #[serde(skip)]
+    pub global_fit_percent: Option<f64>,
+    /// Why the method's global model is missing (text only).
+    #[serde(skip)]
+    pub global_note: Option<String>,
+}
+
+impl fmt::Display for IdentifySummary {
+    /// The lines `feedid identify` prints after `"{file}: "`, each ending
+    /// with a newline.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{} samples at {:.2} Hz, method {}, window {}, horizon {}, hop {}",
+            self.samples, self.rate_hz, self.method, self.window, self.horizon, self.hop
+        )?;
+        if let Some(c) = &self.order_choice {
+            let o = c.orders;
+            writeln!(
+                f,
+                "  order auto ({}): na {}, nb {}, nk {}",
+                c.criterion.label(),
+                o.na,
+                o.nb,
+                o.nk
+            )?;
+        }
+        writeln!(
+            f,
+            "  {} windows ({} failed, {} fallback, {} withheld), {} samples predicted ({:.1} %)",
+            self.windows,
+            self.failed_windows,
+            self.fallback_windows,
+            self.withheld_windows,
+            self.samples_predicted,
+            self.coverage_percent
+        )?;
+        writeln!(
+            f,
+            "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %",
+            1e6 * self.rms_error_m,
+            1e6 * self.max_abs_error_m,
+            self.fit_percent
+        )?;
+        if let (Some(m), Some(fit)) = (&self.global_model, self.global_fit_percent) {
+            writeln!(
+                f,
+                "  global model of the method ({m}): free-run fit {fit:.3} %"
+            )?;
+        }
+        if let Some(n) = &self.global_note {
+            writeln!(f, "  global model: {n}")?;
+        }
+        if let (Some(r), Some(m)) = (self.sim_rms_error_m, self.sim_max_abs_error_m) {
+            writeln!(
+                f,
+                "  simulation model:  rms {:.3} µm, max {:.3} µm",
+                1e6 * r,
+                1e6 * m
+            )?;
+        }
+        writeln!(
+            f,
+            "  time: {:.3} ms identification and prediction, {:.2} µs per window",
+            1e3 * self.identification_seconds,
+            self.per_window_us
+        )
+    }
+}

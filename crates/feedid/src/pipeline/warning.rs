@@ -1,0 +1,41 @@
+//! What a run found that the user should know, without failing it.
+
+use std::fmt;
+
+use serde::{Serialize, Serializer};
+
+/// A warning of an identification run ([`crate::pipeline::Identification::warnings`];
+/// printed on standard error by the CLI). Serialises as its text.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Warning {
+    /// Paper method with the motion time origin: the windows lie so far
+    /// from the origin that the change of basis to the coefficients `N`,
+    /// `D` loses digits (see
+    /// [`crate::ident::PaperConfig::worst_shift_amplification`]); the
+    /// predictions are not affected.
+    PaperCoefficientAccuracy {
+        /// The largest growth factor of the change of basis over the windows.
+        amplification: f64,
+    },
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Warning::PaperCoefficientAccuracy { amplification: g } => write!(
+                f,
+                "paper method: windows lie far from the time origin; the coefficients N, D \
+                 lose about {:.0} of their 16 digits (amplification {g:.1e}); predictions are \
+                 not affected (the time origin `window` keeps the coefficients accurate)",
+                g.log10().min(16.0)
+            ),
+        }
+    }
+}
+
+impl Serialize for Warning {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}

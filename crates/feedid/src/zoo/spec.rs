@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::drive::{RigEffects, RigParams};
 use crate::signal::{Chirp, Contour, PointToPoint, Ramp, Scurve, Square, Step};
 
-/// Class of a virtual-rig axis (ranges in [`super::axis`]).
+/// Class of a virtual-rig axis (ranges in the module doc of [`crate::zoo`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum AxisClass {

@@ -16,6 +16,7 @@ mod compensate;
 mod greybox;
 mod report;
 mod sweep;
+pub(crate) mod zoo;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -36,6 +37,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sweep(a) => sweep::run(&a),
         Command::Greybox(a) => greybox::run(&a),
         Command::Compensate(a) => compensate::run(&a),
+        Command::Zoo(a) => zoo::run(&a),
     }
 }
 

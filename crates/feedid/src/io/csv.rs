@@ -59,15 +59,15 @@ const DETECT_ROWS: usize = 50;
 
 /// A field delimiter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Delim {
+pub(super) enum Delim {
     Byte(u8),
     Whitespace,
 }
 
 /// A non-blank, non-comment line with its 1-based number.
-struct Line<'a> {
-    no: usize,
-    text: &'a str,
+pub(super) struct Line<'a> {
+    pub(super) no: usize,
+    pub(super) text: &'a str,
 }
 
 /// Read a recording from a delimited text file (see the module doc for the format).
@@ -264,7 +264,7 @@ fn split_lines<'a>(bytes: &'a [u8], path: &Path) -> Result<Vec<Line<'a>>> {
 }
 
 /// Pick the delimiter (see the module doc).
-fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
+pub(super) fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
     const CANDIDATES: [Delim; 4] = [
         Delim::Byte(b'\t'),
         Delim::Byte(b';'),
@@ -307,7 +307,12 @@ fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
 }
 
 /// Split a line, mapping quote errors to [`Error::Malformed`].
-fn split_checked<'a>(line: &Line<'a>, d: Delim, path: &Path, out: &mut Vec<&'a str>) -> Result<()> {
+pub(super) fn split_checked<'a>(
+    line: &Line<'a>,
+    d: Delim,
+    path: &Path,
+    out: &mut Vec<&'a str>,
+) -> Result<()> {
     split_fields(line.text, d, out).map_err(|reason| Error::Malformed {
         path: path.to_path_buf(),
         line: line.no,
@@ -322,10 +327,19 @@ fn split_fields<'a>(
     out: &mut Vec<&'a str>,
 ) -> std::result::Result<(), &'static str> {
     out.clear();
+    for_each_field(line, d, |f| out.push(f))
+}
+
+/// Call `field` with each trimmed field of `line` in order (see [`split_fields`]).
+pub(super) fn for_each_field<'a>(
+    line: &'a str,
+    d: Delim,
+    mut field: impl FnMut(&'a str),
+) -> std::result::Result<(), &'static str> {
     let delim = match d {
         Delim::Whitespace => {
             for f in line.split_whitespace() {
-                out.push(unquote(f));
+                field(unquote(f));
             }
             return Ok(());
         }
@@ -343,7 +357,7 @@ fn split_fields<'a>(
             let Some(len) = bytes[start..].iter().position(|&b| b == b'"') else {
                 return Err("unterminated quoted field");
             };
-            out.push(line.get(start..start + len).unwrap_or(""));
+            field(line.get(start..start + len).unwrap_or(""));
             i = start + len + 1;
             while i < bytes.len() && is_space(bytes[i]) {
                 i += 1;
@@ -360,7 +374,7 @@ fn split_fields<'a>(
                 .iter()
                 .position(|&b| b == delim)
                 .map_or(bytes.len(), |p| i + p);
-            out.push(line.get(i..end).unwrap_or("").trim());
+            field(line.get(i..end).unwrap_or("").trim());
             if end >= bytes.len() {
                 return Ok(());
             }
@@ -376,12 +390,12 @@ fn unquote(f: &str) -> &str {
 }
 
 /// Strict number parse (trimmed Rust `f64` syntax).
-fn parse_number(s: &str) -> Option<f64> {
+pub(super) fn parse_number(s: &str) -> Option<f64> {
     s.trim().parse::<f64>().ok()
 }
 
 /// A number, or a number written with a decimal comma (for header detection).
-fn number_like(s: &str) -> bool {
+pub(super) fn number_like(s: &str) -> bool {
     parse_number(s).is_some() || looks_decimal_comma(s)
 }
 
@@ -395,7 +409,7 @@ fn looks_decimal_comma(s: &str) -> bool {
 ///
 /// With `,` as delimiter, decimal commas in a whitespace-separated file show up
 /// as cells like `5 1` (the tail of one number and the head of the next).
-fn decimal_comma_hint(text: &str, d: Delim) -> &'static str {
+pub(super) fn decimal_comma_hint(text: &str, d: Delim) -> &'static str {
     if looks_decimal_comma(text) || (d == Delim::Byte(b',') && split_number(text)) {
         DECIMAL_COMMA_HINT
     } else {
@@ -411,7 +425,7 @@ fn split_number(text: &str) -> bool {
 }
 
 /// Find a column by name or 1-based index.
-fn resolve_column(
+pub(super) fn resolve_column(
     r: &ChannelRef,
     header: Option<&[String]>,
     ncols: usize,

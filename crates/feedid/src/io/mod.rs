@@ -1,14 +1,18 @@
 //! Reading recordings from CSV/text and MATLAB v5 files ([`read_recording`]
 //! dispatches), the options that pick columns and units ([`ReadOptions`]),
-//! the summary a user checks before identifying ([`recording_info`]), and
+//! the summary a user checks before identifying ([`recording_info`]), a
+//! live text stream read line by line with the same options
+//! ([`StreamReader`]), and
 //! writing results without leaving partial files ([`write_atomic`]).
 
 mod csv;
 mod info;
+mod layout;
 mod mat;
 mod options;
 mod output;
 mod read;
+mod stream;
 
 pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
 pub use self::info::{recording_info, ChannelStats, RecordingInfo};
@@ -24,3 +28,6 @@ pub use self::output::{
     cell, write_atomic, write_coefficients_csv, write_predictions_csv, write_string_atomic,
 };
 pub use self::read::{read_recording, read_recording_from_bytes};
+pub use self::stream::{
+    PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,
+};

@@ -43,7 +43,7 @@
 //! |---|---|
 //! | not read (the paper's polynomial prediction) | at the window end |
 //! | known: command lead `N ≥ H` | at the window end, with the real command |
-//! | extrapolated ([`CommandExtrapolation`] hold, velocity — the default —, acceleration) beyond the `N` samples received | at the window end |
+//! | extrapolated ([`CommandExtrapolation`] hold, velocity, acceleration — the default) beyond the `N` samples received | at the window end |
 //! | awaited ([`CommandExtrapolation::Wait`]) | once the command up to `s_j + W + H − 1` has arrived: `H − N − 1` samples late, a reconstruction |
 //!
 //! The extrapolated samples are overwritten by the real command when it

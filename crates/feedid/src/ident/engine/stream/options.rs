@@ -31,12 +31,14 @@ pub enum CommandExtrapolation {
     /// The last command held: `u[n−1+m] = u[n−1]`.
     Hold,
     /// Constant velocity from the last two command samples:
-    /// `u[n−1+m] = u[n−1] + m·Δ` (the default, chosen on the rig scenarios
-    /// and EMPS; see the README's "Streaming" section).
-    #[default]
+    /// `u[n−1+m] = u[n−1] + m·Δ`.
     Velocity,
     /// Constant acceleration from the last three command samples (the
     /// parabola through them): `u[n−1+m] = u[n−1] + m·Δ + m(m+1)/2·Δ²`.
+    /// The default: of the three, the smallest prediction error on the rig
+    /// scenarios and on most of the drive zoo (example
+    /// `stream_extrapolation`; the figures are in the README, "Streaming").
+    #[default]
     Acceleration,
 }
 
@@ -149,7 +151,7 @@ pub struct StreamOptions {
     /// command lead (default).
     pub lookahead: Option<usize>,
     /// How the command over a horizon is filled where it has not arrived
-    /// yet. Default [`CommandExtrapolation::Velocity`].
+    /// yet. Default [`CommandExtrapolation::Acceleration`].
     pub extrapolation: CommandExtrapolation,
     /// Nominal sample interval \[s\]; `None` = the running mean interval of
     /// the current segment (default).

@@ -537,7 +537,7 @@ fn without_extrapolation_predictions_wait_for_the_command_over_the_horizon() {
     assert_eq!(
         s.horizon_command(),
         HorizonCommand::Extrapolated {
-            extrapolation: Velocity,
+            extrapolation: Acceleration,
             known: 0
         }
     );

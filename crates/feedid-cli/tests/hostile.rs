@@ -157,7 +157,8 @@ struct Case {
     extra: &'static [&'static str],
     /// Expectation for every command in [`RECORDING_COMMANDS`] but `stream`…
     expect: Expect,
-    /// …and for `stream`, which reports and skips bad lines and goes on.
+    /// …and for `stream`, which reports and skips bad lines and goes on
+    /// (and fails when no line was usable).
     stream: Expect,
 }
 
@@ -214,7 +215,7 @@ fn catalogue() -> Vec<Case> {
             bytes: vec![],
             extra: &[],
             expect: Fails(&["{file}", "empty"]),
-            stream: Succeeds,
+            stream: Fails(&["no data line"]),
         },
         Case {
             name: "header only",
@@ -222,7 +223,7 @@ fn catalogue() -> Vec<Case> {
             bytes: HEADER.into(),
             extra: &[],
             expect: Fails(&["{file}", "header only"]),
-            stream: Succeeds,
+            stream: Fails(&["no usable line"]),
         },
         Case {
             name: "one sample",
@@ -270,7 +271,7 @@ fn catalogue() -> Vec<Case> {
             bytes: with_bad_row("0.01,abc,0"),
             extra: &[],
             expect: Fails(&["{file}", "line 12", "command_m", "abc"]),
-            stream: Reports(&["line 12:", "skipped lines 1"]),
+            stream: Reports(&["line 12, column `command_m`", "skipped lines 1"]),
         },
         Case {
             name: "missing field",
@@ -335,7 +336,7 @@ fn catalogue() -> Vec<Case> {
             },
             extra: &[],
             expect: Fails(&["{file}", "time_s"]),
-            stream: Succeeds,
+            stream: Fails(&["no column `time_s`"]),
         },
         Case {
             name: "window longer than the data",
@@ -407,7 +408,7 @@ fn catalogue() -> Vec<Case> {
             bytes: fixture("double_v6.mat")[..400].to_vec(),
             extra: MAT_VARS,
             expect: Fails(&["{file}", "truncated"]),
-            stream: Succeeds,
+            stream: Fails(&["no usable line"]),
         },
         Case {
             name: "truncated compressed .mat",
@@ -415,7 +416,7 @@ fn catalogue() -> Vec<Case> {
             bytes: truncated_v7,
             extra: MAT_VARS,
             expect: Fails(&["{file}"]),
-            stream: Succeeds,
+            stream: Fails(&["no usable line"]),
         },
         Case {
             name: "corrupted .mat (size field)",
@@ -423,7 +424,7 @@ fn catalogue() -> Vec<Case> {
             bytes: corrupted,
             extra: MAT_VARS,
             expect: Fails(&["{file}", "byte 128"]),
-            stream: Succeeds,
+            stream: Fails(&["no usable line"]),
         },
         Case {
             name: "corrupted compressed .mat",
@@ -431,7 +432,7 @@ fn catalogue() -> Vec<Case> {
             bytes: compressed_bad,
             extra: MAT_VARS,
             expect: Fails(&["{file}", "compressed"]),
-            stream: Succeeds,
+            stream: Fails(&["no usable line"]),
         },
         Case {
             name: "header-only .mat",
@@ -439,7 +440,7 @@ fn catalogue() -> Vec<Case> {
             bytes: fixture("double_v6.mat")[..128].to_vec(),
             extra: MAT_VARS,
             expect: Fails(&["{file}", "no variable `t`", "available: none"]),
-            stream: Succeeds,
+            stream: Fails(&["no usable line"]),
         },
         Case {
             name: "wrong variable names",
@@ -447,7 +448,7 @@ fn catalogue() -> Vec<Case> {
             bytes: fixture("double_v6.mat"),
             extra: &["--time", "time", "--command", "qg", "--position", "qm"],
             expect: Fails(&["{file}", "no variable `time`", "qg"]),
-            stream: Succeeds,
+            stream: Fails(&["no usable line"]),
         },
         Case {
             name: "text named .mat",

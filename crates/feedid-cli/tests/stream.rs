@@ -429,7 +429,7 @@ fn waiting_for_the_command_gives_the_batch_engine_predictions() {
         }
         assert!(batch.stats.samples > n / 2, "{args:?}");
         assert!(
-            err.contains(&format!("samples {n},")) && err.contains("0 skipped"),
+            err.contains(&format!("samples {n},")) && err.contains("skipped lines 0"),
             "{err}"
         );
         assert!(
@@ -588,7 +588,7 @@ fn malformed_lines_are_reported_with_their_number_and_skipped() {
         !err.contains("line 32") && !err.contains("line 35"),
         "{err}"
     );
-    assert!(err.contains("5 skipped"), "{err}");
+    assert!(err.contains("skipped lines 5,"), "{err}");
     assert!(err.contains(&format!("samples {},", rec.len())), "{err}");
     // a bad option is an error with exit code 2
     for args in [

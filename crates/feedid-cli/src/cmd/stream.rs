@@ -278,7 +278,7 @@ fn summary(lines: &Lines, st: &StreamStats, command: HorizonCommand, rows: usize
         String::new()
     };
     o += &format!(
-        "lines {} ({} header, {} skipped), samples {}{unused}, gaps {}, irregular intervals {}\n",
+        "lines {} ({} header), skipped lines {}, samples {}{unused}, gaps {}, irregular intervals {}\n",
         lines.read, lines.headers, lines.skipped, st.samples, st.gaps, st.irregular_intervals
     );
     let predicted = st.windows - st.failed_windows - st.withheld_windows;

@@ -255,10 +255,7 @@ impl<R: BufRead> StreamReader<R> {
             if too_long {
                 return Ok(Some(Raw::Bad(
                     no,
-                    self.malformed(
-                        no,
-                        format!("longer than {MAX_STREAM_LINE} bytes (1 MiB); not a text sample"),
-                    ),
+                    self.malformed(no, format!("longer than {MAX_STREAM_LINE} bytes")),
                 )));
             }
             if self.buf.last() == Some(&b'\r') {

@@ -29,7 +29,7 @@ pub enum Command {
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),
     /// Identify and predict online: CSV samples on stdin, predictions on stdout as they are due.
-    Stream(StreamArgs),
+    Stream(Box<StreamArgs>),
     /// Write a self-contained HTML report of a recording: figures, residuals, Bode plot, summary.
     Report(Box<ReportArgs>),
     /// Error of every window × horizon × method × order combination, heat map, best choice.

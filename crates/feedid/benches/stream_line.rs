@@ -40,7 +40,12 @@ fn text(seconds: f64, lead: usize) -> Vec<u8> {
         .unwrap_or_else(|e| panic!("{e}"));
     let mut s = String::from("time_s,command_m,position_m\n");
     for k in 0..out.len() - lead {
-        s += &format!("{},{},{}\n", out.time[k], out.command[k + lead], out.position[k]);
+        s += &format!(
+            "{},{},{}\n",
+            out.time[k],
+            out.command[k + lead],
+            out.position[k]
+        );
     }
     s.into_bytes()
 }

@@ -659,13 +659,15 @@ impl<E: Estimator> Streamer<E> {
             expected,
         };
         let deviation = ((t - prev) / expected - 1.0).abs();
-        Ok(if !(deviation <= self.options.gap_deviation()) {
-            Interval::Gap(jump)
-        } else if deviation > self.options.jitter_tolerance {
-            Interval::Irregular(jump)
-        } else {
-            Interval::Regular
-        })
+        Ok(
+            if deviation.is_nan() || deviation > self.options.gap_deviation() {
+                Interval::Gap(jump)
+            } else if deviation > self.options.jitter_tolerance {
+                Interval::Irregular(jump)
+            } else {
+                Interval::Regular
+            },
+        )
     }
 
     /// Take the time stamp `t` (already checked) into the segment's clock.

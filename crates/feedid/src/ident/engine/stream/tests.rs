@@ -1,3 +1,8 @@
+//! Tests of the streamer: the batch engine's windows and predictions where
+//! the stream has the same data, when predictions are made, extrapolation,
+//! gaps, scores and misuse.
+#![allow(clippy::needless_range_loop)]
+
 use std::ops::Range;
 
 use super::*;
@@ -748,7 +753,7 @@ fn a_gap_restarts_the_windows_as_if_a_new_recording_began() {
     }
     // Follow waits for its command: its windows before the gap are cut there
     let c = stream(follow7(), cfg, &rec, Feed::Lines(0), Wait);
-    let (want, _) = batch_by_segments(|| follow7(), &rec, &cuts, &cfg);
+    let (want, _) = batch_by_segments(follow7, &rec, &cuts, &cfg);
     for k in 0..rec.len() {
         assert_eq!(c.has[k], want[k].is_some(), "{k}");
         if let Some(b) = want[k] {

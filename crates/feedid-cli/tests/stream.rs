@@ -459,7 +459,7 @@ fn simulate_output_streams_with_no_options_and_the_reading_options_of_identify_w
     let text = std::fs::read_to_string(&r).unwrap();
     let (plain, err) = stream(&["--method", "paper"], &text);
     assert!(
-        err.contains("lines 501 (1 header, 0 skipped), samples 500"),
+        err.contains("lines 501 (1 header), skipped lines 0, samples 500"),
         "{err}"
     );
     let want = rows(&plain);
@@ -544,7 +544,7 @@ fn gaps_and_backward_times_are_reported_with_their_line() {
         "{err}"
     );
     assert!(
-        err.contains("gaps 1,") && err.contains("1 skipped"),
+        err.contains("gaps 1,") && err.contains("skipped lines 1,"),
         "{err}"
     );
     // no window spans the gap: after the last window before it (predicting

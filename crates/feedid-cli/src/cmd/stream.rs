@@ -230,9 +230,10 @@ fn report_interval<E: Write>(err: &mut E, lines: &mut Lines, no: usize, interval
                         short(j.expected)
                     ),
                     m => format!(
-                        "time jumps from {} s to {} s: {m} samples of {} s missing",
+                        "time jumps from {} s to {} s: {m} sample{} of {} s missing",
                         j.previous_time,
                         j.time,
+                        if m == 1 { "" } else { "s" },
                         short(j.expected)
                     ),
                 };

@@ -1,10 +1,11 @@
 //! The layout of a delimited text recording — its delimiter, whether its
 //! first row is a header, which columns hold time, command and position —
 //! found from its first lines by the rules of [`crate::io::read_csv`], and
-//! the parse of one row with it. The line-by-line reader of a live stream
-//! ([`crate::io::StreamReader`]) decides the layout from the first two
-//! lines (it cannot wait for fifty) and parses every later line with
-//! [`TextLayout::row`], which allocates nothing.
+//! the parse of one row with it ([`TextLayout::row`], which allocates
+//! nothing). The file reader decides the layout from the first fifty lines,
+//! the line-by-line reader of a live stream ([`crate::io::StreamReader`])
+//! from the first two (it cannot wait for fifty); both parse every row with
+//! [`TextLayout::row`].
 
 use std::path::Path;
 
@@ -22,8 +23,8 @@ use crate::io::read::short_text;
 /// and the text has no header.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Headerless {
-    /// The default names (`time_s`, `command_m`, `position_m`) need a header.
-    #[allow(dead_code)] // the file reader's rule; it shares this layout next
+    /// The default names (`time_s`, `command_m`, `position_m`) need a header
+    /// (the file reader's rule).
     ByName,
     /// Time, command, position are columns 1, 2, 3 (command and position 1
     /// and 2 with a sampling rate), as `feedid simulate` writes them.
@@ -33,14 +34,17 @@ pub(crate) enum Headerless {
 /// Delimiter, header and columns of a text recording.
 #[derive(Debug, Clone)]
 pub(crate) struct TextLayout {
-    delim: Delim,
-    ncols: usize,
-    header: Option<Vec<String>>,
-    /// The line whose field count every row must have.
-    reference_line: usize,
-    time_col: Option<usize>,
-    cmd_col: usize,
-    pos_col: usize,
+    pub(super) delim: Delim,
+    /// Fields in every row.
+    pub(super) ncols: usize,
+    /// The header's cells, if the first line is a header.
+    pub(super) header: Option<Vec<String>>,
+    /// The first line: the header, or the row whose field count every row must have.
+    pub(super) first_line: usize,
+    /// Columns (0-based) of time (`None` with a sampling rate), command and position.
+    pub(super) time_col: Option<usize>,
+    pub(super) cmd_col: usize,
+    pub(super) pos_col: usize,
 }
 
 /// One row's time (`None` with a sampling rate), command and position, in
@@ -66,7 +70,7 @@ impl TextLayout {
             return Err(Error::Malformed {
                 path: path.to_path_buf(),
                 line: 1,
-                reason: "the input is empty (no header, no data rows)".into(),
+                reason: "the file is empty (no header, no data rows)".into(),
             });
         };
         let delim = match opts.delimiter {
@@ -93,7 +97,8 @@ impl TextLayout {
             has_header.then(|| fields.iter().map(|s| s.to_string()).collect());
         let ncols = fields.len();
         let names = header.as_deref();
-        let resolve = |r: &ChannelRef| resolve_column(r, names, ncols, path);
+        let resolve =
+            |r: &ChannelRef, role: &str| resolve_column(r, names, ncols, path, role, first.no);
         let default = |o: &Option<ChannelRef>, name: &str, index: usize| {
             o.clone().unwrap_or_else(|| {
                 if names.is_none() && headerless == Headerless::ByIndex {
@@ -107,19 +112,21 @@ impl TextLayout {
         let first_value = if rate { 1 } else { 2 };
         let time_col = match (&opts.time, rate) {
             (None, true) => None,
-            (t, _) => Some(resolve(&default(t, DEFAULT_TIME_COLUMN, 1))?),
+            (t, _) => Some(resolve(&default(t, DEFAULT_TIME_COLUMN, 1), "time")?),
         };
-        let cmd_col = resolve(&default(&opts.command, DEFAULT_COMMAND_COLUMN, first_value))?;
-        let pos_col = resolve(&default(
-            &opts.position,
-            DEFAULT_POSITION_COLUMN,
-            first_value + 1,
-        ))?;
+        let cmd_col = resolve(
+            &default(&opts.command, DEFAULT_COMMAND_COLUMN, first_value),
+            "command",
+        )?;
+        let pos_col = resolve(
+            &default(&opts.position, DEFAULT_POSITION_COLUMN, first_value + 1),
+            "position",
+        )?;
         Ok(Self {
             delim,
             ncols,
             header,
-            reference_line: first.no,
+            first_line: first.no,
             time_col,
             cmd_col,
             pos_col,
@@ -170,7 +177,7 @@ impl TextLayout {
                 line: line.no,
                 reason: format!(
                     "{n} fields, expected {} as in line {}{hint}",
-                    self.ncols, self.reference_line
+                    self.ncols, self.first_line
                 ),
             });
         }

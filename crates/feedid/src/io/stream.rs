@@ -40,16 +40,18 @@
 //! ```
 
 use std::collections::VecDeque;
-use std::io::{BufRead, ErrorKind, Write};
+use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::io::csv::Line;
 use crate::io::layout::{Headerless, TextLayout};
 use crate::io::options::ReadOptions;
+use crate::io::source::LineReader;
 
-/// Longest line of a stream \[bytes\] (1 MiB); a longer one is skipped.
-pub const MAX_STREAM_LINE: usize = 1 << 20;
+/// Longest line of a stream \[bytes\] (1 MiB, [`crate::io::MAX_LINE_BYTES`]);
+/// a longer one is skipped.
+pub const MAX_STREAM_LINE: usize = crate::io::source::MAX_LINE_BYTES;
 
 /// What one content line of a stream was (blank and `#` lines are not reported).
 #[derive(Debug)]
@@ -80,23 +82,13 @@ pub enum StreamLine {
     },
 }
 
-/// A line as read: its text in the reader's buffer, or why it is unusable.
-enum Raw {
-    Text(usize),
-    Bad(usize, Error),
-}
-
 /// Reads a text stream line by line (see the module doc).
 #[derive(Debug)]
 pub struct StreamReader<R> {
-    input: R,
+    lines: LineReader<R>,
     path: PathBuf,
     opts: ReadOptions,
     layout: Option<TextLayout>,
-    /// The current line's bytes.
-    buf: Vec<u8>,
-    /// Lines read so far (the last one's number).
-    line: usize,
     /// Data lines so far (samples and skipped lines after the header).
     data_rows: usize,
     /// Events of the first lines, decided together with the layout.
@@ -110,12 +102,11 @@ impl<R: BufRead> StreamReader<R> {
     pub fn new(input: R, source: &Path, opts: &ReadOptions) -> Result<Self> {
         opts.validate()?;
         Ok(Self {
-            input,
+            // a live stream has no byte limit: it may run for days
+            lines: LineReader::new(input, source, None),
             path: source.to_path_buf(),
             opts: opts.clone(),
             layout: None,
-            buf: Vec::new(),
-            line: 0,
             data_rows: 0,
             queued: VecDeque::new(),
             done: false,
@@ -128,27 +119,34 @@ impl<R: BufRead> StreamReader<R> {
         if let Some(e) = self.queued.pop_front() {
             return Ok(Some(e));
         }
+        if self.done {
+            return Ok(None);
+        }
         if self.layout.is_none() {
             self.start()?;
             return Ok(self.queued.pop_front());
         }
-        match self.read()? {
-            None => Ok(None),
-            Some(Raw::Bad(line, error)) => {
-                self.data_rows += 1;
-                Ok(Some(StreamLine::Skipped { line, error }))
+        let Self {
+            lines,
+            path,
+            opts,
+            layout,
+            data_rows,
+            ..
+        } = self;
+        let Some(layout) = layout.as_ref() else {
+            return Ok(None);
+        };
+        let event = match lines.next_content_line_or_skip()? {
+            None => {
+                self.done = true;
+                return Ok(None);
             }
-            Some(Raw::Text(no)) => {
-                let text = std::str::from_utf8(&self.buf).unwrap_or_default();
-                let line = Line { no, text };
-                let event = match &self.layout {
-                    Some(layout) => sample(layout, &line, &self.path, &self.opts, self.data_rows),
-                    None => return Ok(None),
-                };
-                self.data_rows += 1;
-                Ok(Some(event))
-            }
-        }
+            Some((line, Err(error))) => StreamLine::Skipped { line, error },
+            Some((no, Ok(text))) => sample(layout, &Line { no, text }, path, opts, *data_rows),
+        };
+        *data_rows += 1;
+        Ok(Some(event))
     }
 
     /// Read the first two usable lines, decide the layout from them and
@@ -156,13 +154,9 @@ impl<R: BufRead> StreamReader<R> {
     fn start(&mut self) -> Result<()> {
         let mut read: Vec<(usize, std::result::Result<String, Error>)> = Vec::new();
         while read.iter().filter(|(_, r)| r.is_ok()).count() < 2 {
-            match self.read()? {
+            match self.lines.next_content_line_or_skip()? {
                 None => break,
-                Some(Raw::Bad(no, e)) => read.push((no, Err(e))),
-                Some(Raw::Text(no)) => {
-                    let text = String::from_utf8_lossy(&self.buf).into_owned();
-                    read.push((no, Ok(text)));
-                }
+                Some((no, r)) => read.push((no, r.map(str::to_string))),
             }
         }
         let usable = read.iter().any(|(_, r)| r.is_ok());
@@ -206,98 +200,6 @@ impl<R: BufRead> StreamReader<R> {
         }
         self.layout = Some(layout);
         Ok(())
-    }
-
-    /// Read the next line that is neither blank nor a comment into the buffer.
-    fn read(&mut self) -> Result<Option<Raw>> {
-        loop {
-            if self.done {
-                return Ok(None);
-            }
-            self.buf.clear();
-            let mut too_long = false;
-            // at most MAX_STREAM_LINE bytes are kept; the rest of a longer line is dropped
-            loop {
-                let chunk = match self.input.fill_buf() {
-                    Ok(c) => c,
-                    Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-                    Err(source) => {
-                        return Err(Error::Io {
-                            path: self.path.clone(),
-                            source,
-                        })
-                    }
-                };
-                if chunk.is_empty() {
-                    self.done = true;
-                    break;
-                }
-                let end = chunk.iter().position(|&b| b == b'\n');
-                let take = end.unwrap_or(chunk.len());
-                let room = MAX_STREAM_LINE.saturating_sub(self.buf.len());
-                if take > room {
-                    too_long = true;
-                }
-                if !too_long {
-                    self.buf.extend_from_slice(&chunk[..take]);
-                }
-                let used = end.map_or(take, |i| i + 1);
-                self.input.consume(used);
-                if end.is_some() {
-                    break;
-                }
-            }
-            if self.done && self.buf.is_empty() && !too_long {
-                return Ok(None);
-            }
-            self.line += 1;
-            let no = self.line;
-            if too_long {
-                return Ok(Some(Raw::Bad(
-                    no,
-                    self.malformed(no, format!("longer than {MAX_STREAM_LINE} bytes")),
-                )));
-            }
-            if self.buf.last() == Some(&b'\r') {
-                self.buf.pop();
-            }
-            if no == 1 && self.buf.starts_with(b"\xEF\xBB\xBF") {
-                self.buf.drain(..3);
-            }
-            if let Some(i) = self.buf.iter().position(|&b| b == 0 || b == b'\r') {
-                let what = if self.buf[i] == 0 {
-                    "a NUL byte (binary data?)"
-                } else {
-                    "a carriage return inside the line (CR-only line endings? end lines with LF or CR LF)"
-                };
-                return Ok(Some(Raw::Bad(
-                    no,
-                    self.malformed(no, format!("{what} at byte {}", i + 1)),
-                )));
-            }
-            let text = match std::str::from_utf8(&self.buf) {
-                Ok(t) => t.trim(),
-                Err(e) => {
-                    let reason = format!(
-                        "invalid UTF-8 at byte {} of the line (is this text?)",
-                        e.valid_up_to() + 1
-                    );
-                    return Ok(Some(Raw::Bad(no, self.malformed(no, reason))));
-                }
-            };
-            if text.is_empty() || text.starts_with('#') {
-                continue;
-            }
-            return Ok(Some(Raw::Text(no)));
-        }
-    }
-
-    fn malformed(&self, line: usize, reason: String) -> Error {
-        Error::Malformed {
-            path: self.path.clone(),
-            line,
-            reason,
-        }
     }
 }
 

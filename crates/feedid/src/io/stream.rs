@@ -16,8 +16,11 @@
 //!   skipped: each was a sample) has `t = k / rate`;
 //! - the values are not checked here (finite, time increasing, intervals):
 //!   that is the streamer's part ([`crate::ident::stream::Streamer`]);
-//! - a line over [`MAX_STREAM_LINE`] bytes, with a NUL byte, or not UTF-8 is
-//!   skipped, not fatal; memory stays bounded.
+//! - lines are read as a file's are (`\n`, `\r\n` or `\r` endings, a byte-order
+//!   mark, blank and `#` lines skipped), but a line over [`MAX_STREAM_LINE`]
+//!   bytes, with a NUL byte, or not UTF-8 is skipped, not fatal: the rest of
+//!   it is read without being held, so memory stays bounded; and there is no
+//!   limit on the input's length (a file from a pipe has 256 MiB).
 //!
 //! Every line is parsed without allocating ([`StreamLine::Sample`]);
 //! [`PredictionRows`] writes what a stream predicts.

@@ -400,4 +400,30 @@ mod tests {
             "{e}"
         );
     }
+
+    proptest::proptest! {
+        #[test]
+        fn any_bytes_end_without_panic_and_every_line_is_reported_once(
+            body in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..400),
+            sel in 0u8..8,
+        ) {
+            let opts = ReadOptions {
+                rate_hz: (sel & 1 != 0).then_some(100.0),
+                header: [None, Some(true), Some(false), None][(sel >> 1) as usize],
+                ..ReadOptions::default()
+            };
+            if let Ok(lines) = all(&body, &opts) {
+                let numbers: Vec<usize> = lines
+                    .iter()
+                    .map(|l| match l {
+                        StreamLine::Header { line }
+                        | StreamLine::Sample { line, .. }
+                        | StreamLine::Skipped { line, .. } => *line,
+                    })
+                    .collect();
+                proptest::prop_assert!(numbers.windows(2).all(|w| w[0] < w[1]), "{:?}", numbers);
+                proptest::prop_assert!(numbers.len() <= body.len() + 1);
+            }
+        }
+    }
 }

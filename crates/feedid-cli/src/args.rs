@@ -29,7 +29,7 @@ pub enum Command {
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),
     /// Identify and predict online: CSV samples on stdin, predictions on stdout as they are due.
-    Stream(StreamArgs),
+    Stream(Box<StreamArgs>),
     /// Write a self-contained HTML report of a recording: figures, residuals, Bode plot, summary.
     Report(Box<ReportArgs>),
     /// Error of every window × horizon × method × order combination, heat map, best choice.
@@ -331,9 +331,21 @@ pub struct StreamArgs {
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
-    /// Sampling rate [Hz] when lines are `command,position` without a time.
-    #[arg(long, value_name = "HZ")]
-    pub rate: Option<f64>,
+    /// How to read the lines (as a recording file; without a header and
+    /// without column options: time, command, position are columns 1, 2, 3).
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// The command on each line belongs to the sample N lines later (an
+    /// interpolator's look-ahead) [samples]; with N ≥ the horizon every
+    /// prediction is written before the line of its measurement is read.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub command_lead: usize,
+    /// Command over the horizon beyond the lead: acceleration (from the last
+    /// three commands), velocity (last two), hold, or wait (no extrapolation:
+    /// predictions come after their measurement, as identify's)
+    /// [default: acceleration].
+    #[arg(long, value_name = "HOW")]
+    pub extrapolate: Option<String>,
 }
 
 /// `feedid report`.

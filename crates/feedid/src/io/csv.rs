@@ -50,10 +50,9 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::io::options::{
-    ChannelRef, ReadOptions, DEFAULT_COMMAND_COLUMN, DEFAULT_POSITION_COLUMN, DEFAULT_TIME_COLUMN,
-};
-use crate::io::read::{build_recording, failing_sample, in_file, short_list, short_text, Role};
+use crate::io::layout::{Headerless, TextLayout};
+use crate::io::options::{ChannelRef, ReadOptions};
+use crate::io::read::{build_recording, failing_sample, in_file, short_list, Role};
 use crate::io::source::{open_input, LineReader};
 use crate::recording::Recording;
 
@@ -65,15 +64,15 @@ const DETECT_ROWS: usize = 50;
 
 /// A field delimiter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Delim {
+pub(super) enum Delim {
     Byte(u8),
     Whitespace,
 }
 
 /// A non-blank, non-comment line with its 1-based number.
-struct Line<'a> {
-    no: usize,
-    text: &'a str,
+pub(super) struct Line<'a> {
+    pub(super) no: usize,
+    pub(super) text: &'a str,
 }
 
 /// An owned [`Line`] (the first rows, kept for the detection).
@@ -130,7 +129,7 @@ pub fn read_csv_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
 }
 
 /// The next line that is neither blank nor a comment.
-fn next_content<'r, R: BufRead>(lines: &'r mut LineReader<'_, R>) -> Result<Option<Line<'r>>> {
+fn next_content<'r, R: BufRead>(lines: &'r mut LineReader<R>) -> Result<Option<Line<'r>>> {
     Ok(lines
         .next_content_line()?
         .map(|(no, text)| Line { no, text }))
@@ -138,7 +137,7 @@ fn next_content<'r, R: BufRead>(lines: &'r mut LineReader<'_, R>) -> Result<Opti
 
 /// Parse the lines of a text recording (see the module doc for the format).
 fn parse_text<R: BufRead>(
-    lines: &mut LineReader<'_, R>,
+    lines: &mut LineReader<R>,
     path: &Path,
     opts: &ReadOptions,
 ) -> Result<Recording> {
@@ -154,41 +153,9 @@ fn parse_text<R: BufRead>(
         }
     }
     let head_lines: Vec<Line<'_>> = head.iter().map(OwnedLine::view).collect();
-    let Some(first) = head_lines.first() else {
-        return Err(Error::Malformed {
-            path: path.to_path_buf(),
-            line: 1,
-            reason: "the file is empty (no header, no data rows)".into(),
-        });
-    };
-    let delim = match opts.delimiter {
-        None => detect_delimiter(&head_lines),
-        Some(b' ') => Delim::Whitespace,
-        Some(b) => Delim::Byte(b),
-    };
-
-    let mut fields: Vec<&str> = Vec::new();
-    let mut below: Vec<&str> = Vec::new();
-    split_checked(first, delim, path, &mut fields)?;
-    let has_header = match opts.header {
-        Some(h) => h,
-        None => {
-            if let Some(second) = head_lines.get(1) {
-                split_checked(second, delim, path, &mut below)?;
-                fields
-                    .iter()
-                    .enumerate()
-                    .any(|(i, c)| !number_like(c) && below.get(i).is_some_and(|b| number_like(b)))
-            } else {
-                fields.iter().any(|c| !number_like(c))
-            }
-        }
-    };
-    let header: Option<Vec<String>> =
-        has_header.then(|| fields.iter().map(|s| s.to_string()).collect());
-    let ncols = fields.len();
-    let header_line = first.no;
-    let data_head = if has_header {
+    let layout = TextLayout::detect(&head_lines, opts, path, Headerless::ByName)?;
+    let header_line = layout.first_line;
+    let data_head = if layout.has_header() {
         head_lines.get(1..).unwrap_or_default()
     } else {
         &head_lines[..]
@@ -200,41 +167,19 @@ fn parse_text<R: BufRead>(
             reason: "header only, no data rows".into(),
         });
     }
-
-    // Resolve the columns.
-    let names = header.as_deref();
-    let resolve =
-        |r: &ChannelRef, role: &str| resolve_column(r, names, ncols, path, role, header_line);
-    let default = |o: &Option<ChannelRef>, d: &str| {
-        o.clone().unwrap_or_else(|| ChannelRef::Name(d.to_string()))
-    };
-    let time_col = match (&opts.time, opts.rate_hz) {
-        (None, Some(_)) => None,
-        (t, _) => Some(resolve(&default(t, DEFAULT_TIME_COLUMN), "time")?),
-    };
-    let cmd_col = resolve(&default(&opts.command, DEFAULT_COMMAND_COLUMN), "command")?;
-    let pos_col = resolve(
-        &default(&opts.position, DEFAULT_POSITION_COLUMN),
-        "position",
-    )?;
-    let col_name = |i: usize| match names.and_then(|n| n.get(i)) {
-        Some(n) if !n.is_empty() => n.clone(),
-        _ => (i + 1).to_string(),
-    };
+    let (ncols, time_col, cmd_col, pos_col) = (
+        layout.ncols,
+        layout.time_col,
+        layout.cmd_col,
+        layout.pos_col,
+    );
+    let names = layout.header.as_deref();
+    let col_name = |i: usize| layout.col_name(i);
 
     // Parse the rows as they are read.
     let mut rows = Rows {
         path,
-        delim,
-        ncols,
-        reference_line: if has_header {
-            header_line
-        } else {
-            data_head[0].no
-        },
-        time_col,
-        cmd_col,
-        pos_col,
+        layout: &layout,
         time_factor: opts.time_unit.factor(),
         time: time_col.map(|_| Vec::new()),
         command: Vec::new(),
@@ -246,8 +191,6 @@ fn parse_text<R: BufRead>(
             })
             .collect(),
         row_lines: Vec::new(),
-        fields: Vec::new(),
-        col_name: &col_name,
     };
     for line in data_head {
         rows.push(line)?;
@@ -318,70 +261,31 @@ fn parse_text<R: BufRead>(
 }
 
 /// The columns being collected, row by row.
-struct Rows<'p, 'n> {
+struct Rows<'p, 'l> {
     path: &'p Path,
-    delim: Delim,
-    ncols: usize,
-    /// The line whose field count every row must have.
-    reference_line: usize,
-    time_col: Option<usize>,
-    cmd_col: usize,
-    pos_col: usize,
+    layout: &'l TextLayout,
     time_factor: f64,
     time: Option<Vec<f64>>,
     command: Vec<f64>,
     position: Vec<f64>,
     extras: Vec<Option<Vec<f64>>>,
     row_lines: Vec<usize>,
-    fields: Vec<String>,
-    col_name: &'n dyn Fn(usize) -> String,
 }
 
 impl Rows<'_, '_> {
-    /// Parse one data row: field count, numbers, and the time increasing
-    /// (checked here so that a bad stream stops at once; the other checks of
-    /// [`Recording`] run once everything is read).
+    /// Parse one data row ([`TextLayout::row`]: field count, numbers) and
+    /// check that the time increases (here, so that a bad stream stops at
+    /// once; the other checks of [`Recording`] run once everything is read);
+    /// the extra columns are kept while all their cells are numbers.
     fn push(&mut self, line: &Line<'_>) -> Result<()> {
         let path = self.path;
-        let mut fields: Vec<&str> = Vec::with_capacity(self.ncols);
-        split_checked(line, self.delim, path, &mut fields)?;
-        if fields.len() != self.ncols {
-            let hint = if self.delim == Delim::Byte(b',') && fields.len() > self.ncols {
-                "; if the file uses decimal commas, convert them to decimal points"
-            } else {
-                ""
-            };
-            return Err(Error::Malformed {
-                path: path.to_path_buf(),
-                line: line.no,
-                reason: format!(
-                    "{} fields, expected {} as in line {}{}",
-                    fields.len(),
-                    self.ncols,
-                    self.reference_line,
-                    hint
-                ),
-            });
-        }
-        let col_name = self.col_name;
-        let delim = self.delim;
-        let cell = |c: usize| -> Result<f64> {
-            let text = fields.get(c).copied().unwrap_or("");
-            parse_number(text).ok_or_else(|| Error::BadNumber {
-                path: path.to_path_buf(),
-                line: line.no,
-                column: col_name(c),
-                text: short_text(text),
-                hint: decimal_comma_hint(text, delim),
-            })
-        };
-        if let (Some(t), Some(c)) = (self.time.as_mut(), self.time_col) {
-            let v = cell(c)?;
+        let row = self.layout.row(line, path)?;
+        if let (Some(t), Some(v), Some(c)) = (self.time.as_mut(), row.time, self.layout.time_col) {
             if let Some(&prev) = t.last() {
                 if v.is_finite() && prev.is_finite() && v <= prev {
                     return Err(in_file(
                         path,
-                        format!("line {}, column `{}`", line.no, col_name(c)),
+                        format!("line {}, column `{}`", line.no, self.layout.col_name(c)),
                         Error::NonMonotoneTime {
                             index: t.len(),
                             previous: prev * self.time_factor,
@@ -392,24 +296,27 @@ impl Rows<'_, '_> {
             }
             t.push(v);
         }
-        self.command.push(cell(self.cmd_col)?);
-        self.position.push(cell(self.pos_col)?);
-        for (c, slot) in self.extras.iter_mut().enumerate() {
-            if let Some(v) = slot {
-                match fields.get(c).and_then(|s| parse_number(s)) {
-                    Some(x) if crate::recording::is_usable(x) => v.push(x),
-                    _ => *slot = None,
+        self.command.push(row.command);
+        self.position.push(row.position);
+        if self.extras.iter().any(Option::is_some) {
+            let mut fields: Vec<&str> = Vec::with_capacity(self.layout.ncols);
+            split_checked(line, self.layout.delim, path, &mut fields)?;
+            for (c, slot) in self.extras.iter_mut().enumerate() {
+                if let Some(v) = slot {
+                    match fields.get(c).and_then(|s| parse_number(s)) {
+                        Some(x) if crate::recording::is_usable(x) => v.push(x),
+                        _ => *slot = None,
+                    }
                 }
             }
         }
         self.row_lines.push(line.no);
-        let _ = &self.fields;
         Ok(())
     }
 }
 
 /// Pick the delimiter (see the module doc).
-fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
+pub(super) fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
     const CANDIDATES: [Delim; 4] = [
         Delim::Byte(b'\t'),
         Delim::Byte(b';'),
@@ -452,7 +359,12 @@ fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
 }
 
 /// Split a line, mapping quote errors to [`Error::Malformed`].
-fn split_checked<'a>(line: &Line<'a>, d: Delim, path: &Path, out: &mut Vec<&'a str>) -> Result<()> {
+pub(super) fn split_checked<'a>(
+    line: &Line<'a>,
+    d: Delim,
+    path: &Path,
+    out: &mut Vec<&'a str>,
+) -> Result<()> {
     split_fields(line.text, d, out).map_err(|reason| Error::Malformed {
         path: path.to_path_buf(),
         line: line.no,
@@ -467,10 +379,19 @@ fn split_fields<'a>(
     out: &mut Vec<&'a str>,
 ) -> std::result::Result<(), &'static str> {
     out.clear();
+    for_each_field(line, d, |f| out.push(f))
+}
+
+/// Call `field` with each trimmed field of `line` in order (see [`split_fields`]).
+pub(super) fn for_each_field<'a>(
+    line: &'a str,
+    d: Delim,
+    mut field: impl FnMut(&'a str),
+) -> std::result::Result<(), &'static str> {
     let delim = match d {
         Delim::Whitespace => {
             for f in line.split_whitespace() {
-                out.push(unquote(f));
+                field(unquote(f));
             }
             return Ok(());
         }
@@ -488,7 +409,7 @@ fn split_fields<'a>(
             let Some(len) = bytes[start..].iter().position(|&b| b == b'"') else {
                 return Err("unterminated quoted field");
             };
-            out.push(line.get(start..start + len).unwrap_or(""));
+            field(line.get(start..start + len).unwrap_or(""));
             i = start + len + 1;
             while i < bytes.len() && is_space(bytes[i]) {
                 i += 1;
@@ -505,7 +426,7 @@ fn split_fields<'a>(
                 .iter()
                 .position(|&b| b == delim)
                 .map_or(bytes.len(), |p| i + p);
-            out.push(line.get(i..end).unwrap_or("").trim());
+            field(line.get(i..end).unwrap_or("").trim());
             if end >= bytes.len() {
                 return Ok(());
             }
@@ -521,12 +442,12 @@ fn unquote(f: &str) -> &str {
 }
 
 /// Strict number parse (trimmed Rust `f64` syntax).
-fn parse_number(s: &str) -> Option<f64> {
+pub(super) fn parse_number(s: &str) -> Option<f64> {
     s.trim().parse::<f64>().ok()
 }
 
 /// A number, or a number written with a decimal comma (for header detection).
-fn number_like(s: &str) -> bool {
+pub(super) fn number_like(s: &str) -> bool {
     parse_number(s).is_some() || looks_decimal_comma(s)
 }
 
@@ -540,7 +461,7 @@ fn looks_decimal_comma(s: &str) -> bool {
 ///
 /// With `,` as delimiter, decimal commas in a whitespace-separated file show up
 /// as cells like `5 1` (the tail of one number and the head of the next).
-fn decimal_comma_hint(text: &str, d: Delim) -> &'static str {
+pub(super) fn decimal_comma_hint(text: &str, d: Delim) -> &'static str {
     if looks_decimal_comma(text) || (d == Delim::Byte(b',') && split_number(text)) {
         DECIMAL_COMMA_HINT
     } else {
@@ -558,7 +479,7 @@ fn split_number(text: &str) -> bool {
 /// Find a column by name (exact, else case-insensitive) or 1-based index.
 /// A name that several columns carry is refused (never the first taken
 /// silently); `role` (`time`, `command`, `position`) names the choice.
-fn resolve_column(
+pub(super) fn resolve_column(
     r: &ChannelRef,
     header: Option<&[String]>,
     ncols: usize,

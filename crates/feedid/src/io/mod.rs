@@ -1,16 +1,20 @@
 //! Reading recordings from CSV/text and MATLAB v5 files ([`read_recording`]
 //! dispatches), the options that pick columns and units ([`ReadOptions`]),
-//! the summary a user checks before identifying ([`recording_info`]), and
-//! writing results without destroying anything or leaving partial files
-//! ([`OutputSet`], [`write_atomic`]), and the CSV tables of results.
+//! the summary a user checks before identifying ([`recording_info`]), a
+//! live text stream read line by line with the same options
+//! ([`StreamReader`]), and writing results without destroying anything or
+//! leaving partial files ([`OutputSet`], [`write_atomic`]), and the CSV
+//! tables of results.
 
 mod csv;
 mod info;
+mod layout;
 mod mat;
 mod options;
 mod output;
 mod read;
 mod source;
+mod stream;
 mod table;
 
 pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
@@ -29,4 +33,7 @@ pub use self::output::{
 };
 pub use self::read::{read_recording, read_recording_from_bytes};
 pub use self::source::{read_small_text, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES};
+pub use self::stream::{
+    PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,
+};
 pub use self::table::{cell, write_coefficients_csv, write_predictions_csv, CoefficientRow};

@@ -17,7 +17,7 @@
 
 use std::fs::File;
 use std::io::{BufRead, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 
@@ -110,9 +110,10 @@ pub fn read_small_text(path: &Path) -> Result<String> {
 }
 
 /// Lines of a text input with bounded memory (see the module doc).
-pub(crate) struct LineReader<'p, R> {
+#[derive(Debug)]
+pub(crate) struct LineReader<R> {
     inner: R,
-    path: &'p Path,
+    path: PathBuf,
     buf: Vec<u8>,
     /// 1-based number of the last line returned.
     line: usize,
@@ -124,12 +125,12 @@ pub(crate) struct LineReader<'p, R> {
     done: bool,
 }
 
-impl<'p, R: BufRead> LineReader<'p, R> {
+impl<R: BufRead> LineReader<R> {
     /// Lines of `inner`; at most `limit` bytes are read (`None`: no limit).
-    pub(crate) fn new(inner: R, path: &'p Path, limit: Option<u64>) -> Self {
+    pub(crate) fn new(inner: R, path: &Path, limit: Option<u64>) -> Self {
         Self {
             inner,
-            path,
+            path: path.to_path_buf(),
             buf: Vec::new(),
             line: 0,
             after_cr: false,
@@ -141,7 +142,7 @@ impl<'p, R: BufRead> LineReader<'p, R> {
 
     fn malformed(&self, line: usize, reason: String) -> Error {
         Error::Malformed {
-            path: self.path.to_path_buf(),
+            path: self.path.clone(),
             line,
             reason,
         }
@@ -152,7 +153,7 @@ impl<'p, R: BufRead> LineReader<'p, R> {
         self.total += n as u64;
         match self.limit {
             Some(limit) if self.total > limit => Err(Error::InputTooLarge {
-                path: self.path.to_path_buf(),
+                path: self.path.clone(),
                 limit,
             }),
             _ => Ok(()),
@@ -195,6 +196,78 @@ impl<'p, R: BufRead> LineReader<'p, R> {
         }
     }
 
+    /// For a live stream, where one bad line must not end the input: the
+    /// next line that is neither blank nor a comment, as
+    /// [`LineReader::next_content_line`], or the error of an unusable line
+    /// (longer than [`MAX_LINE_BYTES`], a NUL byte, invalid UTF-8) once the
+    /// rest of it has been skipped. The outer error (reading failed, the byte
+    /// limit) is fatal.
+    pub(crate) fn next_content_line_or_skip(
+        &mut self,
+    ) -> Result<Option<(usize, std::result::Result<&str, Error>)>> {
+        loop {
+            let no = self.line + 1;
+            match self.read_raw() {
+                Ok(None) => return Ok(None),
+                Ok(Some(no)) => {
+                    let usable = match self.checked_text(no) {
+                        Err(e) => return Ok(Some((no, Err(e)))),
+                        Ok(t) => {
+                            let t = t.trim();
+                            let t = if no == 1 {
+                                t.strip_prefix('\u{feff}').unwrap_or(t).trim()
+                            } else {
+                                t
+                            };
+                            !(t.is_empty() || t.starts_with('#'))
+                        }
+                    };
+                    if usable {
+                        let text = self.checked_text(no)?;
+                        let text = if no == 1 {
+                            text.strip_prefix('\u{feff}').unwrap_or(text)
+                        } else {
+                            text
+                        };
+                        return Ok(Some((no, Ok(text))));
+                    }
+                }
+                Err(e @ Error::Malformed { .. }) => {
+                    self.skip_rest_of_line()?;
+                    self.line = no;
+                    return Ok(Some((no, Err(e))));
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// Consume the input up to and including the next line end (after a
+    /// line that was refused part way).
+    fn skip_rest_of_line(&mut self) -> Result<()> {
+        loop {
+            let chunk = match self.inner.fill_buf() {
+                Ok(c) => c,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(io_error(&self.path, e)),
+            };
+            if chunk.is_empty() {
+                self.done = true;
+                return Ok(());
+            }
+            match chunk.iter().position(|&b| b == b'\n' || b == b'\r') {
+                Some(i) => {
+                    self.after_cr = chunk[i] == b'\r';
+                    return self.consume(i + 1);
+                }
+                None => {
+                    let n = chunk.len();
+                    self.consume(n)?;
+                }
+            }
+        }
+    }
+
     /// The line in the buffer as text, or an error naming line `no`.
     fn checked_text(&self, no: usize) -> Result<&str> {
         std::str::from_utf8(&self.buf).map_err(|e| {
@@ -219,7 +292,7 @@ impl<'p, R: BufRead> LineReader<'p, R> {
             let chunk = match self.inner.fill_buf() {
                 Ok(c) => c,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                Err(e) => return Err(io_error(self.path, e)),
+                Err(e) => return Err(io_error(&self.path, e)),
             };
             if chunk.is_empty() {
                 self.done = true;
@@ -344,6 +417,30 @@ mod tests {
             .next_line()
             .unwrap_err();
         assert!(e.to_string().contains("NUL byte at byte 1"), "{e}");
+    }
+
+    #[test]
+    fn a_live_stream_skips_unusable_lines_and_goes_on() {
+        let mut data = b"a\n\x00b\n\xff\r\n# c\n\n".to_vec();
+        data.extend(std::iter::repeat_n(b'x', MAX_LINE_BYTES + 5000));
+        data.extend_from_slice(b"\r\nd\re");
+        let r = std::io::BufReader::with_capacity(4096, &data[..]);
+        let mut lr = LineReader::new(r, Path::new("stdin"), None);
+        let mut got = Vec::new();
+        while let Some((no, l)) = lr.next_content_line_or_skip().unwrap() {
+            got.push((no, l.map(str::to_string).map_err(|e| e.to_string())));
+        }
+        let numbers: Vec<usize> = got.iter().map(|g| g.0).collect();
+        assert_eq!(numbers, [1, 2, 3, 6, 7, 8], "{got:?}");
+        assert_eq!(got[0].1, Ok("a".to_string()));
+        assert!(got[1].1.as_ref().unwrap_err().contains("NUL"), "{got:?}");
+        assert!(got[2].1.as_ref().unwrap_err().contains("UTF-8"), "{got:?}");
+        assert!(
+            got[3].1.as_ref().unwrap_err().contains("longer than"),
+            "{got:?}"
+        );
+        assert_eq!(got[4].1, Ok("d".to_string()));
+        assert_eq!(got[5].1, Ok("e".to_string()));
     }
 
     #[test]

@@ -131,7 +131,7 @@ def read(
         and position named, and time or ``rate``.
     unit : str
         Unit of command and position in the file: ``m`` (default), ``mm``,
-        ``um``, ``nm``, ``in``, ``counts`` (with ``scale``); converted to metres.
+        ``um``, ``nm``; converted to metres.
     rate : float, optional
         Sampling rate [Hz] for a file without a time column (t_k = k / rate).
     delimiter : str, optional
@@ -139,7 +139,7 @@ def read(
     header : bool, optional
         Whether the first row is a header; default: detected.
     scale : float, optional
-        Metres per unit (``unit="counts"``, or to override a unit).
+        Metres per file unit (encoder counts and the like; overrides ``unit``).
     time_unit : str
         Unit of the time column: ``s`` (default), ``ms``, ``us``.
     jitter_tol : float
@@ -469,8 +469,7 @@ def simulate(
     Parameters
     ----------
     scenario : str
-        ``step``, ``ramp``, ``multisine``, ``chirp``, ``prbs``, ``square``,
-        ``scurve``, ``contour``, ``point-to-point``, ...
+        ``ramp``, ``step``, ``scurve``, ``chirp``, ``prbs``, ``multisine``.
     seed : int
         Random seed of the command and the measurement noise (default 1;
         ``feedid simulate``'s is 0: give it to compare).

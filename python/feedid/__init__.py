@@ -285,6 +285,9 @@ def identify(
     params: Params = None,
     allow_unstable: bool = False,
     jitter_tol: float = 0.01,
+    nominal: bool = True,
+    global_model: bool = True,
+    residuals: bool = True,
     **options: Any,
 ) -> Identification:
     """Identify a recording in short sliding windows and predict the next
@@ -319,6 +322,15 @@ def identify(
         Use an unstable nominal model anyway (default False: refused).
     jitter_tol : float
         Sampling jitter tolerance of arrays (relative; default 0.01).
+    nominal, global_model, residuals : bool
+        What ``feedid identify`` computes beside the sliding predictions
+        (default True, all three): the nominal model's simulation (the
+        summary's ``sim_*`` and ``nominal_fit_percent``, ``simulated``), the
+        method's global model and its free-run fit (``global_model``,
+        ``global_fit_percent``, ``model``), the residual analysis
+        (``residuals``). On long recordings they cost several times the
+        sliding identification (README, "Python"): False leaves them out
+        and their keys out of the summary.
     **options
         Method options: ``solver``, ``time_origin``, ``prediction`` (paper),
         ``lambda`` (rls forgetting factor), ``tolerance`` (auto, [µm]).
@@ -353,6 +365,9 @@ def identify(
         horizon=horizon,
         hop=hop,
         allow_unstable=allow_unstable,
+        nominal=nominal,
+        global_model=global_model,
+        residuals=residuals,
         **_params(params),
         **_method_options(order, options),
     )

@@ -108,6 +108,9 @@ def identify(
     params_path: Optional[str] = None,
     params_json: Optional[str] = None,
     allow_unstable: bool = False,
+    nominal: bool = True,
+    global_model: bool = True,
+    residuals: bool = True,
 ) -> Dict[str, Any]: ...
 def simulate(
     scenario: str,

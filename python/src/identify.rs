@@ -4,7 +4,7 @@
 //! fitted for the summary) with the GIL released, its arrays handed to NumPy
 //! without copies.
 
-use feedid::ident::OrderSearch;
+use feedid::ident::{OrderSearch, RESIDUAL_LAGS};
 use feedid::pipeline::Pipeline;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -22,7 +22,8 @@ use crate::recording::PyRecording;
 #[pyfunction]
 #[pyo3(signature = (recording, *, method = "auto", window = None, horizon = 10, hop = None,
     order = None, solver = None, time_origin = None, prediction = None, lambda_ = None,
-    tolerance = None, params_path = None, params_json = None, allow_unstable = false))]
+    tolerance = None, params_path = None, params_json = None, allow_unstable = false,
+    nominal = true, global_model = true, residuals = true))]
 #[allow(clippy::too_many_arguments)]
 pub fn identify<'py>(
     py: Python<'py>,
@@ -40,6 +41,9 @@ pub fn identify<'py>(
     params_path: Option<String>,
     params_json: Option<String>,
     allow_unstable: bool,
+    nominal: bool,
+    global_model: bool,
+    residuals: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = MethodOptions {
         order,
@@ -63,7 +67,11 @@ pub fn identify<'py>(
                 .window_or_default(window)
                 .horizon(horizon)
                 .hop(hop)
-                .nominal(params);
+                .method_global_model(global_model)
+                .residuals(if residuals { Some(RESIDUAL_LAGS) } else { None });
+            if nominal {
+                pipeline = pipeline.nominal(params);
+            }
             if select {
                 pipeline = pipeline.select_orders(OrderSearch::default());
             }

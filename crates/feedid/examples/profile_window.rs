@@ -9,9 +9,9 @@
 //! callgrind_annotate cg.out | head -40
 //! ```
 //!
-//! Arguments: a method name (`arx`, `oe`, `rls`, `auto`, `paper`,
-//! `paper-simplex`, `paper-simplex-previous`, `paper-motion`,
-//! `paper-motion-simplex`) and a repetition count. The workload is the
+//! Arguments: a method name (`arx`, `oe`, `rls`, `auto`, `paper` (QR,
+//! motion origin: the defaults), `paper-window` (window origin),
+//! `paper-simplex`, `paper-simplex-previous`) and a repetition count. The workload is the
 //! benches' (`benches/methods.rs`, `benches/paper_window.rs`): the virtual
 //! rig's chirp (1 s at 5 kHz, seed 1) through the sliding engine with the
 //! method's default window, H = 10, hop 10; the paper variants on the ramp
@@ -20,7 +20,7 @@
 
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::engine::run;
-use feedid::ident::{EngineConfig, Method, PaperConfig, Solver, TimeOrigin};
+use feedid::ident::{EngineConfig, Method, PaperConfig, SimplexStart, Solver, TimeOrigin};
 use feedid::signal::Scenario;
 use feedid::Recording;
 
@@ -42,9 +42,10 @@ fn main() -> feedid::Result<()> {
         if rest.contains("simplex") {
             cfg.solver = Solver::Simplex;
         }
-        if rest.contains("motion") {
-            cfg.time_origin = TimeOrigin::Motion;
-        } else {
+        if rest.contains("previous") {
+            cfg.simplex_start = SimplexStart::Previous;
+        }
+        if rest.contains("window") {
             cfg.time_origin = TimeOrigin::Window;
         }
         (Method::Paper(cfg), recording(Scenario::Ramp, 0.8)?)

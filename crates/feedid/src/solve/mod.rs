@@ -14,6 +14,7 @@ pub(crate) use hessenberg::lstsq_hessenberg_view;
 pub use hessenberg::{hessenberg_condition, lstsq_hessenberg, HessenbergInfo, HessenbergWorkspace};
 pub use lm::{LevenbergMarquardt, LmConfig, LmReport};
 pub use nelder_mead::{nelder_mead, NelderMead, NelderMeadConfig, NelderMeadReport};
+pub(crate) use qr::lstsq_fixed;
 pub use qr::{
     lstsq, lstsq_in_place, lstsq_with, LstsqInfo, LstsqOptions, LstsqSolution, QrWorkspace,
 };

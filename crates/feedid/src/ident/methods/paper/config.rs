@@ -281,8 +281,16 @@ impl PaperConfig {
     }
 
     /// Check the simplex settings (finite non-negative tolerances, positive
-    /// start step, iteration and evaluation caps of at least 1).
+    /// start step, iteration and evaluation caps of at least 1; a simplex
+    /// start other than zeros only with the simplex solver).
     pub fn validate(&self) -> Result<()> {
+        if self.simplex_start != SimplexStart::Zeros && self.solver != Solver::Simplex {
+            return Err(Error::NotApplicable {
+                setting: "simplex start",
+                method: "paper (qr solver)",
+                applies_to: "paper with the simplex solver",
+            });
+        }
         let s = &self.simplex;
         for (name, v) in [
             ("simplex.xtol_data", s.xtol_data),

@@ -29,7 +29,8 @@
 //!
 //! The report gives the final residual norm; the workspace keeps the
 //! residuals and the Jacobian at the returned parameters
-//! ([`LevenbergMarquardt::jacobian`]) for standard errors.
+//! ([`LevenbergMarquardt::jacobian`]) for standard errors (unless
+//! [`LmConfig::final_jacobian`] is off).
 //!
 //! References: K. Levenberg (1944), D.W. Marquardt (1963); J.J. Moré, "The
 //! Levenberg–Marquardt algorithm: implementation and theory", LNM 630 (1978);
@@ -54,6 +55,12 @@ pub struct LmConfig {
     pub initial_damping: f64,
     /// Relative forward-difference step `√ε_fd`. Default `√ε ≈ 1.49e-8`.
     pub fd_step: f64,
+    /// Evaluate the Jacobian at the returned parameters when the last
+    /// accepted step moved them (for standard errors,
+    /// [`LevenbergMarquardt::jacobian`]); default true. `false` saves `n`
+    /// residual evaluations (forward differences) per run and leaves the
+    /// Jacobian of the last iteration in the workspace.
+    pub final_jacobian: bool,
 }
 
 impl Default for LmConfig {
@@ -65,6 +72,7 @@ impl Default for LmConfig {
             max_iterations: 200,
             initial_damping: 1e-3,
             fd_step: f64::EPSILON.sqrt(),
+            final_jacobian: true,
         }
     }
 }
@@ -378,7 +386,7 @@ impl LevenbergMarquardt {
                 }
             }
         };
-        if !self.jac_at_p {
+        if !self.jac_at_p && config.final_jacobian {
             // refresh the Jacobian at the returned parameters
             match jacobian.as_mut() {
                 Some(jf) => jf(p, &mut self.jac),

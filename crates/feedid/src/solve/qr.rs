@@ -189,14 +189,24 @@ pub fn lstsq_in_place(
         Some(t) => t,
         None => m.max(n) as f64 * f64::EPSILON,
     };
-    if let Some((i, &v)) = a.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+    if !all_finite(a) {
+        let (i, &v) = a
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite())
+            .unwrap_or((0, &f64::NAN));
         return Err(Error::NonFinite {
             channel: "least-squares matrix".to_string(),
             index: i,
             value: v,
         });
     }
-    if let Some((i, &v)) = b.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+    if !all_finite(b) {
+        let (i, &v) = b
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite())
+            .unwrap_or((0, &f64::NAN));
         return Err(Error::NonFinite {
             channel: "least-squares right-hand side".to_string(),
             index: i,
@@ -622,6 +632,21 @@ pub(crate) fn lstsq_fixed<const M: usize, const N: usize>(
 fn split_cols(a: &mut [f64], m: usize, k: usize, j: usize) -> (&[f64], &mut [f64]) {
     let (left, right) = a.split_at_mut(j * m);
     (&left[k * m..(k + 1) * m], &mut right[..m])
+}
+
+/// Whether every element is finite: four partial sums of `v·0` (NaN exactly
+/// when some `v` is NaN or infinite), vectorisable.
+#[inline]
+fn all_finite(v: &[f64]) -> bool {
+    let mut acc = [0.0f64; 4];
+    let chunks = v.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().map(|x| x * 0.0).sum();
+    for c in chunks {
+        for (a, x) in acc.iter_mut().zip(c) {
+            *a += x * 0.0;
+        }
+    }
+    (acc[0] + acc[1] + acc[2] + acc[3] + rest) == 0.0
 }
 
 /// Dot product with four partial sums (independent dependency chains).

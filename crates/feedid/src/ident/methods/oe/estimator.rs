@@ -78,7 +78,9 @@ use std::ops::Range;
 
 use nalgebra::{Complex, DMatrix};
 
-use super::companion::{is_hurwitz, output, reflect_unstable, Companion, MAX_ORDER};
+use super::companion::{
+    is_hurwitz, output, reflect_unstable, window_responses, Companion, MAX_ORDER,
+};
 use super::srivc::srivc;
 use crate::error::{Error, Result};
 use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
@@ -578,8 +580,6 @@ struct WindowWork {
     rhs: Vec<f64>,
     x0: Vec<f64>,
     x: Vec<f64>,
-    row: Vec<f64>,
-    row_next: Vec<f64>,
     qr: QrWorkspace,
 }
 
@@ -593,8 +593,6 @@ impl WindowWork {
             rhs: Vec::new(),
             x0: vec![0.0; n],
             x: vec![0.0; n],
-            row: vec![0.0; n],
-            row_next: vec![0.0; n],
             qr: QrWorkspace::new(n),
         }
     }
@@ -624,30 +622,16 @@ impl WindowWork {
         let w = u.len();
         self.comp.discretize(&theta[..n], h)?;
         let beta = &theta[n..];
-        self.x.fill(0.0);
-        for (f, &uk) in self.forced.iter_mut().zip(u) {
-            *f = output(beta, &self.x);
-            self.comp.step_zoh(&mut self.x, uk);
-        }
-        // o_0 = C (c_i = β_i), o_{k+1} = o_k·A_d
-        let mb = beta.len();
-        self.row.fill(0.0);
-        for (i, b) in beta.iter().enumerate() {
-            self.row[mb - 1 - i] = *b;
-        }
-        let ad = self.comp.ad();
-        for k in 0..w {
-            for j in 0..n {
-                self.obs[k + j * w] = self.row[j];
-            }
-            for j in 0..n {
-                self.row_next[j] = (0..n).map(|i| self.row[i] * ad[(i, j)]).sum();
-            }
-            std::mem::swap(&mut self.row, &mut self.row_next);
-        }
-        for ((rh, yk), f) in self.rhs.iter_mut().zip(y).zip(&self.forced) {
-            *rh = yk - f;
-        }
+        // forced response, observability rows C·A_dᵏ, y − forced
+        window_responses(
+            &self.comp,
+            beta,
+            u,
+            y,
+            &mut self.forced,
+            &mut self.obs,
+            &mut self.rhs,
+        );
         self.obs_qr.copy_from_slice(&self.obs);
         if lstsq_in_place(
             w,
@@ -826,7 +810,11 @@ impl Estimator for OeEstimator {
             } else {
                 self.config.window_iterations
             };
-            let cfg = lm_config(&self.config, iters);
+            // the window fit needs no Jacobian at its result (no standard errors)
+            let cfg = LmConfig {
+                final_jacobian: false,
+                ..lm_config(&self.config, iters)
+            };
             let res = lm.minimize(
                 |th: &[f64], r: &mut [f64]| {
                     let (rd, rp) = r.split_at_mut(w);

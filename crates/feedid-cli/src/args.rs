@@ -38,6 +38,8 @@ pub enum Command {
     Greybox(Box<GreyboxArgs>),
     /// Compute the command that makes the predicted position follow a desired trajectory.
     Compensate(Box<CompensateArgs>),
+    /// List the drive zoo (generated recordings of many drives) or write its members as CSV.
+    Zoo(crate::cmd::zoo::ZooArgs),
 }
 
 /// Which D1 coefficient to use.

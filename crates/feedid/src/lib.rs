@@ -7,7 +7,8 @@
 //! and the sliding prediction engine ([`ident`]), one identification run end
 //! to end ([`pipeline`]), solvers ([`solve`]) and file input ([`io`]);
 //! physical parameters from data ([`greybox`]) and model-based compensation
-//! of the command ([`compensate`]).
+//! of the command ([`compensate`]); the drive zoo, a generated family of
+//! recordings to benchmark on ([`zoo`]).
 //!
 //! Figures and HTML reports are in the separate crate `feedid-report`, so
 //! this numerical core builds without a plotting library.
@@ -33,6 +34,7 @@ pub mod recording;
 pub mod signal;
 pub mod solve;
 pub mod stats;
+pub mod zoo;
 
 pub use error::{Error, Result};
 pub use pipeline::Pipeline;

@@ -59,6 +59,7 @@ fn low_layers_import_nothing_from_higher_ones() {
     let everything_above = [
         "recording",
         "drive",
+        "zoo",
         "ident",
         "pipeline",
         "io",
@@ -78,6 +79,7 @@ fn low_layers_import_nothing_from_higher_ones() {
         &["recording.rs"],
         &[
             "drive",
+            "zoo",
             "ident",
             "pipeline",
             "io",
@@ -88,6 +90,18 @@ fn low_layers_import_nothing_from_higher_ones() {
     );
     assert_below(
         &["drive"],
+        &[
+            "zoo",
+            "ident",
+            "pipeline",
+            "io",
+            "greybox",
+            "compensate",
+            "experiment",
+        ],
+    );
+    assert_below(
+        &["zoo"],
         &[
             "ident",
             "pipeline",
@@ -101,6 +115,7 @@ fn low_layers_import_nothing_from_higher_ones() {
         &["ident"],
         &[
             "drive",
+            "zoo",
             "pipeline",
             "io",
             "greybox",

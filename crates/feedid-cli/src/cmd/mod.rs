@@ -15,6 +15,7 @@ mod compensate;
 mod greybox;
 mod report;
 mod sweep;
+pub(crate) mod zoo;
 
 use std::path::{Path, PathBuf};
 
@@ -34,6 +35,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sweep(a) => sweep::run(&a),
         Command::Greybox(a) => greybox::run(&a),
         Command::Compensate(a) => compensate::run(&a),
+        Command::Zoo(a) => zoo::run(&a),
     }
 }
 

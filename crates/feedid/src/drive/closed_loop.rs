@@ -34,6 +34,36 @@
 //! D0 = N0                                        (unit DC gain)
 //! ```
 //!
+//! # Feed-forward
+//!
+//! With velocity and acceleration feed-forward (`control.kvff`, `control.kaff`,
+//! both 0 in the paper's cascade) the references become
+//!
+//! ```text
+//! v_c   = Kv·(x_s − x_a) + kvff·ẋ_s                          [m/s]
+//! i_ref = Kp·(e_v + Ki·z_v) + c_a·ẍ_s,   c_a = kaff·(J + M·r²)/(r·Kt)   [A]
+//! ```
+//!
+//! The poles stay those of `D(s)`; the numerator gains the feed-forward paths
+//! (the velocity reference reaches `x_a` through `N(s)/(Kv·D(s))`, the current
+//! reference through `K·Kpi·Kt·r·s·(s + Kii)/D(s)`):
+//!
+//! ```text
+//! N(s) = G·(Kv + kvff·s)·(s + Ki)·(s + Kii) + H·s³·(s + Kii),
+//! G = K·Kp·Kpi·Kt·r,   H = K·Kpi·kaff·(J + M·r²)
+//! F4 = H,  F3 = H·Kii + G·kvff,  F2 = G·kvff·(Ki + Kii),  F1 = G·kvff·Ki·Kii
+//! ```
+//!
+//! added to `[N4 … N0] = [0, 0, N2, N1, N0]`. The ramp following error
+//! `(D1 − N1 − F1)/D0` becomes `(1 − kvff)/Kv`.
+//!
+//! The state-space model realises the same transfer function with the command
+//! alone as input: with `ẋ = A·x + b₀·x_s + b₁·ẋ_s + b₂·ẍ_s` (b₁ = kvff·b_v,
+//! b₂ = c_a·b_i, b_v and b_i the entries of the velocity and current references)
+//! the state `z = x − b₂·ẋ_s − (A·b₂ + b₁)·x_s` obeys `ż = A·z + g·x_s` with
+//! `g = b₀ + A·b₁ + A²·b₂`, and `x_a` is the same in both (`C·b₁ = C·b₂ = C·A·b₂ = 0`).
+//! Without feed-forward `z = x` (the physical states).
+//!
 //! The paper prints `D1 = K1²·Kt·Kp·Kii·Ki·K·Kpi`, which lacks the term `+N1`.
 //! With it the ramp following error `(D1 − N1)/D0` is `1/Kv − 1/Ki − 1/Kii`
 //! (negative for real gains) instead of `1/Kv`; it is available as
@@ -65,16 +95,33 @@ pub enum D1Variant {
 /// Coefficients of `Xa/Xs` in descending powers of s, normalised so `D7 = J·L·M`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClosedLoopCoefficients {
-    /// `[N2, N1, N0]`.
+    /// `[N2, N1, N0]` of the position-feedback path: the paper's numerator,
+    /// the whole numerator without feed-forward.
     pub num: [f64; 3],
     /// `[D7, D6, …, D0]`.
     pub den: [f64; 8],
+    /// Terms `[F4, F3, F2, F1]` the feed-forward adds to the numerator (see
+    /// the module doc); all 0 without feed-forward.
+    pub feed_forward: [f64; 4],
 }
 
 impl ClosedLoopCoefficients {
-    /// Steady ramp following error per unit command velocity, `(D1 − N1)/D0` \[s\].
+    /// The whole numerator `[N4, N3, N2, N1, N0]` (feedback plus feed-forward).
+    pub fn numerator(&self) -> [f64; 5] {
+        let f = &self.feed_forward;
+        [
+            f[0],
+            f[1],
+            self.num[0] + f[2],
+            self.num[1] + f[3],
+            self.num[2],
+        ]
+    }
+
+    /// Steady ramp following error per unit command velocity,
+    /// `(D1 − N1 − F1)/D0` \[s\] (= `(1 − kvff)/Kv`).
     pub fn following_error_per_velocity(&self) -> f64 {
-        (self.den[6] - self.num[1]) / self.den[7]
+        (self.den[6] - self.numerator()[3]) / self.den[7]
     }
 
     /// DC gain `N0/D0`.
@@ -82,9 +129,10 @@ impl ClosedLoopCoefficients {
         self.num[2] / self.den[7]
     }
 
-    /// The coefficients as a transfer function.
+    /// The coefficients as a transfer function (leading zero coefficients
+    /// dropped: 2nd over 7th order without feed-forward).
     pub fn transfer_function(&self) -> Result<TransferFunction> {
-        TransferFunction::new(self.num.to_vec(), self.den.to_vec())
+        TransferFunction::new(self.numerator().to_vec(), self.den.to_vec())
     }
 }
 
@@ -156,16 +204,26 @@ pub fn closed_loop_coefficients_with_stiffness(
         D1Variant::PaperPrinted => k * kp * kpi * kt * r * ki * kii,
     };
     let d0 = n0;
+    let (kvff, kaff) = (g.kvff, g.kaff);
+    let gain = k * kp * kpi * kt * r;
+    let h = k * kpi * kaff * (j + m * r2);
     ClosedLoopCoefficients {
         num: [n2, n1, n0],
         den: [d7, d6, d5, d4, d3, d2, d1, d0],
+        feed_forward: [
+            h,
+            h * kii + gain * kvff,
+            gain * kvff * (ki + kii),
+            gain * kvff * ki * kii,
+        ],
     }
 }
 
 /// The cascade as a 7-state state-space model at stiffness `params.stiffness_k()`.
 ///
 /// States `[z_v, z_i, i, θ, ω, x_a, v_a]` in SI units, input `x_s` \[m\],
-/// output `x_a` \[m\].
+/// output `x_a` \[m\]; with feed-forward the states are shifted by input
+/// terms (`z` of the module doc), the output is unchanged.
 pub fn closed_loop_state_space(params: &RigParams) -> Result<StateSpace> {
     closed_loop_state_space_with_stiffness(params, params.stiffness_k())
 }
@@ -223,6 +281,19 @@ pub fn closed_loop_state_space_with_stiffness(params: &RigParams, k: f64) -> Res
     a[(VA, XA)] = -k / m;
     a[(VA, VA)] = -c2 / m;
 
+    if g.kvff != 0.0 || g.kaff != 0.0 {
+        // g = b₀ + A·b₁ + A²·b₂ (module doc): b₁ = kvff·b_v, b₂ = c_a·b_i
+        let mut b1 = DVector::<f64>::zeros(7);
+        b1[ZV] = g.kvff;
+        b1[ZI] = g.kvff * kp;
+        b1[I] = g.kvff * kpi * kp / l;
+        let mut b2 = DVector::<f64>::zeros(7);
+        let ca = params.acceleration_feed_forward_gain();
+        b2[ZI] = ca;
+        b2[I] = ca * kpi / l;
+        let ab2 = &a * &b2;
+        b += &a * (b1 + ab2);
+    }
     let mut c = RowDVector::<f64>::zeros(7);
     c[XA] = 1.0;
     StateSpace::new(a, b, c, 0.0)
@@ -316,6 +387,66 @@ mod tests {
             p.damping.c2 *= 2.0;
             p.table.mass *= 0.7;
             p.geometry.nut_position *= 0.5;
+        }
+    }
+
+    #[test]
+    fn feed_forward_coefficients_equal_state_space_conversion_and_keep_the_poles() {
+        for (kvff, kaff, degree) in [(0.9, 0.0, 3), (0.0, 0.7, 4), (1.0, 1.0, 4)] {
+            let mut p = RigParams::default();
+            p.control.kvff = kvff;
+            p.control.kaff = kaff;
+            p.table.mass = 40.0;
+            let c = closed_loop_coefficients(&p, D1Variant::Corrected);
+            let plain = {
+                let mut q = p;
+                q.control.kvff = 0.0;
+                q.control.kaff = 0.0;
+                closed_loop_coefficients(&q, D1Variant::Corrected)
+            };
+            assert_eq!(c.den, plain.den, "feed-forward moves no pole");
+            assert_eq!(c.num, plain.num);
+            let tf = closed_loop_state_space(&p).unwrap().to_tf().unwrap();
+            let scale = c.den[0] / tf.den()[0];
+            for (&got, &want) in tf.den().iter().zip(c.den.iter()) {
+                assert!(rel(got * scale, want) < 1e-9, "{got} vs {want}");
+            }
+            let full = c.numerator();
+            let want = &full[4 - degree..];
+            assert_eq!(tf.num().len(), degree + 1, "{:?}", tf.num());
+            for (&got, &want) in tf.num().iter().zip(want) {
+                assert!(rel(got * scale, want) < 1e-8, "{got} vs {want}");
+            }
+            assert!((c.dc_gain() - 1.0).abs() < 1e-15);
+            let ss = closed_loop_state_space(&p).unwrap();
+            assert!((ss.dc_gain().unwrap() - 1.0).abs() < 1e-9);
+            assert!(
+                rel(
+                    c.following_error_per_velocity(),
+                    (1.0 - kvff) / p.control.kv
+                ) < 1e-9
+                    || kvff == 1.0 && c.following_error_per_velocity().abs() < 1e-12
+            );
+        }
+    }
+
+    #[test]
+    fn feed_forward_numerator_is_the_closed_form_product() {
+        // N(s) = G·(Kv + kvff·s)·(s + Ki)·(s + Kii) + H·s³·(s + Kii)
+        let mut p = RigParams::default();
+        p.control.kvff = 0.8;
+        p.control.kaff = 0.6;
+        let c = closed_loop_coefficients(&p, D1Variant::Corrected);
+        let g = &p.control;
+        let r = p.r();
+        let gain = p.stiffness_k() * g.kp * g.kpi * p.motor.kt * r;
+        let h = p.stiffness_k() * g.kpi * g.kaff * (p.inertia_j() + p.table.mass * r * r);
+        let n = c.numerator();
+        for s in [-300.0, -17.0, 0.5, 40.0, 2000.0] {
+            let direct =
+                gain * (g.kv + g.kvff * s) * (s + g.ki) * (s + g.kii) + h * s * s * s * (s + g.kii);
+            let poly = n.iter().fold(0.0, |acc, &a| acc * s + a);
+            assert!(rel(poly, direct) < 1e-12, "s = {s}: {poly} vs {direct}");
         }
     }
 

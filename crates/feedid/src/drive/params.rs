@@ -119,6 +119,17 @@ pub struct Control {
     pub kpi: f64,
     /// Current-loop reset rate Kii = 1/Tn \[1/s\]; default 3428.6.
     pub kii: f64,
+    /// Velocity feed-forward gain kvff \[-\] (normally 0 … 1): the command
+    /// velocity `kvff·ẋ_s` is added to the velocity reference,
+    /// `v_c = Kv·(x_s − x_a) + kvff·ẋ_s`; the steady ramp following error
+    /// becomes `(1 − kvff)·v/Kv`. Default 0 (the paper's cascade).
+    pub kvff: f64,
+    /// Acceleration (torque) feed-forward gain kaff \[-\] (normally 0 … 1): the
+    /// current `kaff·(J + M·r²)·ẍ_s/(r·Kt)` \[A\] — the share kaff of the
+    /// current that accelerates the rigid axis (motor, screw and table
+    /// inertia) along the command — is added to the current reference.
+    /// Default 0 (the paper's cascade).
+    pub kaff: f64,
 }
 
 /// All parameters of a feed drive and its cascade controller (SI units).
@@ -216,6 +227,8 @@ impl Default for Control {
             ki: 471.2,
             kpi: 4.398,
             kii: 3428.6,
+            kvff: 0.0,
+            kaff: 0.0,
         }
     }
 }
@@ -279,6 +292,20 @@ impl RigParams {
         )
     }
 
+    /// Inertia of the rigid axis reflected to the table, `J/r² + M` \[kg\]:
+    /// the mass that acceleration feed-forward accelerates.
+    pub fn rigid_mass(&self) -> f64 {
+        let r = self.r();
+        self.inertia_j() / (r * r) + self.table.mass
+    }
+
+    /// Current per command acceleration of the acceleration feed-forward,
+    /// `kaff·(J + M·r²)/(r·Kt)` \[A/(m/s²)\] (0 without it).
+    pub fn acceleration_feed_forward_gain(&self) -> f64 {
+        let r = self.r();
+        self.control.kaff * (self.inertia_j() + self.table.mass * r * r) / (r * self.motor.kt)
+    }
+
     /// Total inertia J (eq. 2) \[kg·m²\].
     pub fn inertia_j(&self) -> f64 {
         total_inertia(
@@ -326,6 +353,18 @@ impl RigParams {
             ("damping.c2", self.damping.c2),
             ("motor.ke", self.motor.ke),
         ];
+        for (name, value) in [
+            ("control.kvff", self.control.kvff),
+            ("control.kaff", self.control.kaff),
+        ] {
+            if !value.is_finite() || !(0.0..=MAX_FEED_FORWARD).contains(&value) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be between 0 and 2 (1 = full feed-forward)",
+                });
+            }
+        }
         for (name, value) in non_negative {
             if !value.is_finite() || value < 0.0 {
                 return Err(Error::InvalidParameter {
@@ -433,7 +472,11 @@ const UNITS_HEADER: &str = "\
 # table: mass [kg]                     damping: c1 [N m s/rad], c2 [N s/m]
 # motor: kt [N m/A], ke [V s/rad], resistance [Ohm], inductance [H]
 # control: kv [1/s], kp [A/(m/s)], ki [1/s], kpi [V/A], kii [1/s] (series PI, reset rates)
+#          kvff, kaff [-]: velocity and acceleration feed-forward (0 = off, 1 = full)
 ";
+
+/// Largest accepted feed-forward gain (`control.kvff`, `control.kaff`): 2.
+pub const MAX_FEED_FORWARD: f64 = 2.0;
 
 /// Collapse a multi-line parser message into one line.
 fn one_line(s: &str) -> String {

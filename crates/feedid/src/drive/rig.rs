@@ -9,18 +9,37 @@
 //! `x_s` \[m\], all zero at `t = 0`:
 //!
 //! ```text
-//! v_c   = Kv·(x_s[k] − x̂_a[k])        held over [t_k, t_k+1)   (sampled P position loop)
+//! v_c   = Kv·(x_s[k] − x̂_a[k]) + kvff·v_s[k]   held over [t_k, t_k+1)   (sampled P position loop)
 //! e_v   = v_c − r·ω
-//! i_ref = sat_I( Kp·(e_v + Ki·z_v) ),        ż_v = e_v + (i_ref − i_ref*)/Kp
+//! i_ref = sat_I( Kp·(e_v + Ki·z_v) + c_a·a_s[k] ),  ż_v = e_v + (i_ref − i_ref*)/Kp
 //! u     = sat_U( Kpi·(i_ref − i + Kii·z_i) ), ż_i = i_ref − i + (u − u*)/Kpi
 //! L·di/dt     = u − R·i − Ke·ω
 //! J·dω/dt     = Kt·i − C1·ω − r·F_s − T_f(ω)
-//! M·dv_a/dt   = F_s − C2·v_a − F_f(v_a),      F_s = K(l)·(r·θ − x_a)
+//! M·dv_a/dt   = F_s − C2·v_a − F_f(v_a),      F_s = K(l)·dz_b(r·θ − x_a)
 //! ```
 //!
 //! (`*` marks the unsaturated value). With every effect off (`sat` = identity,
-//! `T_f = F_f = 0`, `K(l) = K`, `x̂_a = x_a`, P loop continuous) these are
-//! exactly the linear equations of the design notes §1.
+//! `T_f = F_f = 0`, `K(l) = K`, `x̂_a = x_a`, `dz_b` = identity, P loop
+//! continuous) and no feed-forward these are exactly the linear equations of
+//! the design notes §1.
+//!
+//! # Feed-forward
+//!
+//! `control.kvff` and `control.kaff` (both 0 by default: the paper's
+//! cascade) add the command velocity to the velocity reference and the
+//! current that accelerates the rigid axis, `c_a·ẍ_s` with
+//! `c_a = kaff·(J + M·r²)/(r·Kt)`, to the current reference (see
+//! [`crate::drive::closed_loop_coefficients`] for the transfer function). In
+//! the sampled loop the set-point generator supplies them from the command
+//! samples, held over the interval like `v_c`: `v_s[k] = (x_s[k+1] − x_s[k])/Δt`
+//! (the velocity of the coming interval) and `a_s[k] = (v_s[k] − v_s[k−1])/Δt`.
+//! In the continuous modes they are the derivatives of the held or
+//! interpolated command: impulses at the sample instants, applied as the
+//! exact state jumps of the linear cascade (`(A·b₂ + b₁)·Δx_s` for the held
+//! command, `b₂·Δẋ_s` for the interpolated one), so the linear rig is the
+//! exact ZOH / FOH discretisation of the transfer function with feed-forward
+//! (tested to 1e-10 m). The command before the first sample is taken equal to
+//! the first sample (no feed-forward kick at `k = 0`).
 //!
 //! # Effects (each switchable in [`RigEffects`])
 //!
@@ -52,6 +71,19 @@
 //!   [`VirtualRig::seed`] (one draw per sample, so the noise depends on the
 //!   seed only). The noise models the acquisition chain; the control loop does
 //!   not see it.
+//! * **Backlash** (`backlash`, default off): a dead band of total width
+//!   `b = backlash_width` (default 5 µm) between the screw nut and the table,
+//!   `dz_b(δ) = δ − clamp(δ, −b/2, b/2)`: inside the play the screw transmits
+//!   no force and the table coasts on its friction and damping. The position
+//!   loop closes on the table encoder, so the play shows as lost motion at
+//!   reversals; in a stiff loop (the default rig's) the dead band lets the
+//!   axis hunt in a limit cycle of the order of the play even on a steady
+//!   move, as real axes with linear scales and worn screws do.
+//! * **Dead time** (`dead_time` = d samples, default 0): the loop acts on the
+//!   command `d` samples late, `x_s[k − d]` (set-point transport to the drive),
+//!   while the recorded command is `x_s[k]`; the command before the first
+//!   sample is the first sample. The linear response is the delay-free one
+//!   shifted by d samples.
 //! * **Sampled position loop**: see below.
 //!
 //! # Sampling and integration
@@ -123,6 +155,9 @@ use crate::error::{Error, Result};
 
 /// Default upper bound of the integration step \[s\]: 10 µs.
 pub const DEFAULT_MAX_STEP: f64 = 1e-5;
+
+/// Largest accepted dead time \[samples\]: 1e6.
+pub const MAX_DEAD_TIME: usize = 1_000_000;
 
 /// Coulomb + Stribeck friction law `F(v) = (F_c + (F_s − F_c)·exp(−(v/v_s)²))·tanh(v/v_ε)`.
 ///
@@ -218,6 +253,13 @@ pub struct RigEffects {
     /// How the P position loop is closed; default [`PositionLoop::Sampled`],
     /// [`PositionLoop::Continuous`] in [`RigEffects::linear`].
     pub position_loop: PositionLoop,
+    /// Backlash (a dead band in the screw–table connection); default off.
+    pub backlash: bool,
+    /// Total play of the backlash b \[m\]; default 5e-6 (5 µm; worn screws 0 … 20 µm).
+    pub backlash_width: f64,
+    /// Dead time between the recorded set-point and the drive \[samples\]:
+    /// the loop acts on `x_s[k − d]`; default 0 (off).
+    pub dead_time: usize,
 }
 
 /// How the P position loop is closed (see the module doc, "Sampling").
@@ -250,6 +292,9 @@ impl Default for RigEffects {
             noise: true,
             noise_std: 2e-7,
             position_loop: PositionLoop::Sampled,
+            backlash: false,
+            backlash_width: 5e-6,
+            dead_time: 0,
         }
     }
 }
@@ -266,6 +311,8 @@ impl RigEffects {
             quantisation: false,
             noise: false,
             position_loop: PositionLoop::Continuous,
+            backlash: false,
+            dead_time: 0,
             ..Self::default()
         }
     }
@@ -287,7 +334,16 @@ impl RigEffects {
         positive("current_limit", self.current_limit)?;
         positive("voltage_limit", self.voltage_limit)?;
         positive("resolution", self.resolution)?;
-        non_negative("noise_std", self.noise_std)
+        non_negative("noise_std", self.noise_std)?;
+        non_negative("backlash_width", self.backlash_width)?;
+        if self.dead_time > MAX_DEAD_TIME {
+            return Err(Error::InvalidParameter {
+                name: "dead_time",
+                value: self.dead_time as f64,
+                reason: "must be at most 1e6 samples",
+            });
+        }
+        Ok(())
     }
 }
 
@@ -449,6 +505,11 @@ impl VirtualRig {
             reason: "must be finite and >= 0",
         })?;
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        // the command the loop acts on: delayed by the dead time, constant
+        // before the first sample (so there is no feed-forward kick at k = 0)
+        let delay = fx.dead_time;
+        let loop_command = |k: usize| command[k.saturating_sub(delay).min(n - 1)];
+        let ff = plant.feed_forward;
 
         let mut x = [0.0f64; 7];
         for (k, &xs) in command.iter().enumerate() {
@@ -471,17 +532,52 @@ impl VirtualRig {
             if k + 1 == n {
                 break;
             }
-            let next = command.get(k + 1).copied().unwrap_or(xs);
+            let xl = loop_command(k);
+            let next = loop_command(k + 1);
             let input = match fx.position_loop {
-                PositionLoop::Sampled => Input::Held(kv * (xs - measured)),
-                PositionLoop::Continuous => Input::Command {
-                    start: xs,
-                    slope: 0.0,
+                PositionLoop::Sampled if ff.active => {
+                    // the set-point generator's velocity over the coming interval
+                    // and the change of velocity from the previous one, held
+                    let prev = loop_command(k.saturating_sub(1));
+                    let v = (next - xl) * rate_hz;
+                    let a = (next - 2.0 * xl + prev) * rate_hz * rate_hz;
+                    Input::Held {
+                        vc: kv * (xl - measured) + ff.kvff * v,
+                        iff: ff.current_gain * a,
+                    }
+                }
+                PositionLoop::Sampled => Input::Held {
+                    vc: kv * (xl - measured),
+                    iff: 0.0,
                 },
-                PositionLoop::Interpolated => Input::Command {
-                    start: xs,
-                    slope: (next - xs) * rate_hz,
-                },
+                PositionLoop::Continuous => {
+                    if ff.active {
+                        // ẋ_s, ẍ_s of the held command are impulses at t_k:
+                        // the exact state jump (A·b₂ + b₁)·Δx_s
+                        let prev = loop_command(k.saturating_sub(1));
+                        ff.jump(&mut x, &ff.ramp_jump, xl - prev);
+                    }
+                    Input::Command {
+                        start: xl,
+                        slope: 0.0,
+                        vff: 0.0,
+                    }
+                }
+                PositionLoop::Interpolated => {
+                    let slope = (next - xl) * rate_hz;
+                    if ff.active {
+                        // ẍ_s of the interpolated command is an impulse at t_k:
+                        // the exact state jump b₂·Δẋ_s
+                        let prev = loop_command(k.saturating_sub(1));
+                        let prev_slope = (xl - prev) * rate_hz;
+                        ff.jump(&mut x, &ff.slope_jump, slope - prev_slope);
+                    }
+                    Input::Command {
+                        start: xl,
+                        slope,
+                        vff: ff.kvff * slope,
+                    }
+                }
             };
             for j in 0..sub {
                 plant.rk4(&mut x, input, j as f64 * h, h);
@@ -491,11 +587,76 @@ impl VirtualRig {
     }
 }
 
+/// Feed-forward of the rig: gains and the state jumps of the continuous modes.
+#[derive(Clone, Copy)]
+struct FeedForward {
+    /// Any feed-forward gain non-zero.
+    active: bool,
+    /// Velocity feed-forward gain kvff \[-\].
+    kvff: f64,
+    /// Current per command acceleration c_a \[A/(m/s²)\].
+    current_gain: f64,
+    /// State jump per step of the command, `A·b₂ + b₁` (held command).
+    ramp_jump: [f64; 7],
+    /// State jump per step of the command slope, `b₂` (interpolated command).
+    slope_jump: [f64; 7],
+}
+
+impl FeedForward {
+    fn new(p: &RigParams) -> Self {
+        let c = &p.control;
+        let (kp, kpi, kii) = (c.kp, c.kpi, c.kii);
+        let (l, res, kt) = (p.motor.inductance, p.motor.resistance, p.motor.kt);
+        let ca = p.acceleration_feed_forward_gain();
+        // b₁ = kvff·b_v with b_v = [1, Kp, Kpi·Kp/L, 0, 0, 0, 0] (velocity reference),
+        // b₂ = c_a·b_i with b_i = [0, 1, Kpi/L, 0, 0, 0, 0] (current reference)
+        let b1 = [
+            c.kvff,
+            c.kvff * kp,
+            c.kvff * kpi * kp / l,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ];
+        let b2 = [0.0, ca, ca * kpi / l, 0.0, 0.0, 0.0, 0.0];
+        // A·b₂ with the columns z_i and i of the cascade's A
+        let ab2 = [
+            0.0,
+            -b2[2],
+            (kpi * kii * b2[1] - (kpi + res) * b2[2]) / l,
+            0.0,
+            kt * b2[2] / p.inertia_j(),
+            0.0,
+            0.0,
+        ];
+        Self {
+            active: c.kvff != 0.0 || c.kaff != 0.0,
+            kvff: c.kvff,
+            current_gain: ca,
+            ramp_jump: std::array::from_fn(|j| ab2[j] + b1[j]),
+            slope_jump: b2,
+        }
+    }
+
+    #[inline]
+    fn jump(&self, x: &mut [f64; 7], direction: &[f64; 7], size: f64) {
+        for (xj, dj) in x.iter_mut().zip(direction) {
+            *xj += dj * size;
+        }
+    }
+}
+
 /// Input of the plant over one sample interval.
 #[derive(Clone, Copy)]
 enum Input {
-    /// Held velocity command v_c \[m/s\] (sampled P loop).
-    Held(f64),
+    /// Held velocity reference and current feed-forward (sampled P loop).
+    Held {
+        /// Velocity reference v_c \[m/s\] (P loop plus velocity feed-forward).
+        vc: f64,
+        /// Current feed-forward \[A\].
+        iff: f64,
+    },
     /// Position command `x_s = start + slope·τ` (τ = time since the sample);
     /// the P loop is closed inside the ODE.
     Command {
@@ -503,6 +664,8 @@ enum Input {
         start: f64,
         /// Command slope over the interval \[m/s\] (0 for a held command).
         slope: f64,
+        /// Velocity feed-forward over the interval \[m/s\].
+        vff: f64,
     },
 }
 
@@ -539,6 +702,9 @@ struct Plant {
     table_friction: Friction,
     quantisation: bool,
     resolution: f64,
+    backlash: bool,
+    half_play: f64,
+    feed_forward: FeedForward,
 }
 
 impl Plant {
@@ -574,6 +740,9 @@ impl Plant {
             table_friction: fx.table_friction,
             quantisation: fx.quantisation,
             resolution: fx.resolution,
+            backlash: fx.backlash,
+            half_play: 0.5 * fx.backlash_width,
+            feed_forward: FeedForward::new(p),
         }
     }
 
@@ -592,20 +761,28 @@ impl Plant {
     #[inline]
     fn deriv(&self, x: &[f64; 7], input: Input, tau: f64) -> [f64; 7] {
         let [zv, zi, i, th, w, xa, va] = *x;
-        let vc = match input {
-            Input::Held(vc) => vc,
-            Input::Command { start, slope } => {
+        let (vc, iff) = match input {
+            Input::Held { vc, iff } => (vc, iff),
+            Input::Command { start, slope, vff } => {
                 let xs = start + slope * tau;
                 let xm = if self.quantisation {
                     (xa / self.resolution).round() * self.resolution
                 } else {
                     xa
                 };
-                self.kv * (xs - xm)
+                if self.feed_forward.active {
+                    (self.kv * (xs - xm) + vff, 0.0)
+                } else {
+                    (self.kv * (xs - xm), 0.0)
+                }
             }
         };
         let ev = vc - self.r * w;
-        let iref_raw = self.kp * (ev + self.ki * zv);
+        let iref_raw = if self.feed_forward.active {
+            self.kp * (ev + self.ki * zv) + iff
+        } else {
+            self.kp * (ev + self.ki * zv)
+        };
         let (iref, dzv) = if self.limits {
             let s = iref_raw.clamp(-self.i_max, self.i_max);
             (s, ev + (s - iref_raw) / self.kp)
@@ -619,7 +796,13 @@ impl Plant {
         } else {
             (u_raw, iref - i)
         };
-        let spring = self.stiffness(xa) * (self.r * th - xa);
+        let stretch = self.r * th - xa;
+        let spring = if self.backlash {
+            // dead band of total width 2·half_play: no force inside the play
+            self.stiffness(xa) * (stretch - stretch.clamp(-self.half_play, self.half_play))
+        } else {
+            self.stiffness(xa) * stretch
+        };
         let (tf, ff) = if self.friction {
             (self.motor_friction.force(w), self.table_friction.force(va))
         } else {
@@ -674,6 +857,9 @@ fn non_negative(name: &'static str, value: f64) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod extension_tests;
 
 #[cfg(test)]
 mod tests {

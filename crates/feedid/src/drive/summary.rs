@@ -50,7 +50,9 @@ pub struct ModelSummary {
     pub j_screw: f64,
     /// Transmission ratio r = lead/2π \[m/rad\].
     pub r: f64,
-    /// Numerator `[N2, N1, N0]`, descending powers of s, normalised so D7 = J·L·M.
+    /// Numerator `[N2, N1, N0]`, descending powers of s, normalised so D7 = J·L·M
+    /// (`[N4, N3, N2, N1, N0]` with acceleration feed-forward, `[N3, …, N0]` with
+    /// velocity feed-forward only).
     pub num: Vec<f64>,
     /// Denominator `[D7, …, D0]`, descending powers of s.
     pub den: Vec<f64>,
@@ -63,7 +65,7 @@ pub struct ModelSummary {
     pub bandwidth_hz: Option<f64>,
     /// DC gain (1 for the corrected coefficients).
     pub dc_gain: f64,
-    /// Steady ramp following error per command velocity `(D1 − N1)/D0` \[s\] (= 1/Kv).
+    /// Steady ramp following error per command velocity `(D1 − N1)/D0` \[s\] (= (1 − kvff)/Kv).
     pub following_error_s: f64,
     /// Which D1 was used.
     pub d1_variant: String,
@@ -82,7 +84,7 @@ impl ModelSummary {
             k_screw: params.screw_stiffness(),
             j_screw: params.screw_inertia(),
             r: params.r(),
-            num: c.num.to_vec(),
+            num: tf.num().to_vec(),
             den: c.den.to_vec(),
             poles: poles.iter().map(|p| [p.re, p.im]).collect(),
             pole_details: poles.iter().map(|&p| PoleInfo::new(p)).collect(),
@@ -153,7 +155,7 @@ impl fmt::Display for ModelSummary {
             self.d1_variant
         )?;
         for (k, v) in self.num.iter().enumerate() {
-            writeln!(f, "  N{} = {:.6e}", 2 - k, v)?;
+            writeln!(f, "  N{} = {:.6e}", self.num.len() - 1 - k, v)?;
         }
         for (k, v) in self.den.iter().enumerate() {
             writeln!(f, "  D{} = {:.6e}", 7 - k, v)?;

@@ -1,0 +1,324 @@
+//! `feedid zoo`: list the drive zoo or write its members as recordings that
+//! `feedid identify` reads with no options, with a manifest of every
+//! parameter drawn.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use feedid::io::{write_atomic, write_string_atomic};
+use feedid::zoo::{MemberSpec, Zoo};
+use rayon::prelude::*;
+
+/// `feedid zoo`.
+#[derive(Debug, Args)]
+pub struct ZooArgs {
+    /// Print a table of the members and the ranges they span.
+    #[arg(long)]
+    pub list: bool,
+    /// Write each member as DIR/zoo-NNN.csv (time_s,command_m,position_m,true_position_m),
+    /// with DIR/manifest.csv and DIR/manifest.json (every parameter drawn).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Members: all, regular (readable), gapped (dropped rows), small (the
+    /// first 20), a range A..B or A..=B, or a list 1,5,9.
+    #[arg(long, value_name = "SET", default_value = "all")]
+    pub members: String,
+}
+
+/// Run `feedid zoo`.
+pub fn run(a: &ZooArgs) -> Result<()> {
+    if !a.list && a.out.is_none() {
+        bail!("nothing to do: give --list, --out DIR or both");
+    }
+    let zoo = Zoo::standard();
+    let indices = parse_members(&a.members, &zoo)?;
+    let specs: Vec<MemberSpec> = zoo
+        .specs(&indices)
+        .into_iter()
+        .collect::<feedid::Result<_>>()?;
+    if a.list {
+        print!("{}", table(&specs));
+    }
+    if let Some(dir) = &a.out {
+        write_members(&zoo, &specs, dir)?;
+    }
+    Ok(())
+}
+
+/// Parse `--members`.
+fn parse_members(s: &str, zoo: &Zoo) -> Result<Vec<usize>> {
+    let t = s.trim();
+    let n = zoo.len();
+    let bad = || {
+        anyhow::anyhow!(
+            "invalid --members `{s}`: expected all, regular, gapped, small, A..B, A..=B or a list 1,5,9 (members 0 … {})",
+            n - 1
+        )
+    };
+    let list: Vec<usize> = match t {
+        "all" => (0..n).collect(),
+        "regular" => zoo.regular().collect(),
+        "gapped" => zoo.gapped().collect(),
+        "small" => zoo.small().collect(),
+        _ if t.contains("..") => {
+            let (lo, hi) = t.split_once("..").ok_or_else(bad)?;
+            let lo: usize = lo.trim().parse().map_err(|_| bad())?;
+            let hi = match hi.strip_prefix('=') {
+                Some(h) => h.trim().parse::<usize>().map_err(|_| bad())?.checked_add(1),
+                None => hi.trim().parse::<usize>().ok(),
+            }
+            .ok_or_else(bad)?;
+            if lo >= hi {
+                bail!("invalid --members `{s}`: the range is empty");
+            }
+            (lo..hi).collect()
+        }
+        _ => t
+            .split(',')
+            .map(|x| x.trim().parse::<usize>().map_err(|_| bad()))
+            .collect::<Result<_>>()?,
+    };
+    if let Some(&i) = list.iter().find(|&&i| i >= n) {
+        bail!(
+            "invalid --members `{s}`: member {i} does not exist (the zoo has members 0 … {})",
+            n - 1
+        );
+    }
+    Ok(list)
+}
+
+/// The member table and the ranges the listed members span.
+fn table(specs: &[MemberSpec]) -> String {
+    let mut s = format!(
+        "{:>5} {:<16} {:<7} {:>9} {:>6} {:>8} {:<7} {:>11}  label\n",
+        "index", "plant", "command", "rate_hz", "rows", "kv", "ff", "amplitude_m"
+    );
+    for m in specs {
+        s += &format!(
+            "{:>5} {:<16} {:<7} {:>9.1} {:>6} {:>8.1} {:<7} {:>11.4e}  {}\n",
+            m.index,
+            m.plant.name(),
+            m.command.name(),
+            m.rate_hz,
+            m.samples,
+            m.kv,
+            m.feed_forward(),
+            m.amplitude_m,
+            m.label
+        );
+    }
+    let span = |name: &str, unit: &str, v: Vec<f64>| -> String {
+        if v.is_empty() {
+            return String::new();
+        }
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+        format!(
+            "  {name:<22} {lo:.3e} … {hi:.3e} {unit} ({} members)\n",
+            v.len()
+        )
+    };
+    s += &format!("{} members span:\n", specs.len());
+    s += &span(
+        "recording rate",
+        "Hz",
+        specs.iter().map(|m| m.rate_hz).collect(),
+    );
+    s += &span("Kv", "1/s", specs.iter().map(|m| m.kv).collect());
+    s += &span(
+        "moving mass (rig)",
+        "kg",
+        specs.iter().filter_map(|m| m.mass_kg).collect(),
+    );
+    s += &span(
+        "friction share (rig)",
+        "",
+        specs
+            .iter()
+            .filter(|m| m.rig.is_some())
+            .map(|m| m.friction_share)
+            .collect(),
+    );
+    s += &span(
+        "backlash",
+        "m",
+        specs
+            .iter()
+            .map(|m| m.backlash_m)
+            .filter(|&b| b > 0.0)
+            .collect(),
+    );
+    s += &span(
+        "placed axial mode",
+        "Hz",
+        specs
+            .iter()
+            .filter(|m| m.resonance_placed)
+            .filter_map(|m| m.axial_mode_hz)
+            .collect(),
+    );
+    s += &span(
+        "dead time",
+        "samples",
+        specs.iter().map(|m| m.dead_time_samples as f64).collect(),
+    );
+    s += &span(
+        "encoder resolution",
+        "m",
+        specs.iter().map(|m| m.resolution_m).collect(),
+    );
+    s += &span(
+        "noise std",
+        "m",
+        specs.iter().map(|m| m.noise_std_m).collect(),
+    );
+    s += &span(
+        "amplitude",
+        "m",
+        specs.iter().map(|m| m.amplitude_m).collect(),
+    );
+    let count = |f: &dyn Fn(&MemberSpec) -> bool| specs.iter().filter(|m| f(m)).count();
+    s += &format!(
+        "  feed-forward           none {}, vff {}, vff+aff {}\n",
+        count(&|m| m.feed_forward() == "none"),
+        count(&|m| m.feed_forward() == "vff"),
+        count(&|m| m.feed_forward() == "vff+aff")
+    );
+    s += &format!(
+        "  defects                glitches on {}, dropped rows on {} (not readable by identify)\n",
+        count(&|m| !m.glitches.is_empty()),
+        count(&|m| m.has_gaps())
+    );
+    s
+}
+
+/// File name of member `i`.
+fn file_name(i: usize) -> String {
+    format!("zoo-{i:03}.csv")
+}
+
+/// Write the members and the manifests; on failure remove what was written.
+fn write_members(zoo: &Zoo, specs: &[MemberSpec], dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("{}: exists and is not a directory", dir.display());
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+    let results: Vec<(PathBuf, Result<()>)> = specs
+        .par_iter()
+        .map(|s| {
+            let path = dir.join(file_name(s.index));
+            let r = zoo
+                .member(s.index)
+                .map_err(anyhow::Error::from)
+                .and_then(|m| Ok(write_atomic(&path, |w| m.write_csv(w))?));
+            (path, r)
+        })
+        .collect();
+    let mut written: Vec<PathBuf> = Vec::new();
+    let mut failure = None;
+    for (path, r) in results {
+        match r {
+            Ok(()) => written.push(path),
+            Err(e) if failure.is_none() => failure = Some(e),
+            Err(_) => {}
+        }
+    }
+    let manifests = failure.map_or_else(|| write_manifests(specs, dir, &mut written), Err);
+    if let Err(e) = manifests {
+        for p in &written {
+            let _ = std::fs::remove_file(p);
+        }
+        return Err(e);
+    }
+    println!(
+        "{}: {} members written (zoo-NNN.csv), manifest.csv, manifest.json",
+        dir.display(),
+        specs.len()
+    );
+    Ok(())
+}
+
+fn write_manifests(specs: &[MemberSpec], dir: &Path, written: &mut Vec<PathBuf>) -> Result<()> {
+    let json_path = dir.join("manifest.json");
+    // every spec with `file` (its CSV, relative to the manifest) and
+    // `readable` (false for dropped rows: `feedid identify` refuses those)
+    let entries = specs
+        .iter()
+        .map(|s| {
+            let mut v = serde_json::to_value(s)?;
+            if let Some(o) = v.as_object_mut() {
+                o.insert("file".into(), file_name(s.index).into());
+                o.insert("readable".into(), (!s.has_gaps()).into());
+            }
+            Ok(v)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let json = serde_json::to_string_pretty(&entries)?;
+    write_string_atomic(&json_path, &format!("{json}\n"))?;
+    written.push(json_path);
+    let csv_path = dir.join("manifest.csv");
+    write_atomic(&csv_path, |w| manifest_csv(specs, w))?;
+    written.push(csv_path);
+    Ok(())
+}
+
+/// The flat manifest: one row per member.
+fn manifest_csv(specs: &[MemberSpec], w: &mut dyn Write) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "index,file,readable,plant,command,rate_hz,loop_rate_hz,samples,duration_s,kv,\
+         velocity_bandwidth_hz,kvff,kaff,mass_kg,axial_mode_hz,resonance_placed,friction_share,\
+         backlash_m,dead_time_samples,resolution_m,noise_std_m,amplitude_m,glitch_rows,\
+         dropped_rows,gap_source,max_real_part,min_damping,spectral_radius,label"
+    )?;
+    let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+    let rows = |v: &[usize]| {
+        v.iter()
+            .map(|k| k.to_string())
+            .collect::<Vec<_>>()
+            .join(";")
+    };
+    for s in specs {
+        let glitches: Vec<usize> = s.glitches.iter().map(|g| g.index).collect();
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
+            s.index,
+            file_name(s.index),
+            !s.has_gaps(),
+            s.plant.name(),
+            s.command.name(),
+            s.rate_hz,
+            s.loop_rate_hz,
+            s.samples,
+            s.duration_s,
+            s.kv,
+            opt(s.velocity_bandwidth_hz),
+            s.kvff,
+            s.kaff,
+            opt(s.mass_kg),
+            opt(s.axial_mode_hz),
+            s.resonance_placed,
+            s.friction_share,
+            s.backlash_m,
+            s.dead_time_samples,
+            s.resolution_m,
+            s.noise_std_m,
+            s.amplitude_m,
+            rows(&glitches),
+            rows(&s.dropped_rows),
+            s.gap_source.map(|g| g.to_string()).unwrap_or_default(),
+            s.stability.max_real_part,
+            s.stability.min_damping,
+            s.stability.spectral_radius,
+            s.label.replace('"', "\"\"")
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,192 @@
+//! `feedid zoo` and the rig extensions as `feedid simulate` reads them.
+
+mod common;
+
+use common::{assert_fails, feedid, stderr, stdout};
+
+fn column(path: &std::path::Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let i = header.iter().position(|h| *h == name).unwrap();
+    lines
+        .map(|l| l.split(',').nth(i).unwrap().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn zoo_list_prints_one_row_per_member_and_the_ranges() {
+    let o = feedid(&["zoo", "--list", "--members", "small"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = stdout(&o);
+    let rows = s
+        .lines()
+        .filter(|l| {
+            l.trim_start()
+                .chars()
+                .next()
+                .is_some_and(|c| c.is_ascii_digit())
+        })
+        .filter(|l| !l.contains("members span"))
+        .count();
+    assert_eq!(rows, 20, "{s}");
+    assert!(s.contains("20 members span:"), "{s}");
+    assert!(s.contains("rig-heavy") && s.contains("second-order"), "{s}");
+    // the whole zoo
+    let o = feedid(&["zoo", "--list"]);
+    assert!(stdout(&o).contains("220 members span:"));
+}
+
+#[test]
+fn zoo_members_are_files_identify_reads_with_no_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("zoo");
+    let o = feedid(&["zoo", "--out", out.to_str().unwrap(), "--members", "0..=2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for i in 0..3 {
+        let f = out.join(format!("zoo-{i:03}.csv"));
+        let p = dir.path().join(format!("p{i}.csv"));
+        let o = feedid(&["identify", f.to_str().unwrap(), "-o", p.to_str().unwrap()]);
+        assert!(o.status.success(), "member {i}: {}", stderr(&o));
+    }
+    // the CSV holds the library's member bit for bit
+    let m = feedid::zoo::Zoo::standard().member(1).unwrap();
+    let f = out.join("zoo-001.csv");
+    assert_eq!(column(&f, "position_m"), m.position);
+    assert_eq!(column(&f, "true_position_m"), m.truth);
+    assert_eq!(column(&f, "time_s"), m.time);
+    // the manifests describe the written members
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    let a = v.as_array().unwrap();
+    assert_eq!(a.len(), 3);
+    assert_eq!(a[1]["file"], "zoo-001.csv");
+    assert_eq!(a[1]["readable"], true);
+    assert_eq!(a[1]["samples"].as_u64().unwrap() as usize, m.len());
+    let csv = std::fs::read_to_string(out.join("manifest.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4);
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .starts_with("index,file,readable,plant"));
+}
+
+#[test]
+fn a_member_with_dropped_rows_is_written_marked_and_refused_by_identify() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("gaps");
+    let o = feedid(&["zoo", "--out", out.to_str().unwrap(), "--members", "215"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(v[0]["readable"], false);
+    assert!(!v[0]["dropped_rows"].as_array().unwrap().is_empty());
+    let f = out.join("zoo-215.csv");
+    let p = dir.path().join("p.csv");
+    let o = feedid(&["identify", f.to_str().unwrap(), "-o", p.to_str().unwrap()]);
+    assert_fails(&o, &["zoo-215.csv"]);
+    assert!(!p.exists());
+}
+
+#[test]
+fn bad_member_sets_are_refused_with_the_choices() {
+    for (set, needle) in [
+        ("5..2", "empty"),
+        ("0..999", "member 220 does not exist"),
+        ("one", "expected all, regular"),
+        ("1,x", "expected all, regular"),
+    ] {
+        let o = feedid(&["zoo", "--list", "--members", set]);
+        assert_fails(&o, &[needle]);
+    }
+    assert_fails(&feedid(&["zoo"]), &["nothing to do"]);
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("f");
+    std::fs::write(&file, "x").unwrap();
+    assert_fails(
+        &feedid(&["zoo", "--out", file.to_str().unwrap(), "--members", "0"]),
+        &["not a directory"],
+    );
+}
+
+#[test]
+fn simulate_reads_feed_forward_backlash_and_dead_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = dir.path().join("ff.toml");
+    std::fs::write(&params, "[control]\nkvff = 0.9\nkaff = 0.5\n").unwrap();
+    let effects = dir.path().join("fx.toml");
+    std::fs::write(
+        &effects,
+        "noise = false\nquantisation = false\nfriction = false\ndead_time = 2\n",
+    )
+    .unwrap();
+    let plain = dir.path().join("plain.csv");
+    let ff = dir.path().join("ff.csv");
+    let simulate = |fx: &std::path::Path, out: &std::path::Path| {
+        let o = feedid(&[
+            "simulate",
+            "--scenario",
+            "ramp",
+            "--params",
+            params.to_str().unwrap(),
+            "--effects",
+            fx.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    let o = feedid(&[
+        "simulate",
+        "--scenario",
+        "ramp",
+        "--linear",
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    simulate(&effects, &ff);
+    let cmd = column(&ff, "command_m");
+    let x = column(&ff, "true_position_m");
+    // steady ramp: (1 − kvff)·v/Kv = 7.14 µm plus two samples of dead time (2·v/rate = 20 µm)
+    let k = 2500;
+    let e = cmd[k] - x[k];
+    let want = 0.1 * 0.05 / 700.0 + 2.0 * 0.05 / 5000.0;
+    assert!((e - want).abs() < 1e-8, "following error {e} vs {want}");
+    let x0 = column(&plain, "true_position_m");
+    assert!(cmd[k] - x0[k] > 70e-6, "without feed-forward: v/Kv");
+    // backlash changes the motion by about its width
+    std::fs::write(
+        &effects,
+        "noise = false\nquantisation = false\nfriction = false\ndead_time = 2\nbacklash = true\nbacklash_width = 1e-5\n",
+    )
+    .unwrap();
+    let with = dir.path().join("backlash.csv");
+    simulate(&effects, &with);
+    let xb = column(&with, "true_position_m");
+    let d = x
+        .iter()
+        .zip(&xb)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(d > 1e-6 && d < 1e-4, "{d}");
+    // the model of these parameters says the same
+    let o = feedid(&["model", "--params", params.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let fe = v["following_error_s"].as_f64().unwrap();
+    assert!((fe - 0.1 / 700.0).abs() < 1e-12, "{fe}");
+    assert_eq!(v["num"].as_array().unwrap().len(), 5);
+    // bad values are refused by name
+    std::fs::write(&params, "[control]\nkvff = -1\n").unwrap();
+    let o = feedid(&[
+        "simulate",
+        "--scenario",
+        "ramp",
+        "--params",
+        params.to_str().unwrap(),
+        "-o",
+        ff.to_str().unwrap(),
+    ]);
+    assert_fails(&o, &["control.kvff"]);
+}

@@ -1,6 +1,9 @@
 //! The streaming path allocates nothing per sample or per window once
 //! running (issue: "No allocation per sample or per window after
-//! construction"). Counted with a global allocator that counts the
+//! construction"): the paper method (QR on its cached projection, the
+//! simplex from zeros and from the previous window), auto, rls, arx (the
+//! two-stack sliding factor and the Hessenberg solve) and oe (both
+//! Jacobians). Counted with a global allocator that counts the
 //! allocations made by the test's own thread.
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -8,7 +11,9 @@ use std::cell::Cell;
 
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::stream::Streamer;
-use feedid::ident::{EngineConfig, Method, PaperConfig, Solver};
+use feedid::ident::{
+    EngineConfig, Method, OeConfig, OeJacobian, PaperConfig, SimplexStart, Solver,
+};
 use feedid::signal::Scenario;
 
 struct Counting;
@@ -65,13 +70,15 @@ fn steady_state_pushes_allocate_nothing_for_the_paper_method() {
         .unwrap();
     // the counter itself works
     assert!(allocations_in(|| drop(std::hint::black_box(vec![1u8; 16]))) >= 1);
-    for (solver, hop) in [
-        (Solver::Qr, None),
-        (Solver::Qr, Some(1)),
-        (Solver::Simplex, None),
+    for (solver, hop, start) in [
+        (Solver::Qr, None, SimplexStart::Zeros),
+        (Solver::Qr, Some(1), SimplexStart::Zeros),
+        (Solver::Simplex, None, SimplexStart::Zeros),
+        (Solver::Simplex, None, SimplexStart::Previous),
     ] {
         let paper = PaperConfig {
             solver,
+            simplex_start: start,
             ..PaperConfig::default()
         }
         .build()
@@ -118,8 +125,18 @@ fn steady_state_pushes_allocate_nothing_for_the_default_and_linear_methods() {
         .with_seed(3)
         .simulate(&command, rate)
         .unwrap();
-    for name in ["auto", "rls", "arx"] {
-        let spec: Method = name.parse().unwrap();
+    let projected = Method::Oe(OeConfig {
+        jacobian: OeJacobian::Projected,
+        ..OeConfig::default()
+    });
+    for (name, spec) in [
+        ("auto", "auto".parse().unwrap()),
+        ("rls", "rls".parse().unwrap()),
+        ("arx", "arx".parse().unwrap()),
+        ("oe", "oe".parse().unwrap()),
+        ("oe (projected Jacobian)", projected),
+    ] {
+        let spec: Method = spec;
         let cfg = EngineConfig {
             window: spec.default_window(),
             ..EngineConfig::default()

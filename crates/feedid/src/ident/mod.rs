@@ -28,8 +28,8 @@ pub use method::{Method, METHOD_NAMES};
 pub use methods::{
     coefficients_from_polynomials, fit_arx, fit_oe, polynomials_from_coefficients, ArxConfig,
     ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, OeConfig,
-    OeEstimator, OeFit, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig,
-    RlsEstimator, SimplexSettings, SimplexStart, Solver, TimeOrigin, AUTO_CANDIDATES,
+    OeEstimator, OeFit, OeJacobian, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode,
+    RlsConfig, RlsEstimator, SimplexSettings, SimplexStart, Solver, TimeOrigin, AUTO_CANDIDATES,
     MAX_ARX_ORDER, SHIFT_AMPLIFICATION_WARNING,
 };
 pub use model::{

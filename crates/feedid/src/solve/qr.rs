@@ -97,6 +97,8 @@ pub struct QrWorkspace {
     /// Squared partial column norms (current estimate, last exact value).
     vn1: Vec<f64>,
     vn2: Vec<f64>,
+    /// Run the AVX2 build of the solver.
+    avx: bool,
 }
 
 impl QrWorkspace {
@@ -111,12 +113,25 @@ impl QrWorkspace {
             small_rhs: vec![0.0; 2 * n],
             vn1: vec![0.0; n],
             vn2: vec![0.0; n],
+            avx: crate::solve::rows::avx2(),
         }
     }
 
     /// Largest number of unknowns this workspace supports.
     pub fn capacity(&self) -> usize {
         self.n_max
+    }
+
+    /// Column permutation of the last [`lstsq_in_place`] with `n` unknowns
+    /// (column `k` of its `R` is column `perm[k]` of `A`).
+    pub(crate) fn permutation(&self, n: usize) -> &[usize] {
+        &self.perm[..n]
+    }
+
+    /// Column scales `d_j` of the last [`lstsq_in_place`] with `n` unknowns
+    /// (`R` is the factor of `A·diag(1/d_j)`, permuted).
+    pub(crate) fn scales(&self, n: usize) -> &[f64] {
+        &self.scale[..n]
     }
 }
 
@@ -145,6 +160,40 @@ impl QrWorkspace {
 /// assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 2.0).abs() < 1e-14);
 /// ```
 pub fn lstsq_in_place(
+    m: usize,
+    n: usize,
+    a: &mut [f64],
+    b: &mut [f64],
+    x: &mut [f64],
+    ws: &mut QrWorkspace,
+    options: &LstsqOptions,
+) -> Result<LstsqInfo> {
+    #[cfg(target_arch = "x86_64")]
+    if ws.avx {
+        // SAFETY: `avx` is set only when the CPU reports AVX2 (workspace construction).
+        return unsafe { lstsq_avx2(m, n, a, b, x, ws, options) };
+    }
+    lstsq_impl(m, n, a, b, x, ws, options)
+}
+
+/// [`lstsq_impl`] compiled for AVX2 (4-wide vectors; the same operations in
+/// the same order, no FMA contraction: bit-identical results).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lstsq_avx2(
+    m: usize,
+    n: usize,
+    a: &mut [f64],
+    b: &mut [f64],
+    x: &mut [f64],
+    ws: &mut QrWorkspace,
+    options: &LstsqOptions,
+) -> Result<LstsqInfo> {
+    lstsq_impl(m, n, a, b, x, ws, options)
+}
+
+#[inline(always)]
+fn lstsq_impl(
     m: usize,
     n: usize,
     a: &mut [f64],
@@ -636,7 +685,7 @@ fn split_cols(a: &mut [f64], m: usize, k: usize, j: usize) -> (&[f64], &mut [f64
 
 /// Whether every element is finite: four partial sums of `v·0` (NaN exactly
 /// when some `v` is NaN or infinite), vectorisable.
-#[inline]
+#[inline(always)]
 fn all_finite(v: &[f64]) -> bool {
     let mut acc = [0.0f64; 4];
     let chunks = v.chunks_exact(4);
@@ -650,7 +699,7 @@ fn all_finite(v: &[f64]) -> bool {
 }
 
 /// Dot product with four partial sums (independent dependency chains).
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
@@ -671,14 +720,14 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Sum of squares (no protection against over/underflow).
-#[inline]
+#[inline(always)]
 fn sum_sq(v: &[f64]) -> f64 {
     dot(v, v)
 }
 
 /// 2-norm without overflow/underflow for extreme magnitudes (one pass when
 /// the sum of squares is safely representable).
-#[inline]
+#[inline(always)]
 fn norm2(v: &[f64]) -> f64 {
     let s = sum_sq(v);
     if s.is_finite() && s >= 1e-200 {

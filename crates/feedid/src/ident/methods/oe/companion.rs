@@ -247,19 +247,22 @@ fn responses<const N: usize>(
     let mut g = [0.0; N];
     g.copy_from_slice(&g0[..N]);
     let mb = beta_desc.len();
-    // forced response from the zero state
+    // The forced response from the zero state and the observability rows
+    // o_0 = C (c_i = β_i), o_{k+1} = o_k·A_d, in one loop: two independent
+    // recursions whose latencies overlap.
     let mut x = [0.0; N];
-    for ((f, &uk), (rh, &yk)) in forced[..w]
-        .iter_mut()
-        .zip(u)
-        .zip(rhs[..w].iter_mut().zip(&y[..w]))
-    {
-        *f = beta_desc
-            .iter()
-            .enumerate()
-            .map(|(k, b)| b * x[mb - 1 - k])
-            .sum();
-        *rh = yk - *f;
+    let mut row = [0.0; N];
+    for (i, b) in beta_desc.iter().enumerate() {
+        row[mb - 1 - i] = *b;
+    }
+    for k in 0..w {
+        let uk = u[k];
+        let mut f = 0.0;
+        for (kk, b) in beta_desc.iter().enumerate() {
+            f += b * x[mb - 1 - kk];
+        }
+        forced[k] = f;
+        rhs[k] = y[k] - f;
         let mut s = [0.0; N];
         for i in 0..N {
             s[i] = g[i] * uk + 0.0;
@@ -272,21 +275,135 @@ fn responses<const N: usize>(
             }
         }
         x = s;
-    }
-    // o_0 = C (c_i = β_i), o_{k+1} = o_k·A_d
-    let mut row = [0.0; N];
-    for (i, b) in beta_desc.iter().enumerate() {
-        row[mb - 1 - i] = *b;
-    }
-    for k in 0..w {
-        for j in 0..N {
-            obs[k + j * w] = row[j];
-        }
         let mut next = [0.0; N];
         for j in 0..N {
-            next[j] = row.iter().zip(&a[j]).map(|(r, c)| r * c).sum();
+            obs[k + j * w] = row[j];
+            let mut v = 0.0;
+            for i in 0..N {
+                v += row[i] * a[j][i];
+            }
+            next[j] = v;
         }
         row = next;
+    }
+}
+
+/// The output `ŷ_k = C·x_k` of the last discretisation over `u` from the
+/// state `x0` (`beta_desc` as in [`output`]), with the states `x_k` into
+/// `states` (`states[k + j·w]`, state `j`) if given. Fixed order up to 8.
+pub(crate) fn simulate_from(
+    comp: &Companion,
+    beta_desc: &[f64],
+    x0: &[f64],
+    u: &[f64],
+    out: &mut [f64],
+    states: Option<&mut [f64]>,
+) {
+    macro_rules! fixed {
+        ($($n:literal),*) => {
+            match comp.n {
+                $($n => simulate::<$n>(comp, beta_desc, x0, u, out, states),)*
+                _ => simulate::<0>(comp, beta_desc, x0, u, out, states),
+            }
+        };
+    }
+    fixed!(1, 2, 3, 4, 5, 6, 7, 8);
+}
+
+#[inline(always)]
+fn simulate<const N: usize>(
+    comp: &Companion,
+    beta_desc: &[f64],
+    x0: &[f64],
+    u: &[f64],
+    out: &mut [f64],
+    states: Option<&mut [f64]>,
+) {
+    if N == 0 {
+        return simulate_dyn(comp, beta_desc, x0, u, out, states);
+    }
+    let w = u.len();
+    let mb = beta_desc.len();
+    let mut a = [[0.0; N]; N]; // a[j] = column j of A_d
+    for (j, col) in a.iter_mut().enumerate() {
+        col.copy_from_slice(&comp.ad[j * N..(j + 1) * N]);
+    }
+    let mut g = [0.0; N];
+    g.copy_from_slice(&comp.g0[..N]);
+    let mut c = [0.0; N]; // the output row: c[mb−1−kk] = β_desc[kk]
+    for (kk, b) in beta_desc.iter().enumerate() {
+        c[mb - 1 - kk] = *b;
+    }
+    let mut x = [0.0; N];
+    x.copy_from_slice(&x0[..N]);
+    let (u, out) = (&u[..w], &mut out[..w]);
+    if let Some(st) = states {
+        let st = &mut st[..w * N];
+        for k in 0..w {
+            out[k] = (0..N).map(|j| c[j] * x[j]).sum();
+            for j in 0..N {
+                st[k + j * w] = x[j];
+            }
+            x = step_fixed(&a, &g, &x, u[k]);
+        }
+    } else {
+        for k in 0..w {
+            out[k] = (0..N).map(|j| c[j] * x[j]).sum();
+            x = step_fixed(&a, &g, &x, u[k]);
+        }
+    }
+}
+
+/// `A_d·x + Γ₀·v` for a fixed order.
+#[inline(always)]
+fn step_fixed<const N: usize>(a: &[[f64; N]; N], g: &[f64; N], x: &[f64; N], v: f64) -> [f64; N] {
+    let mut s = [0.0; N];
+    for i in 0..N {
+        s[i] = g[i] * v;
+    }
+    for j in 0..N {
+        for i in 0..N {
+            s[i] += a[j][i] * x[j];
+        }
+    }
+    s
+}
+
+/// [`simulate`] for any order.
+fn simulate_dyn(
+    comp: &Companion,
+    beta_desc: &[f64],
+    x0: &[f64],
+    u: &[f64],
+    out: &mut [f64],
+    mut states: Option<&mut [f64]>,
+) {
+    let n = comp.n;
+    let w = u.len();
+    let mb = beta_desc.len();
+    let mut x = [0.0; MAX_ORDER];
+    let mut s = [0.0; MAX_ORDER];
+    x[..n].copy_from_slice(&x0[..n]);
+    for k in 0..w {
+        let mut f = 0.0;
+        for (kk, b) in beta_desc.iter().enumerate() {
+            f += b * x[mb - 1 - kk];
+        }
+        out[k] = f;
+        if let Some(st) = states.as_deref_mut() {
+            for j in 0..n {
+                st[k + j * w] = x[j];
+            }
+        }
+        for i in 0..n {
+            s[i] = comp.g0[i] * u[k];
+        }
+        for j in 0..n {
+            for i in 0..n {
+                s[i] += comp.ad[i + j * n] * x[j];
+            }
+        }
+        x[..n].copy_from_slice(&s[..n]);
     }
 }
 
@@ -342,21 +459,20 @@ fn responses_dyn(
 /// or `Σ_{j ≤ n} m[n−1][j]·e[j]`, `O(k·n)` instead of `O(k³)`.
 fn companion_product(n: usize, alpha: f64, m: &[f64], e: &[f64], c: &mut [f64]) {
     let k = n + 2;
+    // the superdiagonal entries are all the scaled step; row n−1 is dense up to column n
+    let row: [f64; MAX_ORDER + 1] =
+        std::array::from_fn(|l| if l <= n { m[(n - 1) + l * k] } else { 0.0 });
     for (cj, ej) in c.chunks_exact_mut(k).zip(e.chunks_exact(k)) {
-        for i in 0..k {
-            let v = if i + 1 == n {
-                let mut s = 0.0;
-                for (l, &elj) in ej.iter().enumerate().take(n + 1) {
-                    s += m[i + l * k] * (alpha * elj);
-                }
-                s
-            } else if i + 1 < k {
-                m[i + (i + 1) * k] * (alpha * ej[i + 1])
-            } else {
-                0.0
-            };
-            cj[i] = v;
+        for i in 0..n - 1 {
+            cj[i] = m[i + (i + 1) * k] * (alpha * ej[i + 1]);
         }
+        let mut s = 0.0;
+        for (r, &elj) in row[..=n].iter().zip(ej) {
+            s += r * (alpha * elj);
+        }
+        cj[n - 1] = s;
+        cj[n] = m[n + (n + 1) * k] * (alpha * ej[n + 1]);
+        cj[n + 1] = 0.0;
     }
 }
 

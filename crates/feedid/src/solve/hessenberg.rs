@@ -596,6 +596,38 @@ mod tests {
     }
 
     #[test]
+    fn avx2_build_gives_the_portable_results_bit_for_bit() {
+        // the kernels are chosen at run time: both builds must agree exactly
+        // (on a CPU without AVX2 both are the portable one), for every row
+        // stride (the fixed-length kernels 8…24 and the general one)
+        let mut fast = HessenbergWorkspace::new(30);
+        let mut slow = crate::solve::rows::portable(|| HessenbergWorkspace::new(30));
+        assert!(!slow.avx);
+        #[cfg(target_arch = "x86_64")]
+        assert_eq!(fast.avx, std::arch::is_x86_feature_detected!("avx2"));
+        let mut rng = ChaCha8Rng::seed_from_u64(43);
+        for case in 0..400 {
+            let n = rng.random_range(1..=30);
+            let m = if case % 3 == 0 { n } else { n + 1 };
+            let (h, b) = problem(&mut rng, m, n);
+            let ridge: Vec<f64> = (0..n).map(|j| [1e-8, 0.0, 1.0][(case + j) % 3]).collect();
+            let run = |ws: &mut HessenbergWorkspace| {
+                let mut x = vec![0.0; n];
+                let info =
+                    lstsq_hessenberg(m, n, &h, &b, &ridge, &mut x, ws).map(|i| format!("{i:?}"));
+                let cond = hessenberg_condition(m, n, &h, ws).map(f64::to_bits);
+                let x: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
+                (
+                    info.map_err(|e| e.to_string()),
+                    cond.map_err(|e| e.to_string()),
+                    x,
+                )
+            };
+            assert_eq!(run(&mut fast), run(&mut slow), "case {case} (m {m}, n {n})");
+        }
+    }
+
+    #[test]
     fn condition_estimate_is_within_a_small_factor_of_the_true_one_norm_condition() {
         let mut rng = ChaCha8Rng::seed_from_u64(12);
         let mut z = [0.0; 12];

@@ -173,6 +173,8 @@ pub fn lstsq_in_place(
         // SAFETY: `avx` is set only when the CPU reports AVX2 (workspace construction).
         return unsafe { lstsq_avx2(m, n, a, b, x, ws, options) };
     }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = ws.avx;
     lstsq_impl(m, n, a, b, x, ws, options)
 }
 
@@ -765,6 +767,48 @@ mod tests {
         let a = DMatrix::from_fn(m, n, |_, _| rng.random_range(-1.0..1.0));
         let b = DVector::from_fn(m, |_, _| rng.random_range(-1.0..1.0));
         (a, b)
+    }
+
+    #[test]
+    fn avx2_build_gives_the_portable_results_bit_for_bit() {
+        // the kernels are chosen at run time: both builds must agree exactly
+        // (on a CPU without AVX2 both are the portable one)
+        let mut fast = QrWorkspace::new(24);
+        let mut slow = crate::solve::rows::portable(|| QrWorkspace::new(24));
+        assert!(!slow.avx);
+        #[cfg(target_arch = "x86_64")]
+        assert_eq!(fast.avx, std::arch::is_x86_feature_detected!("avx2"));
+        let mut rng = ChaCha8Rng::seed_from_u64(41);
+        for case in 0..300 {
+            let n = rng.random_range(1..=24);
+            let m = n + rng.random_range(0..60);
+            let (a, b) = random_problem(&mut rng, m, n);
+            let mut a: Vec<f64> = a.as_slice().to_vec();
+            if n > 2 && case % 3 == 0 {
+                // a nearly dependent column and decades of scale
+                for i in 0..m {
+                    a[i + 2 * m] = a[i + m] + 1e-9 * a[i + 2 * m];
+                    a[i] *= 1e6;
+                }
+            }
+            let options = LstsqOptions {
+                ridge: [0.0, 1e-8, 1e-2][case % 3],
+                rank_tolerance: [None, Some(1e-6)][case % 2],
+            };
+            let run = |ws: &mut QrWorkspace| {
+                let (mut a, mut b, mut x) = (a.clone(), b.as_slice().to_vec(), vec![0.0; n]);
+                let info = lstsq_in_place(m, n, &mut a, &mut b, &mut x, ws, &options)
+                    .map(|i| format!("{i:?}"));
+                let bits = |v: &[f64]| v.iter().map(|e| e.to_bits()).collect::<Vec<_>>();
+                (
+                    info.map_err(|e| e.to_string()),
+                    bits(&x),
+                    bits(&a),
+                    bits(&b),
+                )
+            };
+            assert_eq!(run(&mut fast), run(&mut slow), "case {case} (m {m}, n {n})");
+        }
     }
 
     fn svd_solve(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {

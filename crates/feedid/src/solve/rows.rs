@@ -9,8 +9,15 @@
 //! contraction in Rust: results are bit-identical whatever the length
 //! policy and whether the caller was compiled for AVX2 ([`avx2`]).
 
-/// Whether the CPU has AVX2 (kernels compiled with `#[target_feature(enable = "avx2")]`).
+/// Whether the CPU has AVX2 (kernels compiled with `#[target_feature(enable = "avx2")]`),
+/// detected at run time: a build runs on any x86-64 CPU and selects the
+/// portable kernels where AVX2 is missing (and on other architectures).
+/// Workspaces read this once, at construction.
 pub(crate) fn avx2() -> bool {
+    #[cfg(test)]
+    if PORTABLE.with(|p| p.get()) {
+        return false;
+    }
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2")
@@ -19,6 +26,22 @@ pub(crate) fn avx2() -> bool {
     {
         false
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Tests: make [`avx2`] report `false` on this thread ([`portable`]).
+    static PORTABLE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Tests: run `f` with [`avx2`] reporting `false`, so that the workspaces it
+/// builds use the portable kernels (compared with the AVX2 ones).
+#[cfg(test)]
+pub(crate) fn portable<T>(f: impl FnOnce() -> T) -> T {
+    PORTABLE.with(|p| p.set(true));
+    let out = f();
+    PORTABLE.with(|p| p.set(false));
+    out
 }
 
 /// `y += a·x`.

@@ -656,3 +656,45 @@ fn condition_estimate_on_request_is_close_to_the_pivoted_one() {
     }
     assert!(compared > 50);
 }
+
+#[test]
+fn avx2_kernels_give_the_portable_windows_bit_for_bit() {
+    // the sliding factor's and the Hessenberg solve's kernels are chosen at
+    // run time: an estimator built with the portable ones gives exactly the
+    // same coefficients and predictions (on a CPU without AVX2 both are
+    // portable); orders 8,8 (row stride 20) and 3,2 (the general kernel, 8)
+    for (orders, (t, u, y)) in [
+        (ArxOrders::default(), random_arx8(22, 2500)),
+        (ArxOrders::new(3, 2, 1), rig_chirp(0.4)),
+        (ArxOrders::new(5, 5, 2), random_arx8(23, 1500)),
+    ] {
+        let s = Signals::new(&t, &u, &y, t[1] - t[0], 0.0);
+        let run = || {
+            let mut est = ArxConfig {
+                orders,
+                ..ArxConfig::default()
+            }
+            .build()
+            .unwrap();
+            let p = orders.n_params();
+            let (w, h, hop) = (200, 10, 10);
+            let (mut coef, mut pred) = (vec![0.0; p], vec![0.0; h]);
+            let mut bits = Vec::new();
+            let mut start = orders.lag();
+            while start + w + h <= y.len() {
+                let window = start..start + w;
+                est.fit(&s, window.clone(), &mut coef).unwrap();
+                let ok = est
+                    .predict(&s, window.clone(), window.end..window.end + h, &mut pred)
+                    .is_ok();
+                bits.push(u64::from(ok));
+                bits.extend(coef.iter().chain(&pred).map(|v| v.to_bits()));
+                start += hop;
+            }
+            bits
+        };
+        let fast = run();
+        assert!(fast.len() > 1000);
+        assert_eq!(fast, crate::solve::rows::portable(run), "{orders:?}");
+    }
+}

@@ -229,7 +229,7 @@ impl<'a> Pipeline<'a> {
         let sliding = match &method {
             // the paper's tf prediction may fall back per window: count it
             Method::Paper(paper) if paper.prediction == PredictionMode::TransferFunction => {
-                let mut estimator = paper.clone().build()?;
+                let mut estimator = (*paper).build()?;
                 let sliding = run_with_progress(&mut estimator, &signals, &config, self.progress)?;
                 let fallbacks = estimator.tf_fallbacks();
                 if fallbacks > 0 {

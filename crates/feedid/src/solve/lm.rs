@@ -333,9 +333,9 @@ impl LevenbergMarquardt {
                 self.aug.fill(0.0);
                 for j in 0..n {
                     let col = &mut self.aug[j * rows..(j + 1) * rows];
-                    for i in 0..=j.min(kmax.saturating_sub(1)) {
-                        col[i] = self.jqr[i + j * m];
-                    }
+                    // the upper triangle of R (kmax ≥ 1 rows)
+                    let top = (j + 1).min(kmax);
+                    col[..top].copy_from_slice(&self.jqr[j * m..j * m + top]);
                     let pj = perm[j];
                     col[n + j] = mu.sqrt() * self.diag[pj] / scale[pj];
                 }
@@ -360,8 +360,8 @@ impl LevenbergMarquardt {
                 let mut pred_cost = rest2;
                 for i in 0..kmax {
                     let mut v = -self.jrhs[i];
-                    for j in i..n {
-                        v += self.jqr[i + j * m] * z[j];
+                    for (j, zj) in z.iter().enumerate().skip(i) {
+                        v += self.jqr[i + j * m] * zj;
                     }
                     pred_cost += v * v;
                 }

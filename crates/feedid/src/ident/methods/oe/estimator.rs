@@ -128,8 +128,8 @@ pub enum OeJacobian {
     /// Kaufman's projected Jacobian `P⊥·∂ŷ/∂θ` at the least-squares initial
     /// state: the `β` columns exact (the simulated states), the `α` columns
     /// forward differences of the simulated output at the fixed state — no
-    /// least squares per column. About 1.5× fewer instructions per window;
-    /// it drops the term of the derivative proportional to the residual, so
+    /// least squares per column. 0–25 % less time per window in the
+    /// `methods` bench (README, "Speed"); it drops the term of the derivative proportional to the residual, so
     /// the (capped) iterations take other steps: on the rig and EMPS the
     /// errors agree within 2 %, on some members of the drive zoo they differ
     /// both ways by up to several times (as do the results of the default

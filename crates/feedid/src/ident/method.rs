@@ -155,7 +155,7 @@ impl Method {
             Method::Paper(_) | Method::Oe(_) => None,
             Method::Arx(c) => Some(c.orders),
             Method::Rls(c) => Some(c.orders),
-            Method::Auto(c) => Some(c.long.orders),
+            Method::Auto(c) => c.orders(),
         }
     }
 
@@ -176,7 +176,7 @@ impl Method {
             }
             Method::Arx(c) => c.orders = orders,
             Method::Rls(c) => c.orders = orders,
-            Method::Auto(c) => c.long.orders = orders,
+            Method::Auto(c) => c.set_orders(orders)?,
         }
         Ok(())
     }
@@ -269,8 +269,16 @@ mod tests {
         }) else {
             unreachable!()
         };
-        assert_eq!(c.long.orders, o);
-        assert_eq!(c.short.orders, AutoConfig::default().short.orders);
+        // only the reported (largest) candidate takes them
+        let d = AutoConfig::default();
+        let r = d.reported().unwrap();
+        for (i, (a, b)) in c.candidates.iter().zip(&d.candidates).enumerate() {
+            if i == r {
+                assert_eq!(a.orders(), Some(o));
+            } else {
+                assert_eq!(a, b);
+            }
+        }
         for name in ["paper", "oe"] {
             let mut m: Method = name.parse().unwrap();
             let before = m.clone();

@@ -112,6 +112,8 @@ pub struct RlsConfig {
     pub scale: f64,
     /// Distance from the frame `r₀` that moves the frame \[m\]; default 1e-3.
     pub frame_span: f64,
+    /// Poles must lie strictly inside this radius for a prediction; default 1.0.
+    pub max_pole_radius: f64,
 }
 
 impl Default for RlsConfig {
@@ -125,6 +127,7 @@ impl Default for RlsConfig {
             min_excitation: 1e-9,
             scale: 1e-3,
             frame_span: 1e-3,
+            max_pole_radius: 1.0,
         }
     }
 }
@@ -377,7 +380,45 @@ impl RlsEstimator {
     }
 }
 
-/// [`add_kernel`] with the common sizes as constants (unrolled, vectorised).
+/// Whether the CPU has AVX2 (selects the vectorised RLS update).
+pub(crate) fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// One exponentially weighted RLS update (the update of [`RlsEstimator`],
+/// shared with `auto`'s recursive candidates): `p` row-major `n×n` and
+/// exactly symmetric, `g` a scratch of length `n`, trace bound `max`
+/// (∞ = none), `avx` from [`has_avx2`]. Returns the a-priori error, or
+/// `Err(e)` if `λ + ψᵀPψ` is not positive (nothing updated).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn rls_update(
+    avx: bool,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    let n = psi.len();
+    #[cfg(target_arch = "x86_64")]
+    if avx {
+        // SAFETY: callers pass `avx` from `has_avx2`.
+        return unsafe { add_avx2(n, p, psi, theta, g, target, lambda, max) };
+    }
+    let _ = avx;
+    add_sized(n, p, psi, theta, g, target, lambda, max)
+}
+
+/// [`add_kernel`] with the sizes up to 16 as constants (unrolled, vectorised).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn add_sized(
@@ -390,7 +431,16 @@ fn add_sized(
     lambda: f64,
     max: f64,
 ) -> std::result::Result<f64, f64> {
-    add_kernel(n, p, psi, theta, g, target, lambda, max)
+    // each arm inlines the kernel with a constant size (unrolled loops)
+    macro_rules! sized {
+        ($($k:literal)*) => {
+            match n {
+                $($k => add_kernel($k, p, psi, theta, g, target, lambda, max),)*
+                _ => add_kernel(n, p, psi, theta, g, target, lambda, max),
+            }
+        };
+    }
+    sized!(2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
 }
 
 /// [`add_sized`] compiled for AVX2 (4-wide vectors). No FMA contraction
@@ -628,7 +678,7 @@ impl Estimator for RlsEstimator {
                 context: "rls prediction (no model)",
             });
         }
-        if !poles_inside(&self.theta[..orders.na], 1.0, &mut self.schur) {
+        if !poles_inside(&self.theta[..orders.na], self.config.max_pole_radius, &mut self.schur) {
             return Err(Error::InvalidModel {
                 reason: "RLS estimate has unstable poles",
             });

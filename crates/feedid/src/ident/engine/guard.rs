@@ -1,0 +1,416 @@
+//! What the engine does around every estimator: prediction intervals from
+//! the method's own scored errors, and the rejection of isolated wild
+//! samples (outliers) before any estimator fits them.
+//!
+//! # Prediction intervals
+//!
+//! Every prediction of a window is *scored* once its samples are measured:
+//! the absolute error `|y[k] − ŷ[k]|` of the prediction `j` samples ahead
+//! (`j = 0 … H−1`) joins the `j`-th history of the last
+//! [`GuardConfig::memory`] such errors. A new prediction `ŷ` at `j` samples
+//! ahead gets the interval `ŷ ± q_j`, where `q_j` is the conformal quantile
+//! of that history: its `⌈(n+1)·P⌉`-th smallest value for `n` errors and
+//! probability `P` ([`GuardConfig::interval`]; for exchangeable errors the
+//! new error lies within `q_j` with probability ≥ `P`). Until
+//! [`MIN_HISTORY`] errors are known at `j`, the half-width is the distance
+//! from the last measured position to the prediction plus the range of the
+//! measured position over the window (wide, not calibrated). The share of
+//! measured samples inside their interval is reported as the interval
+//! coverage; it is close to `P` when the recent errors are representative
+//! of the next ones, lower after a sudden change of the motion.
+//!
+//! # Outliers
+//!
+//! Before each fit, the samples measured since the last fit are compared
+//! with their most recent prediction (`j` samples ahead). A sample is an
+//! *outlier* when its error exceeds [`GuardConfig::outlier`] times the
+//! current interval half-width `q_j` (once the history at `j` is known) and
+//! the previous sample's did not: a wild sample is isolated; when the next
+//! sample is beyond the limit too, the motion has changed, and the samples
+//! are kept until their errors are within the limit again. An outlier is replaced, in what
+//! the estimators see, by its prediction: it is neither fitted nor used as
+//! the start of a prediction, and its error does not join the history. The
+//! measured value is kept for the scores: the statistics of a run are over
+//! the measured positions.
+//!
+//! All buffers are allocated in [`Guard::new`]; the per-sample work is a
+//! binary search and a shift in a sorted history of at most
+//! [`GuardConfig::memory`] values.
+
+// Negated comparisons are deliberate (they reject NaN).
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::error::{Error, Result};
+
+/// Errors needed at a step ahead before its interval is calibrated and
+/// outliers are detected there.
+pub const MIN_HISTORY: usize = 20;
+
+/// Settings of the engine's prediction intervals and outlier rejection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GuardConfig {
+    /// Probability `P` of the prediction interval, in (0, 1); default 0.95.
+    pub interval: f64,
+    /// A measured sample whose error exceeds this many interval half-widths
+    /// is an outlier (see the module doc); `None` keeps every sample;
+    /// default `Some(8.0)`.
+    pub outlier: Option<f64>,
+    /// Rate η of the interval's adaptation, in (0, 1]: after a scored error
+    /// its half-width is multiplied by `e^{η·P}` (error beyond it) or
+    /// `e^{−η·(1−P)}` (within it); default 0.1 (a jump of the errors is
+    /// caught up within tens of horizons).
+    pub adaptation: f64,
+}
+
+impl Default for GuardConfig {
+    fn default() -> Self {
+        Self {
+            interval: 0.95,
+            outlier: Some(8.0),
+            adaptation: 0.1,
+        }
+    }
+}
+
+impl GuardConfig {
+    /// Check the settings (`interval` in (0, 1), `outlier` > 1, `adaptation` in (0, 1]).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.interval > 0.0 && self.interval < 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "interval",
+                value: self.interval,
+                reason: "must be in (0, 1) (e.g. 0.95)",
+            });
+        }
+        if let Some(k) = self.outlier {
+            if !(k.is_finite() && k > 1.0) {
+                return Err(Error::InvalidParameter {
+                    name: "outlier",
+                    value: k,
+                    reason: "must be finite and > 1",
+                });
+            }
+        }
+        if !(self.adaptation > 0.0 && self.adaptation <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "interval adaptation",
+                value: self.adaptation,
+                reason: "must be in (0, 1]",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// An online estimate of the `P`-quantile of the absolute errors at one
+/// step ahead: multiplied by `up = e^{η·P}` after an error beyond it and
+/// by `down = e^{−η·(1−P)}` after one within it, so that in the long run a
+/// share `1 − P` of the errors lies beyond it.
+#[derive(Debug, Clone, Copy)]
+struct Tracker {
+    q: f64,
+    n: usize,
+}
+
+impl Tracker {
+    const NEW: Self = Self { q: 0.0, n: 0 };
+
+    fn push(&mut self, e: f64, up: f64, down: f64) {
+        if self.q == 0.0 {
+            self.q = e;
+        } else if e > self.q {
+            self.q *= up;
+        } else {
+            self.q *= down;
+        }
+        self.n += 1;
+    }
+}
+
+/// A prediction not yet fully measured.
+#[derive(Debug, Clone)]
+struct Pending {
+    start: usize,
+    len: usize,
+    values: Vec<f64>,
+}
+
+/// The engine's interval and outlier state for one run (see the module doc).
+#[derive(Debug, Clone)]
+pub struct Guard {
+    config: GuardConfig,
+    horizon: usize,
+    trackers: Vec<Tracker>,
+    up: f64,
+    down: f64,
+    /// Pending predictions, oldest first (a ring of `slots.len()`).
+    slots: Vec<Pending>,
+    first: usize,
+    count: usize,
+    /// Samples below this absolute index have been checked.
+    checked: Option<usize>,
+    /// Consecutive samples beyond the outlier limit so far.
+    run: usize,
+    outliers: usize,
+}
+
+impl Guard {
+    /// A guard for horizons of `horizon` samples made every `hop` samples.
+    pub fn new(config: GuardConfig, horizon: usize, hop: usize) -> Result<Self> {
+        config.validate()?;
+        let horizon = horizon.max(1);
+        let slots = horizon.div_ceil(hop.max(1)) + 1;
+        Ok(Self {
+            config,
+            horizon,
+            trackers: vec![Tracker::NEW; horizon],
+            up: (config.adaptation * config.interval).exp(),
+            down: (-config.adaptation * (1.0 - config.interval)).exp(),
+            slots: (0..slots)
+                .map(|_| Pending {
+                    start: 0,
+                    len: 0,
+                    values: vec![0.0; horizon],
+                })
+                .collect(),
+            first: 0,
+            count: 0,
+            checked: None,
+            run: 0,
+            outliers: 0,
+        })
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &GuardConfig {
+        &self.config
+    }
+
+    /// Forget everything (a new recording or segment).
+    pub fn reset(&mut self) {
+        self.trackers.fill(Tracker::NEW);
+        self.first = 0;
+        self.count = 0;
+        self.checked = None;
+        self.run = 0;
+        self.outliers = 0;
+    }
+
+    /// Outliers found since the reset.
+    pub fn outliers(&self) -> usize {
+        self.outliers
+    }
+
+    /// Check the samples measured since the last call, up to `end`
+    /// (exclusive): score the pending predictions on `position(k)` (the
+    /// measured value) and call `replace(k, prediction)` for each outlier.
+    pub fn observe(
+        &mut self,
+        end: usize,
+        position: impl Fn(usize) -> f64,
+        mut replace: impl FnMut(usize, f64),
+    ) {
+        let from = match self.checked {
+            Some(c) => c,
+            None => {
+                // nothing was predicted before the first window ends
+                self.checked = Some(end);
+                return;
+            }
+        };
+        let n_slots = self.slots.len();
+        for k in from..end {
+            let y = position(k);
+            // the most recent prediction of k decides whether it is an outlier
+            let mut latest: Option<(f64, usize)> = None;
+            for i in 0..self.count {
+                let p = &self.slots[(self.first + i) % n_slots];
+                if k >= p.start && k < p.start + p.len {
+                    latest = Some((p.values[k - p.start], k - p.start));
+                }
+            }
+            let mut outlier = false;
+            match (self.config.outlier, latest) {
+                (Some(limit), Some((yh, j))) if self.trackers[j].n >= MIN_HISTORY => {
+                    let q = self.trackers[j].q;
+                    let e = (y - yh).abs();
+                    if e > limit * q && e > 0.0 {
+                        // the first of a run is an outlier; a run is a change
+                        outlier = self.run == 0;
+                        self.run += 1;
+                    } else {
+                        self.run = 0;
+                    }
+                    if outlier {
+                        replace(k, yh);
+                        self.outliers += 1;
+                    }
+                }
+                _ => self.run = 0,
+            }
+            if !outlier {
+                for i in 0..self.count {
+                    let p = &self.slots[(self.first + i) % n_slots];
+                    if k >= p.start && k < p.start + p.len {
+                        let e = (y - p.values[k - p.start]).abs();
+                        if e.is_finite() {
+                            self.trackers[k - p.start].push(e, self.up, self.down);
+                        }
+                    }
+                }
+            }
+        }
+        // drop the predictions whose samples are all checked
+        while self.count > 0 {
+            let p = &self.slots[self.first];
+            if p.start + p.len <= end {
+                self.first = (self.first + 1) % n_slots;
+                self.count -= 1;
+            } else {
+                break;
+            }
+        }
+        self.checked = Some(end.max(from));
+    }
+
+    /// Record a window's prediction `values` of the samples from `start`
+    /// and write its interval bounds; `last` is the last measured position
+    /// and `spread` the range of the measured position over the window
+    /// (the interval's half-width before the errors are known).
+    pub fn predicted(
+        &mut self,
+        start: usize,
+        values: &[f64],
+        last: f64,
+        spread: f64,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) {
+        let n_slots = self.slots.len();
+        if self.count == n_slots {
+            self.first = (self.first + 1) % n_slots;
+            self.count -= 1;
+        }
+        let len = values.len().min(self.horizon);
+        let slot = &mut self.slots[(self.first + self.count) % n_slots];
+        slot.start = start;
+        slot.len = len;
+        slot.values[..len].copy_from_slice(&values[..len]);
+        self.count += 1;
+        if self.checked.is_none() {
+            self.checked = Some(start);
+        }
+        for (j, ((v, lo), hi)) in values
+            .iter()
+            .zip(lower.iter_mut())
+            .zip(upper.iter_mut())
+            .enumerate()
+            .take(len)
+        {
+            let t = &self.trackers[j];
+            let q = if t.n >= MIN_HISTORY {
+                t.q
+            } else {
+                (v - last).abs() + spread
+            };
+            *lo = v - q;
+            *hi = v + q;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tracker_settles_at_the_quantile_of_stationary_errors() {
+        // uniform errors on [0, 1): the 0.9-quantile is 0.9, and a share
+        // of about 0.1 of new errors lies beyond the tracked value
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let g = Guard::new(
+            GuardConfig {
+                interval: 0.9,
+                ..GuardConfig::default()
+            },
+            1,
+            1,
+        )
+        .unwrap();
+        let mut t = Tracker::NEW;
+        let (mut beyond, mut total, mut sum_q) = (0, 0, 0.0);
+        for i in 0..200_000 {
+            let e: f64 = rng.random();
+            if i >= 1000 {
+                total += 1;
+                beyond += usize::from(e > t.q);
+                sum_q += t.q;
+            }
+            t.push(e, g.up, g.down);
+        }
+        let share = beyond as f64 / total as f64;
+        assert!((share - 0.1).abs() < 0.005, "{share}");
+        let mean_q = sum_q / total as f64;
+        assert!((mean_q - 0.9).abs() < 0.02, "{mean_q}");
+        // scale-free: errors × 1e-6 give q × 1e-6 exactly
+        let (mut a, mut b) = (Tracker::NEW, Tracker::NEW);
+        for i in 0..1000 {
+            let e = ((i * 37 % 101) as f64) / 101.0;
+            a.push(e, g.up, g.down);
+            b.push(e * 1e-6, g.up, g.down);
+        }
+        assert!((b.q - 1e-6 * a.q).abs() <= 1e-15 * a.q);
+    }
+
+    #[test]
+    fn an_isolated_wild_sample_is_replaced_by_its_prediction_and_a_step_is_not() {
+        let mut g = Guard::new(GuardConfig::default(), 5, 5).unwrap();
+        // a ramp predicted with small errors, then a glitch, later a real step
+        let mut y: Vec<f64> = (0..400).map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64)).collect();
+        y[203] += 1e3;
+        for v in &mut y[300..] {
+            *v += 50.0;
+        }
+        let mut clean = y.clone();
+        let (mut lo, mut hi) = ([0.0; 5], [0.0; 5]);
+        let mut replaced = Vec::new();
+        let mut start = 10;
+        while start + 5 <= 400 {
+            g.observe(start, |k| y[k], |k, v| {
+                replaced.push(k);
+                clean[k] = v;
+            });
+            let pred: Vec<f64> = (start..start + 5).map(|k| k as f64 + 0.02).collect();
+            let last = clean[start - 1];
+            g.predicted(start, &pred, last, 1.0, &mut lo, &mut hi);
+            start += 5;
+        }
+        assert!(replaced.contains(&203), "{replaced:?}");
+        assert!((clean[203] - 203.02).abs() < 1e-12);
+        // the step at 300: its first sample may be taken for a glitch, the
+        // second one is kept (a second wild sample in a row is a change)
+        assert!(!replaced.contains(&301), "{replaced:?}");
+        assert_eq!(clean[301], y[301]);
+    }
+
+    #[test]
+    fn invalid_settings_are_refused() {
+        for c in [
+            GuardConfig {
+                interval: 1.0,
+                ..GuardConfig::default()
+            },
+            GuardConfig {
+                outlier: Some(0.5),
+                ..GuardConfig::default()
+            },
+            GuardConfig {
+                adaptation: 0.0,
+                ..GuardConfig::default()
+            },
+        ] {
+            assert!(c.validate().is_err());
+        }
+    }
+}

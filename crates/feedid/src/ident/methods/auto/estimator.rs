@@ -1,0 +1,380 @@
+//! The `auto` estimator: every candidate learns from every sample and
+//! predicts every horizon; each prediction is scored once measured, per
+//! regime of the command, and the candidate with the best score in the
+//! coming horizon's regime predicts.
+
+use std::ops::Range;
+
+use super::candidate::{Candidate, Predictor};
+use super::config::AutoConfig;
+use super::model;
+use crate::error::{Error, Result};
+use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::solve::Termination;
+
+/// Regimes of a horizon, scored apart: 0 = the command is still over the
+/// window and the horizon, 1 = it moves at a constant speed over the
+/// horizon and the `H` samples before it, 2 = its speed changes there.
+pub const REGIMES: usize = 3;
+
+/// Relative change of the command's speed below which it counts as constant.
+const CONSTANT_SPEED: f64 = 1e-3;
+
+/// A candidate, its pending prediction and its scores.
+#[derive(Debug, Clone)]
+struct Member {
+    predictor: Predictor,
+    /// The last prediction, not yet scored.
+    pending: Vec<f64>,
+    pending_start: usize,
+    pending_len: usize,
+    /// Regime of the pending prediction's horizon.
+    pending_regime: usize,
+    /// Exponentially weighted mean squared error per horizon \[m²\], per regime.
+    score: [f64; REGIMES],
+    scored: [usize; REGIMES],
+    /// Whether the candidate can predict (fitted).
+    ready: bool,
+}
+
+impl Member {
+    fn new(c: Candidate) -> Self {
+        Self {
+            predictor: Predictor::new(c),
+            pending: Vec::new(),
+            pending_start: 0,
+            pending_len: 0,
+            pending_regime: 2,
+            score: [0.0; REGIMES],
+            scored: [0; REGIMES],
+            ready: false,
+        }
+    }
+
+    /// The score in regime `r`, else in the first scored regime, else none.
+    fn score_in(&self, r: usize) -> Option<f64> {
+        if self.scored[r] > 0 {
+            Some(self.score[r])
+        } else {
+            (0..REGIMES)
+                .find(|&q| self.scored[q] > 0)
+                .map(|q| self.score[q])
+        }
+    }
+}
+
+/// The `auto` estimator (method name `"auto"`); see the module doc.
+#[derive(Debug, Clone)]
+pub struct AutoEstimator {
+    config: AutoConfig,
+    members: Vec<Member>,
+    selected: Option<usize>,
+    /// The candidate whose coefficients are reported.
+    reported: Option<usize>,
+    /// First sample of the first window since the reset.
+    start: Option<usize>,
+    past: Vec<f64>,
+    arx: Vec<f64>,
+    /// Regime of the next horizon (decided at the fit).
+    regime: usize,
+    /// Horizon length of the last prediction (10 before the first).
+    horizon: usize,
+}
+
+impl AutoEstimator {
+    pub(super) fn new(config: AutoConfig) -> Self {
+        let members = config.candidates.iter().map(|&c| Member::new(c)).collect();
+        let reported = config.reported();
+        let n_arx = reported
+            .and_then(|r| config.candidates[r].orders())
+            .map_or(0, |o| o.n_params());
+        Self {
+            config,
+            members,
+            selected: None,
+            reported,
+            start: None,
+            past: Vec::new(),
+            arx: vec![0.0; n_arx],
+            regime: 2,
+            horizon: 10,
+        }
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &AutoConfig {
+        &self.config
+    }
+
+    /// Index into [`AutoConfig::candidates`] of the candidate chosen at the last fit.
+    pub fn selected(&self) -> Option<usize> {
+        self.selected
+    }
+
+    /// Regime of the horizon after the last fit (see [`REGIMES`]).
+    pub fn regime(&self) -> usize {
+        self.regime
+    }
+
+    /// Each candidate's score in the current regime: its exponentially
+    /// weighted mean squared error per horizon \[m²\], `None` before its
+    /// first scored horizon.
+    pub fn scores(&self) -> impl Iterator<Item = Option<f64>> + '_ {
+        let r = self.regime;
+        self.members.iter().map(move |m| m.score_in(r))
+    }
+
+    /// Score every pending prediction on the samples now known (`< end`).
+    fn score_pending(&mut self, signals: &Signals<'_>, end: usize) {
+        let alpha = self.config.memory;
+        for m in &mut self.members {
+            if m.pending_len == 0 {
+                continue;
+            }
+            let from = m.pending_start.max(signals.offset());
+            let to = (m.pending_start + m.pending_len).min(end);
+            if let (true, Ok(w)) = (to > from, signals.window(from..to, 0, "auto scoring")) {
+                let p = &m.pending[from - m.pending_start..to - m.pending_start];
+                let mse = w
+                    .position
+                    .iter()
+                    .zip(p)
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+                    / (to - from) as f64;
+                let r = m.pending_regime;
+                if mse.is_finite() {
+                    m.score[r] = if m.scored[r] == 0 {
+                        mse
+                    } else {
+                        (1.0 - alpha) * m.score[r] + alpha * mse
+                    };
+                    m.scored[r] += 1;
+                }
+            }
+            m.pending_len = 0;
+        }
+    }
+
+    /// The ready candidate with the lowest score in the current regime
+    /// (unscored candidates last, in the order of the settings).
+    fn choose(&self) -> Option<usize> {
+        let r = self.regime;
+        let mut choice: Option<(usize, Option<f64>)> = None;
+        for (i, m) in self.members.iter().enumerate() {
+            if !m.ready {
+                continue;
+            }
+            let s = m.score_in(r);
+            let better = match (choice, s) {
+                (None, _) => true,
+                (Some((_, None)), Some(_)) => true,
+                (Some((_, Some(b))), Some(a)) => a < b,
+                _ => false,
+            };
+            if better {
+                choice = Some((i, s));
+            }
+        }
+        choice.map(|(i, _)| i)
+    }
+}
+
+/// The regime (see [`REGIMES`]) of the horizon `end..end + h` after a
+/// window starting at `from`, from the command (cut at the end of the data).
+fn regime(signals: &Signals<'_>, from: usize, end: usize, h: usize) -> usize {
+    let to = (end + h).min(signals.end());
+    let Ok(w) = signals.window(from..to, 0, "auto regime") else {
+        return 2;
+    };
+    let u = w.command;
+    let Some(&u0) = u.first() else {
+        return 2;
+    };
+    if u.iter().all(|&v| v == u0) {
+        return 0;
+    }
+    // the speed over the horizon and the h samples before it
+    let tail = &u[u.len().saturating_sub(2 * h + 1)..];
+    let (mut d1, mut d2) = (0.0f64, 0.0f64);
+    for p in tail.windows(3) {
+        d1 = d1.max((p[2] - p[1]).abs());
+        d2 = d2.max((p[2] - 2.0 * p[1] + p[0]).abs());
+    }
+    if d2 <= CONSTANT_SPEED * d1 {
+        1
+    } else {
+        2
+    }
+}
+
+/// The last measured position and the largest plausible excursion from it
+/// over the horizon: the command's largest distance from it over the
+/// horizon plus the horizon length times the largest measured step over
+/// the window (a still axis with a still command: 0).
+fn plausible_excursion(
+    signals: &Signals<'_>,
+    window: Range<usize>,
+    horizon: Range<usize>,
+) -> Result<(f64, f64)> {
+    let w = signals.window(window.start..horizon.end, 0, "auto window")?;
+    let we = window.end - window.start;
+    if we == 0 {
+        return Err(Error::TooFewSamples {
+            what: "auto window",
+            needed: 1,
+            actual: 0,
+        });
+    }
+    let y = &w.position[..we];
+    let last = y[we - 1];
+    let du = w.command[we..]
+        .iter()
+        .fold(0.0f64, |m, u| m.max((u - last).abs()));
+    let dy = y.windows(2).fold(0.0f64, |m, p| m.max((p[1] - p[0]).abs()));
+    Ok((last, du + (horizon.len() as f64) * dy))
+}
+
+impl Estimator for AutoEstimator {
+    fn name(&self) -> &'static str {
+        "auto"
+    }
+
+    /// `candidate` (index into [`AutoConfig::candidates`]; −1 while none
+    /// is fitted and the last position is held),
+    /// `expected_error_m` (its recent rms error over a horizon of the
+    /// coming regime), then the ARX coefficients `a1 …, b_nk …` of the
+    /// reported candidate ([`AutoConfig::reported`], the one `--order` sets).
+    fn coefficient_names(&self) -> Vec<String> {
+        let mut names = vec!["candidate".to_string(), "expected_error_m".to_string()];
+        if let Some(o) = self
+            .reported
+            .and_then(|r| self.config.candidates[r].orders())
+        {
+            names.extend(o.coefficient_names());
+        }
+        names
+    }
+
+    fn warm_up(&self) -> usize {
+        self.config
+            .candidates
+            .iter()
+            .map(Candidate::warm_up)
+            .max()
+            .unwrap_or(1)
+    }
+
+    fn reset(&mut self) {
+        for m in &mut self.members {
+            *m = Member::new(*m.predictor.spec());
+        }
+        self.selected = None;
+        self.start = None;
+        self.regime = 2;
+    }
+
+    fn fit(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        coef: &mut [f64],
+    ) -> Result<WindowFit> {
+        if window.is_empty() || window.end > signals.end() {
+            return Err(Error::TooFewSamples {
+                what: "auto window",
+                needed: window.end.max(signals.offset() + 1),
+                actual: signals.end(),
+            });
+        }
+        self.score_pending(signals, window.end);
+        self.regime = regime(signals, window.start, window.end, self.horizon);
+        let start = *self.start.get_or_insert(window.start);
+        for m in &mut self.members {
+            m.ready = m.predictor.fit(signals, start, window.end);
+        }
+        self.selected = self.choose();
+        coef.fill(0.0);
+        if let Some(x) = coef.get_mut(0) {
+            *x = self.selected.map_or(-1.0, |c| c as f64);
+        }
+        if let (Some(x), Some(c)) = (coef.get_mut(1), self.selected) {
+            *x = self.members[c].score_in(self.regime).map_or(0.0, f64::sqrt);
+        }
+        if let Some(r) = self.reported {
+            let p = &self.members[r].predictor;
+            if let (Some(o), Some(rest)) = (p.spec().orders(), coef.get_mut(2..)) {
+                let n = o.n_params().min(rest.len()).min(self.arx.len());
+                model::arx_coefficients(&o, p.theta(), &mut self.arx);
+                rest[..n].copy_from_slice(&self.arx[..n]);
+            }
+        }
+        Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+    }
+
+    /// The chosen candidate's prediction; if it cannot predict (or its
+    /// prediction is implausible), the best-scored candidate that can.
+    fn predict(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        horizon: Range<usize>,
+        out: &mut [f64],
+    ) -> Result<PredictStatus> {
+        let h = out.len();
+        self.horizon = h.max(1);
+        let (last, bound) = plausible_excursion(signals, window, horizon.clone())?;
+        let limit = self.config.plausibility * bound;
+        for m in &mut self.members {
+            m.pending_len = 0;
+            if !m.ready {
+                continue;
+            }
+            if m.pending.len() < h {
+                m.pending.resize(h, 0.0);
+            }
+            let buf = &mut m.pending[..h];
+            if m
+                .predictor
+                .predict(signals, horizon.clone(), &mut self.past, buf)
+                .is_ok()
+                && buf.iter().all(|p| (p - last).abs() <= limit)
+            {
+                m.pending_start = horizon.start;
+                m.pending_len = h;
+                m.pending_regime = self.regime;
+            }
+        }
+        let usable = |m: &Member| m.pending_len == h;
+        let chosen = match self.selected {
+            Some(c) if usable(&self.members[c]) => Some(c),
+            _ => {
+                let r = self.regime;
+                let mut best: Option<(usize, Option<f64>)> = None;
+                for (i, m) in self.members.iter().enumerate().filter(|(_, m)| usable(m)) {
+                    let s = m.score_in(r);
+                    let better = match (best, s) {
+                        (None, _) | (Some((_, None)), Some(_)) => true,
+                        (Some((_, Some(b))), Some(a)) => a < b,
+                        _ => false,
+                    };
+                    if better {
+                        best = Some((i, s));
+                    }
+                }
+                best.map(|(i, _)| i)
+            }
+        };
+        match chosen {
+            Some(c) => {
+                out.copy_from_slice(&self.members[c].pending[..h]);
+                Ok(PredictStatus::Predicted)
+            }
+            // every candidate is implausible or unfitted: hold the last position
+            None => {
+                out.fill(last);
+                Ok(PredictStatus::Predicted)
+            }
+        }
+    }
+}

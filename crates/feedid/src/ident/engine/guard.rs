@@ -24,10 +24,13 @@
 //! Before each fit, the samples measured since the last fit are compared
 //! with their most recent prediction (`j` samples ahead). A sample is an
 //! *outlier* when its error exceeds [`GuardConfig::outlier`] times the
-//! current interval half-width `q_j` (once the history at `j` is known) and
-//! the previous sample's did not: a wild sample is isolated; when the next
-//! sample is beyond the limit too, the motion has changed, and the samples
-//! are kept until their errors are within the limit again. An outlier is replaced, in what
+//! error scale at `j` — the exponentially weighted rms of the recent errors
+//! there (weight η, [`GuardConfig::adaptation`]), at least the resolution
+//! of the data (the smallest non-zero change between consecutive samples,
+//! one count of a quantised encoder) — once [`MIN_HISTORY`] errors are
+//! known at `j`, and the `H` samples before it were within their limits:
+//! a wild sample is isolated; a sample beyond the limit right after
+//! another is a change of the motion and is kept. An outlier is replaced, in what
 //! the estimators see, by its prediction: it is neither fitted nor used as
 //! the start of a prediction, and its error does not join the history. The
 //! measured value is kept for the scores: the statistics of a run are over
@@ -149,8 +152,15 @@ pub struct Guard {
     count: usize,
     /// Samples below this absolute index have been checked.
     checked: Option<usize>,
-    /// Consecutive samples beyond the outlier limit so far.
-    run: usize,
+    /// Consecutive samples within their outlier limit so far.
+    calm: usize,
+    /// Exponentially weighted mean squared error per step ahead \[m²\].
+    mean_square: Vec<f64>,
+    /// Smallest non-zero change between consecutive measured samples \[m\]
+    /// (the encoder's resolution, for quantised data).
+    resolution: f64,
+    /// The last measured sample (for the resolution).
+    last: Option<f64>,
     outliers: usize,
 }
 
@@ -176,7 +186,10 @@ impl Guard {
             first: 0,
             count: 0,
             checked: None,
-            run: 0,
+            calm: 0,
+            mean_square: vec![0.0; horizon],
+            resolution: f64::INFINITY,
+            last: None,
             outliers: 0,
         })
     }
@@ -192,7 +205,10 @@ impl Guard {
         self.first = 0;
         self.count = 0;
         self.checked = None;
-        self.run = 0;
+        self.calm = 0;
+        self.mean_square.fill(0.0);
+        self.resolution = f64::INFINITY;
+        self.last = None;
         self.outliers = 0;
     }
 
@@ -229,32 +245,47 @@ impl Guard {
                     latest = Some((p.values[k - p.start], k - p.start));
                 }
             }
+            if let Some(prev) = self.last {
+                let d = (y - prev).abs();
+                if d > 0.0 && d < self.resolution {
+                    self.resolution = d;
+                }
+            }
+            self.last = Some(y);
             let mut outlier = false;
             match (self.config.outlier, latest) {
-                (Some(limit), Some((yh, j))) if self.trackers[j].n >= MIN_HISTORY => {
-                    let q = self.trackers[j].q;
+                (Some(factor), Some((yh, j))) if self.trackers[j].n >= MIN_HISTORY => {
+                    let scale = self.mean_square[j].sqrt().max(self.resolution);
                     let e = (y - yh).abs();
-                    if e > limit * q && e > 0.0 {
-                        // the first of a run is an outlier; a run is a change
-                        outlier = self.run == 0;
-                        self.run += 1;
+                    if e > factor * scale {
+                        // isolated: the previous H samples were within their limits
+                        outlier = self.calm >= self.horizon;
+                        self.calm = 0;
                     } else {
-                        self.run = 0;
+                        self.calm += 1;
                     }
                     if outlier {
                         replace(k, yh);
                         self.outliers += 1;
                     }
                 }
-                _ => self.run = 0,
+                _ => self.calm = 0,
             }
             if !outlier {
+                let w = self.config.adaptation;
                 for i in 0..self.count {
                     let p = &self.slots[(self.first + i) % n_slots];
                     if k >= p.start && k < p.start + p.len {
-                        let e = (y - p.values[k - p.start]).abs();
+                        let j = k - p.start;
+                        let e = (y - p.values[j]).abs();
                         if e.is_finite() {
-                            self.trackers[k - p.start].push(e, self.up, self.down);
+                            self.trackers[j].push(e, self.up, self.down);
+                            let ms = &mut self.mean_square[j];
+                            *ms = if self.trackers[j].n == 1 {
+                                e * e
+                            } else {
+                                (1.0 - w) * *ms + w * e * e
+                            };
                         }
                     }
                 }

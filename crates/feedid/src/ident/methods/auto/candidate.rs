@@ -14,8 +14,9 @@ use crate::ident::methods::rls::{has_avx2, rls_update};
 use crate::ident::{ArxOrders, Signals};
 
 /// Initial covariance `P₀ = p0·I` of the recursive candidates, in
-/// coordinates scaled by the first informative window's largest regressor:
-/// a weak prior, learnt over within a few dozen samples.
+/// coordinates scaled by the largest regressor of the first informative
+/// window (and the bound on `tr P / n`): a weak prior, learnt over within a
+/// few dozen samples.
 const P0: f64 = 1e6;
 
 /// One candidate predictor of `auto`.
@@ -218,6 +219,22 @@ impl Predictor {
     /// Free parameters of the unit-gain model (empty for hold and command).
     pub(crate) fn theta(&self) -> &[f64] {
         &self.theta
+    }
+
+    /// Forget the model but keep the position in the data (a model that
+    /// predicted implausibly starts learning again from the next sample).
+    pub(crate) fn restart(&mut self) {
+        let cursor = match &self.state {
+            State::Recursive(r) => r.cursor,
+            State::Windowed(l) => l.cursor,
+            State::Plain => None,
+        };
+        self.reset();
+        match &mut self.state {
+            State::Recursive(r) => r.cursor = cursor,
+            State::Windowed(l) => l.cursor = cursor,
+            State::Plain => {}
+        }
     }
 
     /// Forget all state.

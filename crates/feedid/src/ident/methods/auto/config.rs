@@ -17,10 +17,10 @@ pub struct AutoConfig {
     /// in (0, 1]; default 0.1 (chosen on the drive zoo).
     pub memory: f64,
     /// A candidate's prediction is discarded when it leaves the last
-    /// measured position by more than this factor times the plausible
-    /// excursion (the command's largest distance from that position over
-    /// the horizon plus `H` times the largest measured step in the window),
-    /// ≥ 1; default 4.
+    /// measured position by more than this factor times the experienced
+    /// motion (the largest range of the measured position over `H + 1`
+    /// consecutive samples so far), ≥ 1; default 4. Until the axis has
+    /// moved, only predictions that stay where it is pass.
     pub plausibility: f64,
 }
 

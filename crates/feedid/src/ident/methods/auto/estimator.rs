@@ -79,6 +79,11 @@ pub struct AutoEstimator {
     regime: usize,
     /// Horizon length of the last prediction (10 before the first).
     horizon: usize,
+    /// Largest range of the measured position over `H + 1` consecutive
+    /// samples seen so far \[m\] (the experienced motion over a horizon).
+    experience: f64,
+    /// Samples below this index are in `experience`.
+    experienced_to: usize,
 }
 
 impl AutoEstimator {
@@ -98,6 +103,8 @@ impl AutoEstimator {
             arx: vec![0.0; n_arx],
             regime: 2,
             horizon: 10,
+            experience: 0.0,
+            experienced_to: 0,
         }
     }
 
@@ -156,6 +163,26 @@ impl AutoEstimator {
         }
     }
 
+    /// Extend the experienced motion over the samples measured up to `end`.
+    fn learn_experience(&mut self, signals: &Signals<'_>, end: usize) {
+        let h = self.horizon;
+        let from = self.experienced_to.max(signals.offset() + h).min(end);
+        if let Ok(w) = signals.window(from..end, h, "auto experience") {
+            let y = w.position;
+            for k in h..y.len() {
+                let (mut lo, mut hi) = (y[k], y[k]);
+                for &v in &y[k - h..k] {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+                if hi - lo > self.experience {
+                    self.experience = hi - lo;
+                }
+            }
+        }
+        self.experienced_to = end.max(self.experienced_to);
+    }
+
     /// The ready candidate with the lowest score in the current regime
     /// (unscored candidates last, in the order of the settings).
     fn choose(&self) -> Option<usize> {
@@ -208,31 +235,10 @@ fn regime(signals: &Signals<'_>, from: usize, end: usize, h: usize) -> usize {
     }
 }
 
-/// The last measured position and the largest plausible excursion from it
-/// over the horizon: the command's largest distance from it over the
-/// horizon plus the horizon length times the largest measured step over
-/// the window (a still axis with a still command: 0).
-fn plausible_excursion(
-    signals: &Signals<'_>,
-    window: Range<usize>,
-    horizon: Range<usize>,
-) -> Result<(f64, f64)> {
-    let w = signals.window(window.start..horizon.end, 0, "auto window")?;
-    let we = window.end - window.start;
-    if we == 0 {
-        return Err(Error::TooFewSamples {
-            what: "auto window",
-            needed: 1,
-            actual: 0,
-        });
-    }
-    let y = &w.position[..we];
-    let last = y[we - 1];
-    let du = w.command[we..]
-        .iter()
-        .fold(0.0f64, |m, u| m.max((u - last).abs()));
-    let dy = y.windows(2).fold(0.0f64, |m, p| m.max((p[1] - p[0]).abs()));
-    Ok((last, du + (horizon.len() as f64) * dy))
+/// The last measured position of the window.
+fn last_position(signals: &Signals<'_>, window: Range<usize>) -> Result<f64> {
+    let w = signals.window(window.end..window.end, 1, "auto window")?;
+    Ok(w.position[0])
 }
 
 impl Estimator for AutoEstimator {
@@ -272,6 +278,8 @@ impl Estimator for AutoEstimator {
         self.selected = None;
         self.start = None;
         self.regime = 2;
+        self.experience = 0.0;
+        self.experienced_to = 0;
     }
 
     fn fit(
@@ -288,6 +296,7 @@ impl Estimator for AutoEstimator {
             });
         }
         self.score_pending(signals, window.end);
+        self.learn_experience(signals, window.end);
         self.regime = regime(signals, window.start, window.end, self.horizon);
         let start = *self.start.get_or_insert(window.start);
         for m in &mut self.members {
@@ -323,8 +332,8 @@ impl Estimator for AutoEstimator {
     ) -> Result<PredictStatus> {
         let h = out.len();
         self.horizon = h.max(1);
-        let (last, bound) = plausible_excursion(signals, window, horizon.clone())?;
-        let limit = self.config.plausibility * bound;
+        let last = last_position(signals, window)?;
+        let limit = self.config.plausibility * self.experience;
         for m in &mut self.members {
             m.pending_len = 0;
             if !m.ready {
@@ -334,15 +343,18 @@ impl Estimator for AutoEstimator {
                 m.pending.resize(h, 0.0);
             }
             let buf = &mut m.pending[..h];
-            if m
+            let ok = m
                 .predictor
                 .predict(signals, horizon.clone(), &mut self.past, buf)
-                .is_ok()
-                && buf.iter().all(|p| (p - last).abs() <= limit)
-            {
+                .is_ok();
+            if ok && buf.iter().all(|p| (p - last).abs() <= limit) {
                 m.pending_start = horizon.start;
                 m.pending_len = h;
                 m.pending_regime = self.regime;
+            } else if ok && self.experience > 0.0 {
+                // an implausible model (wound up, or fitted on noise) learns again
+                m.predictor.restart();
+                m.ready = false;
             }
         }
         let usable = |m: &Member| m.pending_len == h;

@@ -28,9 +28,12 @@
 //! there (weight η, [`GuardConfig::adaptation`]), at least the resolution
 //! of the data (the smallest non-zero change between consecutive samples,
 //! one count of a quantised encoder) — once [`MIN_HISTORY`] errors are
-//! known at `j`, and the `H` samples before it were within their limits:
-//! a wild sample is isolated; a sample beyond the limit right after
-//! another is a change of the motion and is kept. An outlier is replaced, in what
+//! known at `j`, while the samples just before and after it are within
+//! theirs: a wild sample is isolated, two in a row are a change of the
+//! motion and are kept. The last sample before a fit has no successor yet:
+//! it is an outlier only if its error also exceeds the factor times the
+//! largest change of the position over `H` samples seen so far (a jump no
+//! motion of the recording could make). An outlier is replaced, in what
 //! the estimators see, by its prediction: it is neither fitted nor used as
 //! the start of a prediction, and its error does not join the history. The
 //! measured value is kept for the scores: the statistics of a run are over
@@ -130,6 +133,17 @@ impl Tracker {
     }
 }
 
+/// A newly measured sample during [`Guard::observe`].
+#[derive(Debug, Clone, Copy)]
+struct Checked {
+    y: f64,
+    /// Its latest prediction and how many samples ahead it was made.
+    latest: Option<(f64, usize)>,
+    /// `|y − prediction|` (0 without a prediction).
+    excess: f64,
+    exceeds: bool,
+}
+
 /// A prediction not yet fully measured.
 #[derive(Debug, Clone)]
 struct Pending {
@@ -152,8 +166,15 @@ pub struct Guard {
     count: usize,
     /// Samples below this absolute index have been checked.
     checked: Option<usize>,
-    /// Consecutive samples within their outlier limit so far.
-    calm: usize,
+    /// Whether the last checked sample exceeded its outlier limit.
+    previous_exceeds: bool,
+    /// The samples of the current check (scratch).
+    batch: Vec<Checked>,
+    /// The last `H` cleaned samples (a ring) and how many were seen.
+    recent: Vec<f64>,
+    seen: usize,
+    /// Largest change of the cleaned position over `H` samples so far \[m\].
+    motion: f64,
     /// Exponentially weighted mean squared error per step ahead \[m²\].
     mean_square: Vec<f64>,
     /// Smallest non-zero change between consecutive measured samples \[m\]
@@ -186,7 +207,11 @@ impl Guard {
             first: 0,
             count: 0,
             checked: None,
-            calm: 0,
+            previous_exceeds: false,
+            batch: Vec::new(),
+            recent: vec![0.0; horizon],
+            seen: 0,
+            motion: 0.0,
             mean_square: vec![0.0; horizon],
             resolution: f64::INFINITY,
             last: None,
@@ -205,7 +230,9 @@ impl Guard {
         self.first = 0;
         self.count = 0;
         self.checked = None;
-        self.calm = 0;
+        self.previous_exceeds = false;
+        self.seen = 0;
+        self.motion = 0.0;
         self.mean_square.fill(0.0);
         self.resolution = f64::INFINITY;
         self.last = None;
@@ -235,9 +262,11 @@ impl Guard {
             }
         };
         let n_slots = self.slots.len();
+        // pass 1: each new sample, its latest prediction and whether its
+        // error exceeds the limit
+        self.batch.clear();
         for k in from..end {
             let y = position(k);
-            // the most recent prediction of k decides whether it is an outlier
             let mut latest: Option<(f64, usize)> = None;
             for i in 0..self.count {
                 let p = &self.slots[(self.first + i) % n_slots];
@@ -245,39 +274,74 @@ impl Guard {
                     latest = Some((p.values[k - p.start], k - p.start));
                 }
             }
+            let limit = |j: usize| {
+                self.config.outlier.filter(|_| self.trackers[j].n >= MIN_HISTORY).map(|f| {
+                    f * self.mean_square[j].sqrt().max(self.resolution)
+                })
+            };
+            let (excess, exceeds) = match latest {
+                Some((yh, j)) => {
+                    let e = (y - yh).abs();
+                    (e, limit(j).is_some_and(|l| e > l))
+                }
+                None => (0.0, false),
+            };
+            self.batch.push(Checked {
+                y,
+                latest,
+                excess,
+                exceeds,
+            });
+        }
+        // pass 2: an outlier exceeds its limit, the samples on both sides do
+        // not; the last sample (its successor unknown) must also exceed the
+        // largest motion over a horizon seen so far
+        let n = self.batch.len();
+        for i in 0..n {
+            let c = self.batch[i];
+            let k = from + i;
+            let before = if i == 0 {
+                self.previous_exceeds
+            } else {
+                self.batch[i - 1].exceeds
+            };
+            let outlier = c.exceeds
+                && !before
+                && if i + 1 < n {
+                    !self.batch[i + 1].exceeds
+                } else {
+                    c.excess > self.config.outlier.unwrap_or(f64::INFINITY) * self.motion
+                };
+            let y_clean = match (outlier, c.latest) {
+                (true, Some((yh, _))) => {
+                    replace(k, yh);
+                    self.outliers += 1;
+                    yh
+                }
+                _ => c.y,
+            };
             if let Some(prev) = self.last {
-                let d = (y - prev).abs();
+                let d = (c.y - prev).abs();
                 if d > 0.0 && d < self.resolution {
                     self.resolution = d;
                 }
             }
-            self.last = Some(y);
-            let mut outlier = false;
-            match (self.config.outlier, latest) {
-                (Some(factor), Some((yh, j))) if self.trackers[j].n >= MIN_HISTORY => {
-                    let scale = self.mean_square[j].sqrt().max(self.resolution);
-                    let e = (y - yh).abs();
-                    if e > factor * scale {
-                        // isolated: the previous H samples were within their limits
-                        outlier = self.calm >= self.horizon;
-                        self.calm = 0;
-                    } else {
-                        self.calm += 1;
-                    }
-                    if outlier {
-                        replace(k, yh);
-                        self.outliers += 1;
-                    }
-                }
-                _ => self.calm = 0,
+            self.last = Some(c.y);
+            // the largest motion over a horizon, on the cleaned samples
+            let h = self.recent.len();
+            if self.seen >= h {
+                let old = self.recent[self.seen % h];
+                self.motion = self.motion.max((y_clean - old).abs());
             }
+            self.recent[self.seen % h] = y_clean;
+            self.seen += 1;
             if !outlier {
                 let w = self.config.adaptation;
-                for i in 0..self.count {
-                    let p = &self.slots[(self.first + i) % n_slots];
+                for s in 0..self.count {
+                    let p = &self.slots[(self.first + s) % n_slots];
                     if k >= p.start && k < p.start + p.len {
                         let j = k - p.start;
-                        let e = (y - p.values[j]).abs();
+                        let e = (c.y - p.values[j]).abs();
                         if e.is_finite() {
                             self.trackers[j].push(e, self.up, self.down);
                             let ms = &mut self.mean_square[j];
@@ -290,6 +354,9 @@ impl Guard {
                     }
                 }
             }
+        }
+        if let Some(c) = self.batch.last() {
+            self.previous_exceeds = c.exceeds;
         }
         // drop the predictions whose samples are all checked
         while self.count > 0 {

@@ -45,7 +45,7 @@ impl AutoConfig {
             Candidate::Windowed {
                 orders: ArxOrders::new(2, 2, 0),
                 window: 100,
-                ridge: 0.0,
+                ridge: 1e-6,
             },
             rls(3, 3, 0.995),
             rls(4, 4, 0.999),

@@ -347,7 +347,8 @@ fn score(m: &ZooMember) -> Vec<Row> {
                 rms: own.map(|o| o.0),
                 max: own.map(|o| o.1),
                 coverage: 100.0 * predicted as f64 / n as f64,
-                coverage_after: 100.0 * p.has[p.first.min(n)..].iter().filter(|&&h| h).count() as f64
+                coverage_after: 100.0
+                    * p.has[p.first.min(n)..].iter().filter(|&&h| h).count() as f64
                     / (n - p.first.min(n)).max(1) as f64,
                 ratio,
                 beaten_by: worst.filter(|w| w.1 > 1.0).map(|w| w.0),
@@ -383,8 +384,11 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
 
 fn parse_members(s: &str, zoo: &Zoo) -> Result<Vec<usize>, String> {
     let n = zoo.len();
-    let bad =
-        || format!("invalid --members `{s}` (all, regular, even, odd, gapped, small, A..B, A..=B, 1,5,9)");
+    let bad = || {
+        format!(
+            "invalid --members `{s}` (all, regular, even, odd, gapped, small, A..B, A..=B, 1,5,9)"
+        )
+    };
     let v: Vec<usize> = match s {
         "all" => (0..n).collect(),
         "regular" => zoo.regular().collect(),

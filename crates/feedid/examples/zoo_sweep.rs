@@ -51,6 +51,7 @@ fn parse(cfg: &str) -> Result<(Method, usize), String> {
                 (Method::Arx(c), "ridge") => c.ridge = f()?,
                 (Method::Arx(c), "minx") => c.min_excitation = f()?,
                 (Method::Arx(c), "dc") => c.dc_gain_bounds = (-f64::INFINITY, f64::INFINITY),
+                (Method::Arx(c), "dcw") => c.dc_gain_bounds = (1.0 / f()?, f()?),
                 (Method::Arx(c), "offset") => c.offset = v == "1",
                 (Method::Arx(c), "radius") => c.max_pole_radius = f()?,
                 (Method::Arx(c), "refac") => c.refactor_every = v.parse().unwrap(),
@@ -58,7 +59,7 @@ fn parse(cfg: &str) -> Result<(Method, usize), String> {
                 (Method::Rls(c), "lambda") => c.lambda = f()?,
                 (Method::Rls(c), "p0") => c.p0 = f()?,
                 (Method::Rls(c), "minx") => c.min_excitation = f()?,
-                (Method::Rls(c), "scale") => c.scale = f()?,
+                (Method::Rls(c), "scale") => c.scale = Some(f()?),
                 (Method::Rls(c), "span") => c.frame_span = f()?,
                 (Method::Auto(c), "cands") => c.candidates = v.split(';').map(cand).collect(),
                 (Method::Auto(c), "mem") => c.memory = f()?,
@@ -100,7 +101,9 @@ fn arx220f(u: &[f64], y: &[f64], frame: bool) -> (Vec<f64>, Vec<bool>) {
             let (mut y1, mut y2) = (y[t0 - 1] - r, y[t0 - 2] - r);
             let end = (t0 + H).min(n);
             for k in t0..end {
-                let p = -theta[0] * y1 - theta[1] * y2 + theta[2] * (u[k] - r) + theta[3] * (u[k - 1] - r);
+                let p = -theta[0] * y1 - theta[1] * y2
+                    + theta[2] * (u[k] - r)
+                    + theta[3] * (u[k - 1] - r);
                 value[k] = p + r;
                 has[k] = p.is_finite();
                 y2 = y1;
@@ -165,6 +168,38 @@ fn main() {
     for c in configs.iter().filter(|c| !c.starts_with("arx220")) {
         parse(c).unwrap();
     }
+    if set == "emps" {
+        use feedid::io::{read_recording, ChannelRef, ReadOptions};
+        let rec = read_recording(
+            std::path::Path::new("../shared/data/emps/DATA_EMPS.mat"),
+            &ReadOptions {
+                time: Some(ChannelRef::Name("t".into())),
+                command: Some(ChannelRef::Name("qg".into())),
+                position: Some(ChannelRef::Name("qm".into())),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        for c in &configs {
+            let (spec, w) = parse(c).unwrap();
+            let mut est = spec.build().unwrap();
+            let cfg = EngineConfig {
+                window: w,
+                horizon: H,
+                hop: None,
+                warm_up: 0,
+            };
+            let r = engine::run(&mut est, &rec.signals(), &cfg).unwrap();
+            println!(
+                "{c:60} rms {:.3} µm max {:.2} µm coverage {:.1} % interval {:.1} %",
+                r.stats.rms * 1e6,
+                r.stats.max_abs * 1e6,
+                100.0 * r.stats.samples as f64 / rec.len() as f64,
+                r.interval_coverage_percent().unwrap_or(f64::NAN)
+            );
+        }
+        return;
+    }
     let zoo = Zoo::standard();
     let members: Vec<usize> = zoo
         .regular()
@@ -198,18 +233,19 @@ fn main() {
                 } else if let Some(w) = c.strip_prefix("arx220unit") {
                     arx220unit(&m.command, y, w.trim().parse().unwrap_or(100))
                 } else {
-                let (spec, w) = parse(c).unwrap();
-                let mut est = spec.build().unwrap();
-                let cfg = EngineConfig {
-                    window: w,
-                    horizon: H,
-                    hop: None,
-                    warm_up: 0,
+                    let (spec, w) = parse(c).unwrap();
+                    let mut est = spec.build().unwrap();
+                    let cfg = EngineConfig {
+                        window: w,
+                        horizon: H,
+                        hop: None,
+                        warm_up: 0,
+                    };
+                    match engine::run(&mut est, &s, &cfg) {
+                        Ok(r) => (r.predicted, r.has_prediction),
+                        Err(_) => (vec![0.0; n], vec![false; n]),
+                    }
                 };
-                match engine::run(&mut est, &s, &cfg) {
-                    Ok(r) => (r.predicted, r.has_prediction),
-                    Err(_) => (vec![0.0; n], vec![false; n]),
-                }};
                 let secs = t.elapsed().as_secs_f64();
                 let (mut se, mut cnt, mut seb, mut cb) = (0.0, 0usize, 0.0, 0usize);
                 for k in 0..n {
@@ -232,10 +268,22 @@ fn main() {
                 let _ = cb;
                 rows.push(format!(
                     "{i},\"{c}\",{},{},{},{},{},{secs:.4},{}",
-                    if cnt > 0 { (se / cnt as f64).sqrt() } else { f64::NAN },
+                    if cnt > 0 {
+                        (se / cnt as f64).sqrt()
+                    } else {
+                        f64::NAN
+                    },
                     100.0 * cnt as f64 / n as f64,
-                    if c2 > 0 { (se2 / c2 as f64).sqrt() } else { f64::NAN },
-                    if c2 > 0 { (seb / c2 as f64).sqrt() } else { f64::NAN },
+                    if c2 > 0 {
+                        (se2 / c2 as f64).sqrt()
+                    } else {
+                        f64::NAN
+                    },
+                    if c2 > 0 {
+                        (seb / c2 as f64).sqrt()
+                    } else {
+                        f64::NAN
+                    },
                     n,
                     m.spec.plant.name()
                 ));
@@ -243,11 +291,17 @@ fn main() {
             rows
         })
         .collect();
-    let mut text = String::from("member,config,rms,coverage,rms_shared_arx220,arx220_rms,n,secs,plant\n");
+    let mut text =
+        String::from("member,config,rms,coverage,rms_shared_arx220,arx220_rms,n,secs,plant\n");
     for r in rows {
         text += &r;
         text += "\n";
     }
     std::fs::write(&out, text).unwrap();
-    eprintln!("{} configs × {} members in {:.1} s", configs.len(), members.len(), t.elapsed().as_secs_f64());
+    eprintln!(
+        "{} configs × {} members in {:.1} s",
+        configs.len(),
+        members.len(),
+        t.elapsed().as_secs_f64()
+    );
 }

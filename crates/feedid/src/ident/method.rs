@@ -123,7 +123,7 @@ impl Method {
     pub fn default_window(&self) -> usize {
         match self {
             Method::Paper(_) => 20,
-            Method::Arx(_) => 200,
+            Method::Arx(_) => 100,
             Method::Rls(_) => 100,
             Method::Oe(_) => 200,
             Method::Auto(_) => 50,

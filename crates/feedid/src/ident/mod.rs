@@ -22,15 +22,15 @@ pub use analysis::{
 };
 pub use engine::{
     batch, stream, EngineConfig, Estimator, FitStatus, GuardConfig, PredictStatus, Prediction,
-    Samples, Signals,
-    SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit, WindowOutcome, WindowRecord,
+    Samples, Signals, SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit,
+    WindowOutcome, WindowRecord,
 };
 pub use method::{Method, METHOD_NAMES};
 pub use methods::{
     coefficients_from_polynomials, fit_arx, fit_oe, polynomials_from_coefficients, ArxConfig,
-    ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, Candidate, OeConfig,
-    OeEstimator, OeFit, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig,
-    RlsEstimator, SimplexSettings, Solver, TimeOrigin, MAX_ARX_ORDER,
+    ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, Candidate,
+    OeConfig, OeEstimator, OeFit, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode,
+    RlsConfig, RlsEstimator, SimplexSettings, Solver, TimeOrigin, MAX_ARX_ORDER,
     SHIFT_AMPLIFICATION_WARNING,
 };
 pub use model::{

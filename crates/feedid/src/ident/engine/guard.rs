@@ -275,9 +275,10 @@ impl Guard {
                 }
             }
             let limit = |j: usize| {
-                self.config.outlier.filter(|_| self.trackers[j].n >= MIN_HISTORY).map(|f| {
-                    f * self.mean_square[j].sqrt().max(self.resolution)
-                })
+                self.config
+                    .outlier
+                    .filter(|_| self.trackers[j].n >= MIN_HISTORY)
+                    .map(|f| f * self.mean_square[j].sqrt().max(self.resolution))
             };
             let (excess, exceeds) = match latest {
                 Some((yh, j)) => {
@@ -465,7 +466,9 @@ mod tests {
     fn an_isolated_wild_sample_is_replaced_by_its_prediction_and_a_step_is_not() {
         let mut g = Guard::new(GuardConfig::default(), 5, 5).unwrap();
         // a ramp predicted with small errors, then a glitch, later a real step
-        let mut y: Vec<f64> = (0..400).map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64)).collect();
+        let mut y: Vec<f64> = (0..400)
+            .map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64))
+            .collect();
         y[203] += 1e3;
         for v in &mut y[300..] {
             *v += 50.0;
@@ -475,10 +478,14 @@ mod tests {
         let mut replaced = Vec::new();
         let mut start = 10;
         while start + 5 <= 400 {
-            g.observe(start, |k| y[k], |k, v| {
-                replaced.push(k);
-                clean[k] = v;
-            });
+            g.observe(
+                start,
+                |k| y[k],
+                |k, v| {
+                    replaced.push(k);
+                    clean[k] = v;
+                },
+            );
             let pred: Vec<f64> = (start..start + 5).map(|k| k as f64 + 0.02).collect();
             let last = clean[start - 1];
             g.predicted(start, &pred, last, 1.0, &mut lo, &mut hi);

@@ -271,7 +271,13 @@ pub fn run_with_progress<E: Estimator + ?Sized>(
     config: &EngineConfig,
     progress: Option<Progress<'_>>,
 ) -> Result<SlidingResult> {
-    run_with(estimator, signals, config, &GuardConfig::default(), progress)
+    run_with(
+        estimator,
+        signals,
+        config,
+        &GuardConfig::default(),
+        progress,
+    )
 }
 
 /// [`run_with_progress`] with the interval and outlier settings `guard`.
@@ -348,9 +354,18 @@ pub fn run_with<E: Estimator + ?Sized>(
             let win = &y[window.clone()];
             let (mn, mx) = win
                 .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
             let (lo, hi) = (&mut lo[..h], &mut hi[..h]);
-            guard.predicted(record.horizon.start, out, y[window.end - 1], mx - mn, lo, hi);
+            guard.predicted(
+                record.horizon.start,
+                out,
+                y[window.end - 1],
+                mx - mn,
+                lo,
+                hi,
+            );
             predicted[record.horizon.clone()].copy_from_slice(out);
             has_prediction[record.horizon.clone()].fill(true);
             lower[record.horizon.clone()].copy_from_slice(lo);

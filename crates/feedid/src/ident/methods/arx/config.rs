@@ -49,11 +49,11 @@ pub struct ArxConfig {
 impl Default for ArxConfig {
     fn default() -> Self {
         Self {
-            orders: ArxOrders::default(),
-            ridge: 1e-8,
-            max_pole_radius: 1.0,
-            dc_gain_bounds: (0.5, 2.0),
-            min_excitation: 1e-7,
+            orders: ArxOrders::new(3, 3, 0),
+            ridge: 1e-10,
+            max_pole_radius: 1.05,
+            dc_gain_bounds: (f64::NEG_INFINITY, f64::INFINITY),
+            min_excitation: 0.0,
             max_condition: f64::INFINITY,
             refactor_every: 64,
             sliding: true,

@@ -357,7 +357,14 @@ impl Predictor {
                 }
                 l.cursor = Some(end);
                 if l.rows[0] >= n
-                    && solve_ridge(&l.factors[0], n, ridge, &mut l.small, &mut l.tail, &mut l.rhs)
+                    && solve_ridge(
+                        &l.factors[0],
+                        n,
+                        ridge,
+                        &mut l.small,
+                        &mut l.tail,
+                        &mut l.rhs,
+                    )
                     && l.rhs.iter().all(|v| v.is_finite())
                 {
                     self.theta.copy_from_slice(&l.rhs);

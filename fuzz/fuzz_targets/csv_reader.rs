@@ -1,10 +1,12 @@
 //! The text reader on arbitrary bytes: never panics; an accepted recording
 //! is finite with strictly increasing time and a finite, positive interval.
+//! The same bytes as a live stream (`StreamReader`, what `feedid stream`
+//! reads) never panic either, and end.
 #![no_main]
 
 use std::path::Path;
 
-use feedid::io::{read_csv_from_bytes, ChannelRef, ReadOptions};
+use feedid::io::{read_csv_from_bytes, ChannelRef, ReadOptions, StreamLine, StreamReader};
 use feedid::Recording;
 use libfuzzer_sys::fuzz_target;
 
@@ -58,5 +60,16 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(rec) = read_csv_from_bytes(body, Path::new("fuzz.csv"), &opts) {
         check(&rec);
         let _ = feedid::io::recording_info(&rec);
+    }
+    if let Ok(mut r) = StreamReader::new(body, Path::new("stdin"), &opts) {
+        // every call consumes at least one line: at most one event per byte, then the end
+        let mut events = 0usize;
+        while let Ok(Some(l)) = r.next_line() {
+            events += 1;
+            assert!(events <= body.len() + 1, "the stream reader does not end");
+            if let StreamLine::Sample { time, .. } = l {
+                assert!(!time.is_nan() || opts.rate_hz.is_none());
+            }
+        }
     }
 });

@@ -103,11 +103,13 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(est) = spec.build() {
         if let Ok(mut s) = Streamer::new(est, cfg) {
             for k in 0..n {
-                if let Ok(Some(p)) = s.push(t0 + k as f64 * dt, u[k], y[k]) {
-                    assert!(
-                        p.position.iter().all(|v| v.is_finite()),
-                        "stream prediction"
-                    );
+                if s.push(t0 + k as f64 * dt, u[k], y[k]).is_ok() {
+                    while let Ok(Some(p)) = s.poll() {
+                        assert!(
+                            p.position.iter().all(|v| v.is_finite()),
+                            "stream prediction"
+                        );
+                    }
                 }
             }
             s.finish();

@@ -29,7 +29,7 @@ pub enum Command {
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),
     /// Identify and predict online: CSV samples on stdin, predictions on stdout as they are due.
-    Stream(StreamArgs),
+    Stream(Box<StreamArgs>),
     /// Write a self-contained HTML report of a recording: figures, residuals, Bode plot, summary.
     Report(Box<ReportArgs>),
     /// Error of every window × horizon × method × order combination, heat map, best choice.
@@ -137,6 +137,9 @@ pub struct SimulateArgs {
     /// Switch every nonlinear effect off (continuous linear cascade, no noise).
     #[arg(long)]
     pub linear: bool,
+    /// Use an unstable physical model anyway (its simulation diverges; refused by default).
+    #[arg(long)]
+    pub allow_unstable: bool,
     /// Duration [s]; default: the scenario's.
     #[arg(long, value_name = "S")]
     pub duration: Option<f64>,
@@ -232,6 +235,9 @@ pub struct IdentifyArgs {
     /// Rig parameters of the nominal simulation model (TOML); default: the built-in rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
+    /// Use an unstable physical model anyway (its simulation diverges; refused by default).
+    #[arg(long)]
+    pub allow_unstable: bool,
     /// Predictions CSV: time_s,command_m,measured_m,predicted_m,simulated_m.
     #[arg(
         short,
@@ -274,6 +280,9 @@ pub struct ReproduceArgs {
     /// Seed of the measurement noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Use an unstable physical model anyway (its simulation diverges; refused by default).
+    #[arg(long)]
+    pub allow_unstable: bool,
     /// Solver of the paper method: qr or simplex.
     #[arg(long, default_value = "simplex", value_name = "NAME")]
     pub solver: String,
@@ -322,9 +331,21 @@ pub struct StreamArgs {
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
-    /// Sampling rate [Hz] when lines are `command,position` without a time.
-    #[arg(long, value_name = "HZ")]
-    pub rate: Option<f64>,
+    /// How to read the lines (as a recording file; without a header and
+    /// without column options: time, command, position are columns 1, 2, 3).
+    #[command(flatten)]
+    pub recording: RecordingArgs,
+    /// The command on each line belongs to the sample N lines later (an
+    /// interpolator's look-ahead) [samples]; with N ≥ the horizon every
+    /// prediction is written before the line of its measurement is read.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub command_lead: usize,
+    /// Command over the horizon beyond the lead: acceleration (from the last
+    /// three commands), velocity (last two), hold, or wait (no extrapolation:
+    /// predictions come after their measurement, as identify's)
+    /// [default: acceleration].
+    #[arg(long, value_name = "HOW")]
+    pub extrapolate: Option<String>,
 }
 
 /// `feedid report`.
@@ -347,6 +368,9 @@ pub struct ReportArgs {
     /// Rig parameters of the nominal model (TOML); default: the built-in rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
+    /// Use an unstable physical model anyway (its simulation diverges; refused by default).
+    #[arg(long)]
+    pub allow_unstable: bool,
     /// Length of the zoom after the motion start [ms].
     #[arg(long, value_name = "MS", default_value_t = 60.0)]
     pub zoom: f64,
@@ -423,9 +447,15 @@ pub struct GreyboxArgs {
     /// Fit a set that is not identifiable anyway and report it, instead of refusing.
     #[arg(long)]
     pub allow_unidentifiable: bool,
+    /// Use an unstable physical model anyway (its simulation diverges; refused by default).
+    #[arg(long)]
+    pub allow_unstable: bool,
     /// Levenberg–Marquardt iteration cap.
     #[arg(long, default_value_t = 100, value_name = "N")]
     pub max_iterations: usize,
+    /// Fits restarted from the estimate moved ±22 % to check that the data pin it (0: no check).
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    pub restarts: usize,
     /// Summary JSON.
     #[arg(long, value_name = "gb.json")]
     pub summary: Option<PathBuf>,
@@ -487,6 +517,9 @@ pub struct CompensateArgs {
     /// Keep the model's DC gain instead of rescaling it to 1 (a position loop has 1).
     #[arg(long)]
     pub keep_dc_gain: bool,
+    /// Use an unstable physical model anyway (its simulation diverges; refused by default).
+    #[arg(long)]
+    pub allow_unstable: bool,
     /// Run the compensated and the plain command through the nonlinear virtual rig and report both tracking errors.
     #[arg(long)]
     pub verify: bool,

@@ -34,11 +34,20 @@ mod cmd;
 
 use std::io::{ErrorKind, Write};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 
 fn main() -> ExitCode {
-    let cli = args::Cli::parse();
+    install_signal_handlers();
+    // `--scale -1e-6`, `--rate -5000`: a negative number is a value (for the
+    // validators to judge), not an unknown flag
+    let matches = numbers_take_a_minus(args::Cli::command()).get_matches();
+    let cli = match args::Cli::from_arg_matches(&matches) {
+        Ok(c) => c,
+        Err(e) => e.exit(),
+    };
     match cmd::run(cli) {
         Ok(()) => match std::io::stdout().lock().flush() {
             Ok(()) => ExitCode::SUCCESS,
@@ -49,6 +58,56 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// `--scale -1e-6`, `--rate -5000`, `--window -5`: an option that takes a
+/// number takes a value starting with `-` (clap would read `-1e-6` as the
+/// flags `-1`, `-e`, `-6`), so that its validator names the value; any
+/// other negative number is accepted as a value too.
+fn numbers_take_a_minus(c: clap::Command) -> clap::Command {
+    use std::any::TypeId;
+    let numeric = [
+        TypeId::of::<f64>(),
+        TypeId::of::<usize>(),
+        TypeId::of::<u64>(),
+    ];
+    c.allow_negative_numbers(true)
+        .mut_args(move |a| {
+            if numeric.iter().any(|t| a.get_value_parser().type_id() == *t) {
+                a.allow_hyphen_values(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(numbers_take_a_minus)
+}
+
+/// Signals: SIGINT, SIGTERM and SIGHUP remove the temporary files of
+/// unfinished outputs (a set being renamed is finished first) and then end
+/// the process as the signal would; SIGXFSZ (a write beyond `ulimit -f`) no
+/// longer kills the process, so the write fails with `EFBIG` and is reported.
+fn install_signal_handlers() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM, SIGXFSZ};
+    let _ = signal_hook::flag::register(SIGXFSZ, Arc::new(AtomicBool::new(false)));
+    if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+        std::thread::spawn(move || {
+            if let Some(sig) = signals.forever().next() {
+                feedid::io::abandon_pending_outputs(|_| {
+                    let _ = signal_hook::low_level::emulate_default_handler(sig);
+                    std::process::exit(128 + sig)
+                });
+            }
+        });
+    }
+}
+
+/// Set when an output of the command is standard output (`-o -`): the
+/// command's own text then goes to standard error.
+static STDOUT_TAKEN: AtomicBool = AtomicBool::new(false);
+
+/// Send the command's printed text to standard error from now on.
+fn stdout_taken_by_output() {
+    STDOUT_TAKEN.store(true, Ordering::SeqCst);
 }
 
 /// An error with its whole cause chain on one line, `outer: cause: root`
@@ -76,6 +135,10 @@ fn one_line(e: &anyhow::Error) -> String {
 
 /// Write to standard output (see the macros above).
 fn write_stdout(args: std::fmt::Arguments<'_>) {
+    if STDOUT_TAKEN.load(Ordering::SeqCst) {
+        write_stderr(args);
+        return;
+    }
     if let Err(e) = std::io::stdout().lock().write_fmt(args) {
         stdout_failed(&e);
     }

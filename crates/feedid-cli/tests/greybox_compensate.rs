@@ -265,6 +265,7 @@ fn greybox_tracks_a_gain_over_sliding_windows() {
             "mean_position_m",
             "Kv",
             "Kv_std_error",
+            "Kv_verdict",
             "residual_rms_m",
             "termination"
         ]

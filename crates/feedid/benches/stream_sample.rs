@@ -30,10 +30,9 @@ fn per_sample(c: &mut Criterion) {
             s.reset();
             let mut acc = 0.0;
             for k in 0..n {
-                if let Some(p) = s
-                    .push(out.time[k], out.command[k], out.position[k])
-                    .unwrap_or_else(|e| panic!("{e}"))
-                {
+                s.push(out.time[k], out.command[k], out.position[k])
+                    .unwrap_or_else(|e| panic!("{e}"));
+                while let Some(p) = s.poll().unwrap_or_else(|e| panic!("{e}")) {
                     acc += p.position[0];
                 }
             }

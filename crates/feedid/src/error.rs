@@ -194,6 +194,13 @@ pub enum Error {
         reason: &'static str,
     },
 
+    /// A physical model has poles with a non-negative real part.
+    #[error("the physical model is unstable: poles with a positive real part at {poles}; its simulation diverges (check the gains and the mechanics)")]
+    UnstableModel {
+        /// The unstable poles, e.g. `1.3913e3 ± 3.9766e3j rad/s (6.7051e2 Hz)`.
+        poles: String,
+    },
+
     /// An iterative algorithm did not converge.
     #[error("{algorithm} did not converge after {iterations} iterations")]
     NotConverged {
@@ -272,6 +279,15 @@ pub enum Error {
         value: f64,
         /// The largest magnitude accepted.
         limit: f64,
+    },
+
+    /// A stream (FIFO, device, pipe) delivered more than a recording may hold.
+    #[error("{}: more than {limit} bytes from a pipe or device; feedid reads a recording whole: save it to a file first, or use `feedid stream` for live data", path.display())]
+    InputTooLarge {
+        /// The input.
+        path: PathBuf,
+        /// The most bytes read \[bytes\].
+        limit: u64,
     },
 
     /// The mean sampling interval of the time stamps is too short for a

@@ -30,6 +30,7 @@ pub mod ident;
 pub mod io;
 pub mod lti;
 pub mod pipeline;
+pub mod plausibility;
 pub mod recording;
 pub mod signal;
 pub mod solve;

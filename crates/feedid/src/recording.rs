@@ -39,6 +39,7 @@ pub struct Recording {
     extra: Vec<(String, Vec<f64>)>,
     dt: f64,
     max_jitter: f64,
+    notes: Vec<String>,
 }
 
 impl Recording {
@@ -133,6 +134,7 @@ impl Recording {
             extra: Vec::new(),
             dt,
             max_jitter,
+            notes: Vec::new(),
         })
     }
 
@@ -148,6 +150,18 @@ impl Recording {
         check_finite(name, &values)?;
         self.extra.push((name.to_string(), values));
         Ok(self)
+    }
+
+    /// Attach a note about how the recording was read (e.g. renamed
+    /// duplicate columns); shown with the plausibility warnings.
+    pub fn with_note(mut self, note: String) -> Self {
+        self.notes.push(note);
+        self
+    }
+
+    /// Notes attached while reading.
+    pub fn notes(&self) -> &[String] {
+        &self.notes
     }
 
     /// The first `n` samples (all of them if `n` is larger) as a recording

@@ -88,6 +88,31 @@ fn low_layers_import_nothing_from_higher_ones() {
             "experiment",
         ],
     );
+    // the plausibility checks sit on the recording: nothing else
+    assert_below(
+        &["plausibility.rs"],
+        &[
+            "drive",
+            "ident",
+            "pipeline",
+            "io",
+            "greybox",
+            "compensate",
+            "experiment",
+        ],
+    );
+    // io writes plain columns: it knows nothing of identification
+    assert_below(
+        &["io"],
+        &[
+            "drive",
+            "ident",
+            "pipeline",
+            "greybox",
+            "compensate",
+            "experiment",
+        ],
+    );
     assert_below(
         &["drive"],
         &[

@@ -5,6 +5,7 @@
 //! and they agree on which samples are predicted.
 
 use feedid::ident::engine::{run, EngineConfig};
+use feedid::ident::stream::CommandExtrapolation;
 use feedid::ident::{
     Method, PaperConfig, PredictionMode, SlidingResult, Solver, Streamer, TimeOrigin,
 };
@@ -170,35 +171,41 @@ fn every_estimator_on_degenerate_data_fails_cleanly_or_stays_finite() {
             // the recording's interval: the default running-mean interval
             // differs in the last digits far from t = 0, and OE's iterations
             // can then end differently)
-            let opts = feedid::ident::StreamOptions {
-                dt: Some(rec.dt()),
-                ..Default::default()
-            };
-            let mut s = Streamer::with_options(spec.build().unwrap(), cfg, opts).unwrap();
-            let mut predicted = vec![false; rec.len()];
-            let mut take = |p: feedid::ident::Prediction<'_>| {
-                for (k, v) in p.horizon.clone().zip(p.position) {
-                    assert!(v.is_finite(), "{what}: stream prediction {k} = {v}");
-                    // (a horizon may reach past the last sample)
-                    if let Some(slot) = predicted.get_mut(k) {
-                        *slot = true;
+            // (waiting for the command over the horizon, as batch has it; and
+            // extrapolating it, the default, where only finiteness is checked)
+            for extrapolation in [CommandExtrapolation::Wait, CommandExtrapolation::default()] {
+                let opts = feedid::ident::StreamOptions {
+                    dt: Some(rec.dt()),
+                    extrapolation,
+                    ..Default::default()
+                };
+                let mut s = Streamer::with_options(spec.build().unwrap(), cfg, opts).unwrap();
+                let mut predicted = vec![false; rec.len()];
+                let take = |predicted: &mut Vec<bool>, p: feedid::ident::Prediction<'_>| {
+                    for (k, v) in p.horizon.clone().zip(p.position) {
+                        assert!(v.is_finite(), "{what}: stream prediction {k} = {v}");
+                        // (a horizon may reach past the last sample)
+                        if let Some(slot) = predicted.get_mut(k) {
+                            *slot = true;
+                        }
+                    }
+                };
+                for k in 0..rec.len() {
+                    let (t, u, y) = (rec.time()[k], rec.command()[k], rec.position()[k]);
+                    s.push(t, u, y).unwrap();
+                    while let Some(p) = s.poll().unwrap() {
+                        take(&mut predicted, p);
                     }
                 }
-            };
-            for k in 0..rec.len() {
-                let (t, u, y) = (rec.time()[k], rec.command()[k], rec.position()[k]);
-                if let Some(p) = s.push(t, u, y).unwrap() {
-                    take(p);
+                s.finish();
+                while let Some(p) = s.poll().unwrap() {
+                    take(&mut predicted, p);
                 }
-            }
-            s.finish();
-            while let Some(p) = s.poll().unwrap() {
-                take(p);
-            }
-            if let Ok(r) = &batch {
-                let batch_predicted: Vec<bool> =
-                    (0..rec.len()).map(|k| r.prediction(k).is_some()).collect();
-                assert_eq!(predicted, batch_predicted, "{what}: predicted samples");
+                if let (Ok(r), CommandExtrapolation::Wait) = (&batch, extrapolation) {
+                    let batch_predicted: Vec<bool> =
+                        (0..rec.len()).map(|k| r.prediction(k).is_some()).collect();
+                    assert_eq!(predicted, batch_predicted, "{what}: predicted samples");
+                }
             }
         }
     }

@@ -172,7 +172,12 @@ proptest! {
         let mut est = spec.build().unwrap();
         let batch = run(est.as_mut(), &rec.signals(), &cfg).unwrap();
         // the stream with the recording's interval (its default is the running mean)
-        let opts = StreamOptions { dt: Some(rec.dt()), ..StreamOptions::default() };
+        // (waiting for the real command over each horizon, as batch has it)
+        let opts = StreamOptions {
+            dt: Some(rec.dt()),
+            extrapolation: feedid::ident::stream::CommandExtrapolation::Wait,
+            ..StreamOptions::default()
+        };
         let mut s = Streamer::with_options(spec.build().unwrap(), cfg, opts).unwrap();
         let mut streamed = vec![None; n];
         let mut take = |p: feedid::ident::Prediction<'_>| {
@@ -183,7 +188,8 @@ proptest! {
             }
         };
         for k in 0..n {
-            if let Some(p) = s.push(rec.time()[k], rec.command()[k], rec.position()[k]).unwrap() {
+            s.push(rec.time()[k], rec.command()[k], rec.position()[k]).unwrap();
+            while let Some(p) = s.poll().unwrap() {
                 take(p);
             }
         }

@@ -7,7 +7,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use feedid::drive::{RigParams, VirtualRig};
-use feedid::ident::stream::Streamer;
+use feedid::ident::stream::{CommandExtrapolation, StreamOptions, Streamer};
 use feedid::ident::{EngineConfig, Method, PaperConfig, Solver};
 use feedid::signal::Scenario;
 
@@ -85,15 +85,15 @@ fn steady_state_pushes_allocate_nothing_for_the_paper_method() {
         for k in 0..warm {
             s.push(rig.time[k], rig.command[k], rig.position[k])
                 .unwrap();
+            while s.poll().unwrap().is_some() {}
         }
         let mut predictions = 0;
         let mut sum = 0.0;
         let n = allocations_in(|| {
             for k in warm..rig.time.len() {
-                if let Some(p) = s
-                    .push(rig.time[k], rig.command[k], rig.position[k])
-                    .unwrap()
-                {
+                s.push(rig.time[k], rig.command[k], rig.position[k])
+                    .unwrap();
+                while let Some(p) = s.poll().unwrap() {
                     predictions += 1;
                     sum += p.position.iter().sum::<f64>();
                 }
@@ -118,32 +118,60 @@ fn steady_state_pushes_allocate_nothing_for_the_default_and_linear_methods() {
         .with_seed(3)
         .simulate(&command, rate)
         .unwrap();
+    let n = rig.time.len();
+    // extrapolating the command (the default), waiting for it, with a command
+    // lead, and across gaps (a 1 ms pause every 500 lines)
+    let feeds = [
+        (CommandExtrapolation::default(), 0, false),
+        (CommandExtrapolation::Acceleration, 0, true),
+        (CommandExtrapolation::Wait, 0, false),
+        (CommandExtrapolation::default(), 10, true),
+    ];
     for name in ["auto", "rls", "arx"] {
-        let spec: Method = name.parse().unwrap();
-        let cfg = EngineConfig {
-            window: spec.default_window(),
-            ..EngineConfig::default()
-        };
-        let mut s = Streamer::new(spec.build().unwrap(), cfg).unwrap();
-        let warm = 400;
-        for k in 0..warm {
-            s.push(rig.time[k], rig.command[k], rig.position[k])
-                .unwrap();
-        }
-        let mut predictions = 0;
-        let n = allocations_in(|| {
-            for k in warm..rig.time.len() {
-                if let Some(p) = s
-                    .push(rig.time[k], rig.command[k], rig.position[k])
-                    .unwrap()
-                {
+        for (extrapolation, lead, gaps) in feeds {
+            let what = format!("{name} {extrapolation:?} lead {lead} gaps {gaps}");
+            let spec: Method = name.parse().unwrap();
+            let cfg = EngineConfig {
+                window: spec.default_window(),
+                ..EngineConfig::default()
+            };
+            let opts = StreamOptions {
+                command_lead: lead,
+                extrapolation,
+                ..StreamOptions::default()
+            };
+            let mut s = Streamer::with_options(spec.build().unwrap(), cfg, opts).unwrap();
+            let time = |k: usize| rig.time[k] + if gaps { (k / 500) as f64 * 1e-3 } else { 0.0 };
+            let push = |s: &mut Streamer<_>, k: usize, predictions: &mut usize| {
+                s.push(time(k), rig.command[(k + lead).min(n - 1)], rig.position[k])
+                    .unwrap();
+                while let Some(p) = s.poll().unwrap() {
                     if p.is_ok() {
-                        predictions += 1;
+                        *predictions += 1;
                     }
                 }
+            };
+            let warm = 400;
+            let mut predictions = 0;
+            for k in 0..warm {
+                push(&mut s, k, &mut predictions);
             }
-        });
-        assert!(predictions >= 150, "{name}: {predictions}");
-        assert_eq!(n, 0, "{name}: {n} allocations in steady state");
+            predictions = 0;
+            let allocated = allocations_in(|| {
+                for k in warm..n {
+                    push(&mut s, k, &mut predictions);
+                }
+            });
+            assert!(predictions >= 100, "{what}: {predictions}");
+            assert_eq!(
+                allocated, 0,
+                "{what}: {allocated} allocations in steady state"
+            );
+            assert_eq!(
+                s.stats().gaps,
+                if gaps { (n - 1) / 500 } else { 0 },
+                "{what}"
+            );
+        }
     }
 }

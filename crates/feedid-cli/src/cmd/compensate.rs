@@ -11,15 +11,22 @@ use feedid::compensate::{
 };
 use feedid::drive::{RigEffects, VirtualRig};
 use feedid::greybox::LoopModel;
-use feedid::ident::ModelFile;
-use feedid::io::{read_recording, write_atomic, write_string_atomic, ChannelRef, ReadOptions};
+use feedid::io::{cell, read_recording, ChannelRef, ReadOptions};
 
 use crate::args::CompensateArgs;
-use crate::cmd::greybox::load_effects;
-use crate::cmd::{load_params, Outputs};
+use crate::cmd::{check_distinct, load_effects, load_model_params, Outputs};
 
 /// Compute, write, verify, print.
 pub fn run(a: &CompensateArgs) -> Result<()> {
+    let mut ins = vec![a.desired.as_path()];
+    ins.extend(a.model.as_deref());
+    ins.extend(a.params.as_deref());
+    ins.extend(a.rig.as_deref());
+    ins.extend(a.effects.as_deref());
+    let mut outs = vec![a.output.as_path()];
+    outs.extend(a.verify_out.as_deref());
+    outs.extend(a.summary.as_deref());
+    check_distinct(&ins, &outs)?;
     let smoothing = match a.smooth.trim() {
         "auto" => Smoothing::Auto,
         s => Smoothing::Fixed(s.parse::<f64>().map_err(|_| {
@@ -37,7 +44,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     cfg.validate()?;
     let position_loop: LoopModel = a.position_loop.parse()?;
     let verify_rig = if a.verify {
-        let params = load_params(a.rig.as_deref())?;
+        let params = load_model_params(a.rig.as_deref(), a.allow_unstable)?;
         let effects = match &a.effects {
             Some(p) => load_effects(p)?,
             None => RigEffects::default(),
@@ -65,7 +72,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     let mut text = String::new();
     let (source, comp) = match (&a.model, &a.params) {
         (Some(path), _) => {
-            let file = ModelFile::load(path)?;
+            let file = crate::cmd::load_model_file(path)?;
             let comp = compensate_model(&file.model, desired, dt, &cfg)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             let how = match &file.identified_by {
@@ -75,7 +82,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             (format!("{} [{how}]", path.display()), comp)
         }
         (None, Some(path)) => {
-            let params = load_params(Some(path))?;
+            let params = load_model_params(Some(path), a.allow_unstable)?;
             let comp = compensate_params(&params, position_loop, desired, dt, &cfg)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             (
@@ -89,6 +96,20 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         }
         (None, None) => anyhow::bail!("give --model model.json or --params rig.toml"),
     };
+    // an unstable model (allowed by --allow-unstable) can give a command that runs away
+    for (name, v) in [
+        ("command", &comp.command),
+        ("predicted position", &comp.predicted),
+    ] {
+        if let Some(k) = v.iter().position(|x| !feedid::recording::is_usable(*x)) {
+            anyhow::bail!(
+                "{}: the {name} runs away ({:e} at t = {} s): the model cannot be inverted here; nothing written",
+                a.output.display(),
+                v[k],
+                rec.time()[k]
+            );
+        }
+    }
     let _ = writeln!(
         text,
         "{}: {} samples at {:.2} Hz; model {source}",
@@ -107,39 +128,49 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     }
 
     let mut outputs = Outputs::default();
-    outputs.write(&a.output, |p| {
-        write_atomic(p, |w| {
-            writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
-            for (((t, u), d), y) in rec
-                .time()
-                .iter()
-                .zip(&comp.command)
-                .zip(desired)
-                .zip(&comp.predicted)
-            {
-                writeln!(w, "{t},{u},{d},{y}")?;
-            }
-            Ok(())
-        })
+    outputs.add(&a.output, |w| {
+        writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
+        for (((t, u), d), y) in rec
+            .time()
+            .iter()
+            .zip(&comp.command)
+            .zip(desired)
+            .zip(&comp.predicted)
+        {
+            writeln!(
+                w,
+                "{},{},{},{}",
+                cell(Some(*t)),
+                cell(Some(*u)),
+                cell(Some(*d)),
+                cell(Some(*y))
+            )?;
+        }
+        Ok(())
     })?;
     if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
-        outputs.write(p, |p| {
-            write_atomic(p, |w| {
+        outputs.add(p, |w| {
+            writeln!(
+                w,
+                "time_s,desired_m,position_uncompensated_m,position_compensated_m"
+            )?;
+            for (((t, d), a), b) in rec
+                .time()
+                .iter()
+                .zip(desired)
+                .zip(&v.position_uncompensated)
+                .zip(&v.position_compensated)
+            {
                 writeln!(
                     w,
-                    "time_s,desired_m,position_uncompensated_m,position_compensated_m"
+                    "{},{},{},{}",
+                    cell(Some(*t)),
+                    cell(Some(*d)),
+                    cell(Some(*a)),
+                    cell(Some(*b))
                 )?;
-                for (((t, d), a), b) in rec
-                    .time()
-                    .iter()
-                    .zip(desired)
-                    .zip(&v.position_uncompensated)
-                    .zip(&v.position_compensated)
-                {
-                    writeln!(w, "{t},{d},{a},{b}")?;
-                }
-                Ok(())
-            })
+            }
+            Ok(())
         })?;
     }
     if let Some(p) = &a.summary {
@@ -163,9 +194,9 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             }
         }
         let json = serde_json::to_string_pretty(&v)?;
-        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+        outputs.add_text(p, format!("{json}\n"))?;
     }
-    outputs.commit();
+    outputs.commit()?;
     print!("{text}");
     if !comp.exact_inverse {
         eprintln!(

@@ -9,30 +9,29 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use feedid::drive::RigEffects;
 use feedid::greybox::{
-    fit_coefficients, fit_greybox, track_greybox, Dynamics, GreyboxConfig, GreyboxFit, LoopModel,
-    Measurements, PhysicalParameter, TrackConfig, TrackWindow,
+    fit_coefficients, fit_greybox_with_progress, track_greybox_with_progress, Dynamics,
+    GreyboxConfig, GreyboxFit, LoopModel, Measurements, PhysicalParameter, TrackConfig,
+    TrackWindow,
 };
-use feedid::ident::{LinearModel, ModelFile};
-use feedid::io::{cell, write_atomic, write_string_atomic};
+use feedid::ident::LinearModel;
+use feedid::io::cell;
 
 use crate::args::GreyboxArgs;
-use crate::cmd::{load_params, recording, Outputs};
-
-/// Rig effects from a TOML file (as `feedid simulate --effects`).
-pub fn load_effects(path: &Path) -> Result<RigEffects> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let fx: RigEffects = toml::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " ")))?;
-    fx.validate()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    Ok(fx)
-}
+use crate::cmd::progress::ProgressBar;
+use crate::cmd::{check_distinct, load_effects, load_model_params, recording, Outputs};
 
 /// Run the fit(s), write the outputs, print the report.
 pub fn run(a: &GreyboxArgs) -> Result<()> {
+    let mut ins: Vec<&Path> = a.input.iter().map(|p| p.as_path()).collect();
+    ins.extend(a.from_model.as_deref());
+    ins.extend(a.params.as_deref());
+    ins.extend(a.effects.as_deref());
+    let mut outs: Vec<&Path> = a.summary.iter().map(|p| p.as_path()).collect();
+    outs.extend(a.params_out.as_deref());
+    outs.extend(a.track_out.as_deref());
+    check_distinct(&ins, &outs)?;
     let estimate = PhysicalParameter::parse_list(&a.estimate)?;
-    let start = load_params(a.params.as_deref())?;
+    let start = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let position_loop: LoopModel = a.position_loop.parse()?;
     let effects = match &a.effects {
         Some(p) => load_effects(p)?,
@@ -48,6 +47,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
         effects,
         max_iterations: a.max_iterations,
         refuse_unidentifiable: !a.allow_unidentifiable,
+        restarts: a.restarts,
         ..GreyboxConfig::default()
     };
     if a.track_window.is_some() && a.track_out.is_none() {
@@ -58,7 +58,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     let mut context = serde_json::Map::new();
     let (fit, track) = match (&a.from_model, &a.input) {
         (Some(path), _) => {
-            let file = ModelFile::load(path)?;
+            let file = crate::cmd::load_model_file(path)?;
             let (num, den) = match &file.model {
                 LinearModel::Continuous { num, den } if den.len() == 8 && num.len() <= 3 => {
                     (num.clone(), den.clone())
@@ -80,7 +80,8 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             (fit, None)
         }
         (None, Some(input)) => {
-            let rec = recording::load(input, &a.recording)?;
+            let (rec, warnings) = recording::load_checked(input, &a.recording)?;
+            context.insert("warnings".into(), warnings.into());
             let current = match &a.current {
                 Some(name) => Some(
                     rec.extra()
@@ -103,8 +104,11 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             if let Some(c) = current {
                 data = data.with_current(c);
             }
-            let fit = fit_greybox(&data, &start, &estimate, &cfg)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+            let bar = ProgressBar::new("greybox", "fits");
+            let update = |done: u64, total: u64| bar.update(done, total);
+            let fit = fit_greybox_with_progress(&data, &start, &estimate, &cfg, Some(&update));
+            bar.finish();
+            let fit = fit.map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
             let _ = writeln!(
                 text,
                 "{}: {} samples at {:.2} Hz; {} model, {} position loop; outputs: position{}",
@@ -150,7 +154,9 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                         ..TrackConfig::default()
                     };
                     let start_track = fit.params;
-                    let rows = track_greybox(
+                    let bar = ProgressBar::new("tracking", "windows");
+                    let update = |done: u64, total: u64| bar.update(done, total);
+                    let rows = track_greybox_with_progress(
                         rec.command(),
                         rec.position(),
                         rec.dt(),
@@ -158,8 +164,11 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                         &estimate,
                         &cfg,
                         &tc,
-                    )
-                    .map_err(|e| anyhow::anyhow!("{}: tracking: {e}", input.display()))?;
+                        Some(&update),
+                    );
+                    bar.finish();
+                    let rows =
+                        rows.map_err(|e| anyhow::anyhow!("{}: tracking: {e}", input.display()))?;
                     Some(rows)
                 }
                 None => None,
@@ -175,6 +184,12 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     }
 
     let mut outputs = Outputs::default();
+    if let Some(p) = &a.params_out {
+        outputs.add_text(p, fit.params.to_toml_string())?;
+    }
+    if let (Some(p), Some(rows)) = (&a.track_out, &track) {
+        outputs.add(p, |w| write_track_csv(w, &estimate, rows))?;
+    }
     if let Some(p) = &a.summary {
         let mut v = serde_json::to_value(&fit)?;
         if let Some(obj) = v.as_object_mut() {
@@ -186,15 +201,9 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             }
         }
         let json = serde_json::to_string_pretty(&v)?;
-        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
+        outputs.add_text(p, format!("{json}\n"))?;
     }
-    if let Some(p) = &a.params_out {
-        outputs.write(p, |p| write_string_atomic(p, &fit.params.to_toml_string()))?;
-    }
-    if let (Some(p), Some(rows)) = (&a.track_out, &track) {
-        outputs.write(p, |p| write_track_csv(p, &estimate, rows))?;
-    }
-    outputs.commit();
+    outputs.commit()?;
     print!("{text}");
     for w in fit.warnings() {
         eprintln!("warning: {w}");
@@ -261,10 +270,37 @@ fn report(t: &mut String, fit: &GreyboxFit) {
         "  condition number of the log-parameter Jacobian: {:.3e}",
         fit.condition_number
     );
+    if !fit.residual_structure.is_empty() {
+        let parts: Vec<String> = fit
+            .residual_structure
+            .iter()
+            .map(|s| {
+                format!(
+                    "{} {:.1} % predictable from its past ({})",
+                    s.output,
+                    100.0 * s.predictable_share,
+                    if s.structured { "structured" } else { "white" }
+                )
+            })
+            .collect();
+        let _ = writeln!(t, "  residuals: {}", parts.join(", "));
+    }
+    if fit.restarts > 0 {
+        let _ = writeln!(
+            t,
+            "  restarts: {} fits started ±22 % from the estimate",
+            fit.restarts
+        );
+    }
 }
 
 fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWindow]) {
-    let _ = writeln!(t, "  tracking: {} windows", rows.len());
+    let skipped = rows.iter().filter(|r| !r.excited).count();
+    let _ = writeln!(
+        t,
+        "  tracking: {} windows ({skipped} without excitation of a parameter: no estimate, the previous one kept)",
+        rows.len()
+    );
     let _ = write!(t, "  {:>9} {:>10}", "time s", "nut m");
     for p in estimate {
         let _ = write!(t, " {:>12} {:>10}", p.name(), "std");
@@ -277,35 +313,59 @@ fn report_track(t: &mut String, estimate: &[PhysicalParameter], rows: &[TrackWin
         }
         let _ = write!(t, "  {:>9.4} {:>10.5}", r.time_s, r.nut_position_m);
         for (v, s) in r.values.iter().zip(&r.std_errors) {
+            let v = if !r.excited {
+                "-".to_string()
+            } else {
+                format!("{v:.5e}")
+            };
             let _ = write!(
                 t,
-                " {:>12.5e} {:>10}",
+                " {:>12} {:>10}",
                 v,
                 s.map_or("-".to_string(), |s| format!("{s:.2e}"))
             );
+        }
+        if !r.excited {
+            let _ = write!(t, "  not excited");
         }
         let _ = writeln!(t);
     }
 }
 
 fn write_track_csv(
-    path: &Path,
+    w: &mut dyn std::io::Write,
     estimate: &[PhysicalParameter],
     rows: &[TrackWindow],
-) -> feedid::Result<()> {
-    write_atomic(path, |w| {
-        write!(w, "time_s,nut_position_m,mean_position_m")?;
-        for p in estimate {
-            write!(w, ",{},{}_std_error", p.name(), p.name())?;
+) -> std::io::Result<()> {
+    write!(w, "time_s,nut_position_m,mean_position_m")?;
+    for p in estimate {
+        write!(w, ",{0},{0}_std_error,{0}_verdict", p.name())?;
+    }
+    writeln!(w, ",residual_rms_m,termination")?;
+    for r in rows {
+        write!(
+            w,
+            "{},{},{}",
+            cell(Some(r.time_s)),
+            cell(Some(r.nut_position_m)),
+            cell(Some(r.mean_position_m))
+        )?;
+        for ((v, s), verdict) in r.values.iter().zip(&r.std_errors).zip(&r.verdicts) {
+            // a window that does not determine the parameter has no estimate of it
+            let v = (r.excited).then_some(*v);
+            write!(w, ",{},{},{}", cell(v), cell(*s), verdict.label())?;
         }
-        writeln!(w, ",residual_rms_m,termination")?;
-        for r in rows {
-            write!(w, "{},{},{}", r.time_s, r.nut_position_m, r.mean_position_m)?;
-            for (v, s) in r.values.iter().zip(&r.std_errors) {
-                write!(w, ",{},{}", v, cell(*s))?;
+        writeln!(
+            w,
+            ",{},{}",
+            cell(Some(r.residual_rms_m)),
+            // a window that does not excite a parameter has no estimate
+            if r.excited {
+                r.termination.label()
+            } else {
+                "not_excited"
             }
-            writeln!(w, ",{},{}", r.residual_rms_m, r.termination.label())?;
-        }
-        Ok(())
-    })
+        )?;
+    }
+    Ok(())
 }

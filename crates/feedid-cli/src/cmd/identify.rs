@@ -5,14 +5,33 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use feedid::ident::{GlobalModelKind, OrderSearch};
-use feedid::io::{write_coefficients_csv, write_predictions_csv, write_string_atomic};
+use feedid::ident::{GlobalModelKind, OrderSearch, SlidingResult};
+use feedid::io::{write_coefficients_csv, write_predictions_csv, CoefficientRow};
 use feedid::pipeline::Pipeline;
 use rayon::prelude::*;
 
 use crate::args::{IdentifyArgs, RecordingArgs};
 use crate::cmd::method::OrderOption;
-use crate::cmd::{check_distinct, load_params, recording, Outputs};
+use crate::cmd::progress::ProgressBar;
+use crate::cmd::{check_distinct, load_model_params, recording, Outputs};
+
+/// The coefficients table's rows of a sliding run.
+fn coefficient_rows<'a>(
+    time: &'a [f64],
+    s: &'a SlidingResult,
+) -> impl Iterator<Item = CoefficientRow<'a>> + 'a {
+    s.windows
+        .iter()
+        .enumerate()
+        .map(move |(i, rec)| CoefficientRow {
+            start_s: time.get(rec.window.start).copied(),
+            end_s: time.get(rec.window.end.saturating_sub(1)).copied(),
+            residual_rms_m: rec.residual_rms,
+            iterations: rec.iterations,
+            termination: rec.outcome.label(),
+            coefficients: s.window_coefficients(i),
+        })
+}
 
 /// Output paths of one recording.
 struct OutputPaths {
@@ -25,7 +44,7 @@ struct OutputPaths {
 /// Identify, write the outputs, print a short summary (one file, or a batch with --out-dir).
 pub fn run(a: &IdentifyArgs) -> Result<()> {
     let method = a.options.method(&a.method)?;
-    let params = load_params(a.params.as_deref())?;
+    let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let mut pipeline = Pipeline::new(method)
         .window_or_default(a.windows.window)
         .horizon(a.windows.horizon)
@@ -60,7 +79,13 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             outs.extend(paths.summary.as_deref());
             outs.extend(paths.model.as_deref());
             check_distinct(&ins, &outs)?;
-            let text = identify_file(input, &a.recording, &pipeline, &paths)?;
+            // a bar on a terminal for a long run (an hour of data: about a minute)
+            let bar = ProgressBar::new("identify", "samples");
+            let update = |done: u64, total: u64| bar.update(done, total);
+            let pipeline = pipeline.progress(&update);
+            let text = identify_file(input, &a.recording, &pipeline, &paths);
+            bar.finish();
+            let text = text?;
             print!("{text}");
             Ok(())
         }
@@ -81,6 +106,20 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             }
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+            // no output may overwrite an input (`--out-dir .` beside a recording
+            // named like another's output)
+            let batch_outputs: Vec<PathBuf> = inputs
+                .iter()
+                .flat_map(|input| {
+                    let stem = output_stem(input);
+                    ["predictions.csv", "coefficients.csv", "summary.json"]
+                        .map(|ext| dir.join(format!("{stem}.{ext}")))
+                })
+                .collect();
+            let mut ins: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+            ins.extend(a.params.as_deref());
+            let outs: Vec<&Path> = batch_outputs.iter().map(PathBuf::as_path).collect();
+            check_distinct(&ins, &outs)?;
             let results: Vec<Result<String>> = inputs
                 .par_iter()
                 .map(|input| {
@@ -130,7 +169,8 @@ fn identify_file(
     pipeline: &Pipeline<'_>,
     paths: &OutputPaths,
 ) -> Result<String> {
-    let rec = recording::load(input, read)?;
+    // the recording's plausibility warnings come back among the run's
+    let rec = recording::read(input, read)?;
     let run = pipeline
         .run(&rec)
         .with_context(|| input.display().to_string())?;
@@ -139,25 +179,8 @@ fn identify_file(
     }
     let summary = run.summary();
 
-    let mut outputs = Outputs::default();
-    outputs.write(&paths.predictions, |p| {
-        write_predictions_csv(
-            p,
-            rec.time(),
-            rec.command(),
-            rec.position(),
-            &run.sliding,
-            run.simulated.as_deref(),
-        )
-    })?;
-    if let Some(p) = &paths.coefficients {
-        outputs.write(p, |p| write_coefficients_csv(p, rec.time(), &run.sliding))?;
-    }
-    if let Some(p) = &paths.summary {
-        let json = serde_json::to_string_pretty(&summary)?;
-        outputs.write(p, |p| write_string_atomic(p, &format!("{json}\n")))?;
-    }
     let mut model_line = None;
+    let mut model_json = None;
     if let (Some(p), Some(model)) = (&paths.model, &run.model) {
         let mut file = model.clone();
         if let Some(prov) = file.identified_by.as_mut() {
@@ -171,11 +194,36 @@ fn identify_file(
                 p.display()
             ));
         }
-        outputs.write(p, |p| {
-            write_string_atomic(p, &format!("{}\n", file.to_json()))
+        model_json = Some((p, format!("{}\n", file.to_json())));
+    }
+
+    // every output written together or not at all, the summary last
+    let mut outputs = Outputs::default();
+    let s = &run.sliding;
+    outputs.add(&paths.predictions, |w| {
+        write_predictions_csv(
+            w,
+            rec.time(),
+            rec.command(),
+            rec.position(),
+            &s.predicted,
+            &s.has_prediction,
+            run.simulated.as_deref(),
+        )
+    })?;
+    if let Some(p) = &paths.coefficients {
+        outputs.add(p, |w| {
+            write_coefficients_csv(w, &s.coefficient_names, coefficient_rows(rec.time(), s))
         })?;
     }
-    outputs.commit();
+    if let Some((p, json)) = model_json {
+        outputs.add_text(p, json)?;
+    }
+    if let Some(p) = &paths.summary {
+        let json = serde_json::to_string_pretty(&summary)?;
+        outputs.add_text(p, format!("{json}\n"))?;
+    }
+    outputs.commit()?;
     Ok(format!(
         "{}: {summary}{}",
         input.display(),

@@ -4,10 +4,16 @@ use anyhow::Result;
 use feedid::drive::{D1Variant, ModelSummary};
 
 use crate::args::{D1Arg, ModelArgs};
-use crate::cmd::{load_params, params_error};
+use crate::cmd::{check_distinct, load_params, params_error, Outputs};
 
 /// Print the model summary as text or JSON.
 pub fn run(a: &ModelArgs) -> Result<()> {
+    if let Some(p) = &a.save_params {
+        check_distinct(
+            &a.params.iter().map(|p| p.as_path()).collect::<Vec<_>>(),
+            &[p],
+        )?;
+    }
     let params = load_params(a.params.as_deref())?;
     let variant = match a.d1 {
         D1Arg::Corrected => D1Variant::Corrected,
@@ -16,8 +22,9 @@ pub fn run(a: &ModelArgs) -> Result<()> {
     let summary =
         ModelSummary::new(&params, variant).map_err(|e| params_error(a.params.as_deref(), e))?;
     if let Some(p) = &a.save_params {
-        // saving over the file read is fine (a template of the same values)
-        feedid::io::write_string_atomic(p, &params.to_toml_string())?;
+        let mut outputs = Outputs::default();
+        outputs.add_text(p, params.to_toml_string())?;
+        outputs.commit()?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);

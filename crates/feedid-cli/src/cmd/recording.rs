@@ -4,6 +4,7 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use feedid::io::{read_recording, ChannelRef, ReadOptions};
+use feedid::plausibility::check_recording;
 use feedid::Recording;
 
 use crate::args::RecordingArgs;
@@ -47,15 +48,29 @@ pub fn read_options(a: &RecordingArgs) -> Result<ReadOptions> {
     Ok(opts)
 }
 
-/// Read and check a recording; warn on standard error when the command never moves.
+/// Read and check a recording, without printing its plausibility warnings
+/// (for commands whose library call reports them, as the pipeline does).
+pub fn read(path: &Path, a: &RecordingArgs) -> Result<Recording> {
+    Ok(read_recording(path, &read_options(a)?)?)
+}
+
+/// Read and check a recording; its plausibility warnings go to standard error.
 pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
+    Ok(load_checked(path, a)?.0)
+}
+
+/// Read and check a recording; its plausibility warnings
+/// (`feedid::plausibility`) go to standard error and are returned for the
+/// summaries.
+pub fn load_checked(path: &Path, a: &RecordingArgs) -> Result<(Recording, Vec<String>)> {
     let opts = read_options(a)?;
     let rec = read_recording(path, &opts)?;
-    if !rec.command_moves() {
-        eprintln!(
-            "warning: {}: the command never moves; there is nothing to identify",
-            path.display()
-        );
+    let warnings: Vec<String> = check_recording(&rec)
+        .into_iter()
+        .map(|w| w.message)
+        .collect();
+    for w in &warnings {
+        eprintln!("warning: {}: {w}", path.display());
     }
-    Ok(rec)
+    Ok((rec, warnings))
 }

@@ -2,12 +2,12 @@
 
 use anyhow::{bail, Result};
 use feedid::ident::EngineConfig;
-use feedid::io::write_string_atomic;
 use feedid_report::{recording_report, RecordingAnalysis, ReportOptions};
 
 use crate::args::ReportArgs;
 use crate::cmd::method::OrderOption;
-use crate::cmd::{load_params, params_error, recording, Outputs};
+use crate::cmd::progress::ProgressBar;
+use crate::cmd::{check_distinct, load_model_params, params_error, recording, Outputs};
 
 /// Identify with every method, build the page, write it atomically.
 pub fn run(a: &ReportArgs) -> Result<()> {
@@ -23,8 +23,11 @@ pub fn run(a: &ReportArgs) -> Result<()> {
             a.zoom
         );
     }
-    let params = load_params(a.params.as_deref())?;
-    let rec = recording::load(&a.input, &a.recording)?;
+    let mut ins = vec![a.input.as_path()];
+    ins.extend(a.params.as_deref());
+    check_distinct(&ins, &[a.output.as_path()])?;
+    let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
+    let (rec, warnings) = recording::load_checked(&a.input, &a.recording)?;
     let methods = methods
         .into_iter()
         .map(|m| {
@@ -48,7 +51,11 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         || a.input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let analysis = RecordingAnalysis::run(&name, rec, &opts).map_err(|e| match e {
+    let bar = ProgressBar::new("report", "samples");
+    let update = |done: u64, total: u64| bar.update(done, total);
+    let analysis = RecordingAnalysis::run_with_progress(&name, rec, &opts, Some(&update));
+    bar.finish();
+    let mut analysis = analysis.map_err(|e| match e {
         // extreme but valid parameters can give no usable nominal model: say which file
         feedid_report::Error::Core(core)
             if matches!(core.root(), feedid::Error::InvalidModel { .. }) && a.params.is_some() =>
@@ -57,11 +64,14 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         }
         other => other.into(),
     })?;
+    analysis
+        .notes
+        .extend(warnings.iter().map(|w| format!("warning: {w}")));
     let page = recording_report(&analysis)?;
     let html = page.to_html();
     let mut outputs = Outputs::default();
-    outputs.write(&a.output, |p| write_string_atomic(p, &html))?;
-    outputs.commit();
+    outputs.add(&a.output, |w| w.write_all(html.as_bytes()))?;
+    outputs.commit()?;
 
     println!(
         "{}: {} samples at {:.2} Hz",

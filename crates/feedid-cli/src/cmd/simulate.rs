@@ -5,7 +5,8 @@ use feedid::drive::{RigEffects, VirtualRig};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
-use crate::cmd::{check_distinct, load_params, params_error};
+use crate::cmd::progress::ProgressBar;
+use crate::cmd::{check_distinct, load_effects, load_model_params, params_error, Outputs};
 
 /// Simulate and write `time_s,command_m,position_m,…`.
 pub fn run(a: &SimulateArgs) -> Result<()> {
@@ -17,17 +18,11 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         .collect();
     check_distinct(&inputs, &[a.output.as_path()])?;
     let scenario: Scenario = a.scenario.parse()?;
-    let params = load_params(a.params.as_deref())?;
+    let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let effects = if a.linear {
         RigEffects::linear()
     } else if let Some(p) = &a.effects {
-        let text =
-            std::fs::read_to_string(p).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
-        let fx: RigEffects = toml::from_str(&text).map_err(|e| {
-            anyhow::anyhow!("{}: {}", p.display(), e.to_string().replace('\n', " "))
-        })?;
-        fx.validate()?;
-        fx
+        load_effects(p)?
     } else {
         RigEffects::default()
     };
@@ -36,10 +31,31 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     let rig = VirtualRig::new(params)
         .with_effects(effects)
         .with_seed(a.seed);
-    let out = rig
-        .simulate(&command, a.rate)
-        .map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
-    feedid::io::write_atomic(&a.output, |w| {
+    let bar = ProgressBar::new("simulate", "samples");
+    let update = |done: u64, total: u64| bar.update(done, total);
+    let out = rig.simulate_with_progress(&command, a.rate, &update);
+    bar.finish();
+    let out = out.map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
+    // an unstable rig (allowed by --allow-unstable) may run away: never write
+    // what cannot be read back as a recording
+    let channels = [
+        ("position_m", &out.position),
+        ("true_position_m", &out.true_position),
+        ("current_a", &out.motor_current),
+        ("velocity_m_per_s", &out.velocity),
+    ];
+    for (name, v) in channels {
+        if let Some(k) = v.iter().position(|x| !feedid::recording::is_usable(*x)) {
+            anyhow::bail!(
+                "{}: the simulation diverged: {name} reaches {:e} at t = {} s (beyond ±1e100 or not finite); nothing written",
+                a.output.display(),
+                v[k],
+                out.time[k]
+            );
+        }
+    }
+    let mut outputs = Outputs::default();
+    outputs.add(&a.output, |w| {
         writeln!(
             w,
             "time_s,command_m,position_m,true_position_m,current_a,velocity_m_per_s"
@@ -58,6 +74,7 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         }
         Ok(())
     })?;
+    outputs.commit()?;
     let peak = command.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
     println!(
         "{}: {} samples at {} Hz ({:.3} s), {} command, peak {:.4} mm, effects {}",

@@ -1,60 +1,53 @@
 //! `feedid stream`: online identification in a pipe.
 //!
-//! Reads samples from standard input, one per line: `time,command,position`
-//! (seconds, metres), or `command,position` with `--rate`. Fields may be
-//! separated by commas, semicolons, tabs or blanks; a first line that is not
-//! numeric is a header; lines starting with `#` and empty lines are ignored.
-//! Each window's prediction is written to standard output as soon as it is
-//! due (see `feedid::ident::stream` for when that is), one row
-//! `time_s,predicted_m` per horizon sample, and flushed. With a hop shorter
-//! than the horizon a time appears in several windows' rows; the later row
-//! supersedes the earlier.
+//! Reads standard input line by line with the recording options of
+//! `identify` (`feedid::io::StreamReader`: what `feedid simulate` writes
+//! needs none), pushes each sample into the library's streamer
+//! (`feedid::ident::stream::Streamer`, with `--command-lead` and
+//! `--extrapolate`), writes each prediction as soon as it is due as
+//! `time_s,predicted_m` rows (`feedid::io::PredictionRows`) and flushes
+//! before the next line is read. With a hop shorter than the horizon a time
+//! appears in several windows' rows; the later row supersedes the earlier.
 //!
-//! A malformed line (wrong field count, not a number, not finite, time not
-//! increasing) gets a message with its line number on standard error and is
-//! skipped; the stream goes on. At the end of input the last windows are
-//! processed and a summary goes to standard error.
+//! On standard error: each skipped line, gap and irregular interval with its
+//! line number (the first hundred of each kind), and at the end a summary.
+//! The header row goes out with the first usable sample: an input without
+//! one leaves standard output empty. Exit code 2 (after the summary) when no
+//! line was usable, or at once when standard output cannot be written; a
+//! reader that closes the pipe ends the stream quietly (exit code 0).
 
-use std::io::{BufRead, ErrorKind, Read, Write};
+use std::io::{BufRead, BufWriter, ErrorKind, Write};
+use std::path::Path;
 
 use anyhow::{bail, Result};
-use feedid::ident::{EngineConfig, Prediction, Streamer};
+use feedid::ident::stream::{
+    CommandExtrapolation, HorizonCommand, Interval, StreamOptions, StreamStats,
+};
+use feedid::ident::{EngineConfig, Estimator, Streamer};
+use feedid::io::{PredictionRows, StreamLine, StreamReader};
 
 use crate::args::StreamArgs;
 use crate::cmd::method::OrderOption;
+use crate::cmd::recording::read_options;
+
+/// Messages of one kind printed at most (the summary counts them all).
+const MAX_MESSAGES: usize = 100;
 
 /// Run on the process's standard streams.
 pub fn run(a: &StreamArgs) -> Result<()> {
     let stdin = std::io::stdin();
     let stdout = std::io::stdout();
     let stderr = std::io::stderr();
-    run_on(a, stdin.lock(), stdout.lock(), stderr.lock())
+    run_on(
+        a,
+        stdin.lock(),
+        BufWriter::new(stdout.lock()),
+        stderr.lock(),
+    )
 }
 
-/// Counters for the summary.
-#[derive(Default)]
-struct Counts {
-    skipped: usize,
-    rows: usize,
-}
-
-/// Outcome of writing rows: keep going, or the reader has gone away.
-enum Sink {
-    Open,
-    Closed,
-}
-
-fn run_on<R: BufRead, W: Write, E: Write>(
-    a: &StreamArgs,
-    input: R,
-    mut out: W,
-    mut err: E,
-) -> Result<()> {
-    if let Some(rate) = a.rate {
-        if !(rate.is_finite() && rate > 0.0) {
-            bail!("--rate must be a positive number of Hz, got {rate}");
-        }
-    }
+/// The streamer `a` asks for.
+fn streamer(a: &StreamArgs, rate: Option<f64>) -> Result<Streamer<Box<dyn Estimator + Send>>> {
     if a.options.order_option()? == Some(OrderOption::Select) {
         bail!("--order auto chooses the orders from a whole recording; a stream needs them given (na,nb,nk; `feedid order` chooses them)");
     }
@@ -65,193 +58,257 @@ fn run_on<R: BufRead, W: Write, E: Write>(
         hop: a.windows.hop,
         warm_up: 0,
     };
-    let mut streamer = Streamer::new(method.build()?, config)?;
-    let fields = if a.rate.is_some() { 2 } else { 3 };
-    let layout = if a.rate.is_some() {
-        "command,position"
-    } else {
-        "time,command,position"
+    let extrapolation: CommandExtrapolation = match &a.extrapolate {
+        Some(s) => s.parse()?,
+        None => CommandExtrapolation::default(),
     };
+    let options = StreamOptions {
+        command_lead: a.command_lead,
+        extrapolation,
+        // with a rate the intervals are exact: a skipped line is a gap
+        dt: rate.map(|r| 1.0 / r),
+        jitter_tolerance: a.recording.jitter_tol,
+        ..StreamOptions::default()
+    };
+    let s = Streamer::with_options(method.build()?, config, options)?;
+    if a.extrapolate.is_some() {
+        match s.horizon_command() {
+            HorizonCommand::NotRead => bail!(
+                "--extrapolate does not apply to --method {}{}: it does not read the command over the horizon",
+                method.name(),
+                if method.name() == "paper" { " with its polynomial prediction" } else { "" }
+            ),
+            HorizonCommand::Known { lead } => bail!(
+                "--extrapolate does not apply with --command-lead {lead} ≥ --horizon {}: the command over the horizon is known",
+                config.horizon
+            ),
+            _ => {}
+        }
+    }
+    Ok(s)
+}
 
-    let mut counts = Counts::default();
-    let mut sink = write_rows(&mut out, None, &mut counts, true);
-    let mut seen_data_line = false;
-    let mut values = [0.0; 3];
-    let mut line: Vec<u8> = Vec::new();
-    let mut input = input;
-    let mut number = 0usize;
-    while matches!(sink, Sink::Open) {
-        line.clear();
-        // at most MAX_LINE bytes per line: a stream without newlines
-        // (`cat /dev/zero | feedid stream`) must not exhaust memory
-        match (&mut input).take(MAX_LINE).read_until(b'\n', &mut line) {
-            Ok(0) => break,
-            Ok(_) => {}
-            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-            Err(e) => return Err(e.into()),
-        }
-        number += 1;
-        if line.len() as u64 >= MAX_LINE && line.last() != Some(&b'\n') {
-            skip_rest_of_line(&mut input)?;
-            counts.skipped += 1;
-            let _ = writeln!(err, "line {number}: longer than {MAX_LINE} bytes; skipped");
-            continue;
-        }
-        let Ok(text) = std::str::from_utf8(&line) else {
-            counts.skipped += 1;
-            let _ = writeln!(err, "line {number}: not UTF-8 text; skipped");
-            continue;
+/// Line counts for the summary.
+#[derive(Default)]
+struct Lines {
+    read: usize,
+    headers: usize,
+    skipped: usize,
+    gaps_shown: usize,
+    irregular_shown: usize,
+}
+
+/// Why writing stopped.
+enum Output {
+    Open,
+    /// The reader closed the pipe: stop quietly.
+    Closed,
+}
+
+/// Write a prediction's rows.
+fn write<W: Write>(rows: &mut PredictionRows<W>, time: &[f64], position: &[f64]) -> Result<Output> {
+    check(rows.write(time, position))
+}
+
+/// A closed pipe ends the stream quietly, other write failures are errors.
+fn check(r: std::io::Result<()>) -> Result<Output> {
+    match r {
+        Ok(()) => Ok(Output::Open),
+        Err(e) if e.kind() == ErrorKind::BrokenPipe => Ok(Output::Closed),
+        Err(e) => bail!("cannot write the predictions to standard output: {e}"),
+    }
+}
+
+fn run_on<R: BufRead, W: Write, E: Write>(
+    a: &StreamArgs,
+    input: R,
+    out: W,
+    mut err: E,
+) -> Result<()> {
+    let opts = read_options(&a.recording)?;
+    let mut s = streamer(a, opts.rate_hz)?;
+    let mut reader = StreamReader::new(input, Path::new("stdin"), &opts)?;
+    let mut rows = PredictionRows::new(out);
+    // the header goes out with the first usable sample: an input with none
+    // leaves standard output empty
+    let mut output = Output::Open;
+    let mut header = false;
+    let mut lines = Lines::default();
+    while let Output::Open = output {
+        let Some(line) = reader.next_line()? else {
+            break;
         };
-        let text = text.trim();
-        if text.is_empty() || text.starts_with('#') {
-            continue;
-        }
-        let first = !seen_data_line;
-        seen_data_line = true;
-        match parse_fields(text, &mut values[..fields]) {
-            Ok(()) => {}
-            Err(FieldError::NotNumeric) if first => continue, // a header line
-            Err(_) => {
-                counts.skipped += 1;
-                // quote at most 60 characters of the line (it may be megabytes)
-                let cut = text.char_indices().nth(60).map_or(text.len(), |(i, _)| i);
-                let more = if cut < text.len() { "…" } else { "" };
-                let _ = writeln!(
-                    err,
-                    "line {number}: expected {fields} numbers `{layout}`, got `{}{more}`; skipped",
-                    &text[..cut]
-                );
+        lines.read += 1;
+        let (no, t, u, y) = match line {
+            StreamLine::Header { .. } => {
+                lines.headers += 1;
+                continue;
+            }
+            StreamLine::Skipped { error, .. } => {
+                lines.skipped += 1;
+                if lines.skipped <= MAX_MESSAGES {
+                    let _ = writeln!(err, "{error}; skipped");
+                }
+                continue;
+            }
+            StreamLine::Sample {
+                line,
+                time,
+                command,
+                position,
+            } => (line, time, command, position),
+        };
+        match s.push(t, u, y) {
+            Ok(arrival) => {
+                report_interval(&mut err, &mut lines, no, arrival.interval);
+                if !header {
+                    header = true;
+                    output = check(rows.header())?;
+                    if let Output::Closed = output {
+                        break;
+                    }
+                }
+            }
+            Err(e) => {
+                lines.skipped += 1;
+                if lines.skipped <= MAX_MESSAGES {
+                    let _ = writeln!(err, "stdin: line {no}: {e}; skipped");
+                }
                 continue;
             }
         }
-        let (t, u, y) = match a.rate {
-            Some(rate) => (streamer.stats().samples as f64 / rate, values[0], values[1]),
-            None => (values[0], values[1], values[2]),
-        };
-        match streamer.push(t, u, y) {
-            Ok(p) => sink = write_rows(&mut out, p, &mut counts, false),
-            Err(e) => {
-                counts.skipped += 1;
-                let _ = writeln!(err, "line {number}: {e}; skipped");
+        while let Some(p) = s.poll()? {
+            if p.is_ok() {
+                output = write(&mut rows, p.time, p.position)?;
+                if let Output::Closed = output {
+                    break;
+                }
             }
         }
     }
-    if matches!(sink, Sink::Open) {
-        streamer.finish();
-        while let Some(p) = streamer.poll()? {
-            if let Sink::Closed = write_rows(&mut out, Some(p), &mut counts, false) {
-                break;
+    if let Output::Open = output {
+        s.finish();
+        while let Some(p) = s.poll()? {
+            if p.is_ok() {
+                if let Output::Closed = write(&mut rows, p.time, p.position)? {
+                    break;
+                }
             }
         }
     }
-    let s = streamer.stats();
-    let _ = writeln!(
+    let st = s.stats();
+    let _ = write!(
         err,
-        "samples {}, predictions {} ({} windows, {} failed, {} withheld, {} rows), skipped lines {}, \
-         rms error {:.6e} m over {} scored samples (max {:.6e} m)",
-        s.samples,
-        s.windows - s.failed_windows - s.withheld_windows,
-        s.windows,
-        s.failed_windows,
-        s.withheld_windows,
-        counts.rows,
-        counts.skipped,
-        s.scored.rms,
-        s.scored.samples,
-        s.scored.max_abs,
+        "{}",
+        summary(&lines, &st, s.horizon_command(), rows.rows())
     );
+    if st.lines == 0 {
+        if lines.read == 0 {
+            bail!("no data line in the input (it is empty or has only blank and comment lines)");
+        }
+        bail!(
+            "no usable line in the input ({} read: {} header, {} skipped)",
+            lines.read,
+            lines.headers,
+            lines.skipped
+        );
+    }
     Ok(())
 }
 
-/// Longest input line \[bytes\]; longer ones are reported and skipped.
-const MAX_LINE: u64 = 1 << 20;
-
-/// Discard input up to and including the next newline (or to the end).
-fn skip_rest_of_line<R: BufRead>(input: &mut R) -> std::io::Result<()> {
-    loop {
-        let buf = match input.fill_buf() {
-            Ok(b) => b,
-            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-            Err(e) => return Err(e),
-        };
-        if buf.is_empty() {
-            return Ok(());
-        }
-        match buf.iter().position(|&b| b == b'\n') {
-            Some(i) => {
-                input.consume(i + 1);
-                return Ok(());
+/// Report a gap or an irregular interval (the first hundred of each).
+fn report_interval<E: Write>(err: &mut E, lines: &mut Lines, no: usize, interval: Interval) {
+    match interval {
+        Interval::Regular => {}
+        Interval::Gap(j) => {
+            lines.gaps_shown += 1;
+            if lines.gaps_shown <= MAX_MESSAGES {
+                let what = match j.missing_samples() {
+                    0 => format!(
+                        "the interval {} s is not the {} s so far (the sampling changed?)",
+                        short(j.interval()),
+                        short(j.expected)
+                    ),
+                    m => format!(
+                        "time jumps from {} s to {} s: {m} sample{} of {} s missing",
+                        j.previous_time,
+                        j.time,
+                        if m == 1 { "" } else { "s" },
+                        short(j.expected)
+                    ),
+                };
+                let _ = writeln!(err, "stdin: line {no}: gap: {what}; the windows restart");
             }
-            None => {
-                let n = buf.len();
-                input.consume(n);
+        }
+        Interval::Irregular(j) => {
+            lines.irregular_shown += 1;
+            if lines.irregular_shown <= MAX_MESSAGES {
+                let _ = writeln!(
+                    err,
+                    "stdin: line {no}: interval {} s is {:+.1} % off the {} s so far; kept",
+                    short(j.interval()),
+                    100.0 * (j.interval() / j.expected - 1.0),
+                    short(j.expected)
+                );
             }
         }
     }
 }
 
-/// Write the header (`header`) or a prediction's rows, and flush.
-fn write_rows<W: Write>(
-    out: &mut W,
-    p: Option<Prediction<'_>>,
-    counts: &mut Counts,
-    header: bool,
-) -> Sink {
-    let res = (|| -> std::io::Result<bool> {
-        if header {
-            writeln!(out, "time_s,predicted_m")?;
-        }
-        let mut wrote = header;
-        if let Some(p) = p {
-            for (t, y) in p.time.iter().zip(p.position) {
-                writeln!(out, "{t},{y}")?;
-                counts.rows += 1;
-                wrote = true;
-            }
-        }
-        if wrote {
-            out.flush()?;
-        }
-        Ok(wrote)
-    })();
-    match res {
-        Ok(_) => Sink::Open,
-        // the reader closed the pipe: stop quietly
-        Err(_) => Sink::Closed,
-    }
+/// A number with 6 significant digits.
+fn short(v: f64) -> String {
+    format!("{v:.6e}")
+        .parse::<f64>()
+        .map_or_else(|_| v.to_string(), |x| x.to_string())
 }
 
-/// Why a line did not parse.
-enum FieldError {
-    /// Some field is not a number (a header if it is the first line).
-    NotNumeric,
-    /// Wrong number of fields.
-    Count,
+/// A share in per cent of `n` over `of` (`of` > 0).
+fn percent(n: usize, of: usize) -> String {
+    format!("{:.1} %", 100.0 * n as f64 / of as f64)
 }
 
-/// Split `text` into exactly `out.len()` numbers.
-fn parse_fields(text: &str, out: &mut [f64]) -> std::result::Result<(), FieldError> {
-    let separated = text.contains([',', ';', '\t']);
-    let parts: Box<dyn Iterator<Item = &str>> = if separated {
-        Box::new(text.split([',', ';', '\t']).map(str::trim))
+/// The summary on standard error (several lines; never an rms over nothing).
+fn summary(lines: &Lines, st: &StreamStats, command: HorizonCommand, rows: usize) -> String {
+    let mut o = String::new();
+    let unused = if st.unused_positions > 0 {
+        format!(
+            " ({} positions before the command lead unused)",
+            st.unused_positions
+        )
     } else {
-        Box::new(text.split_whitespace())
+        String::new()
     };
-    let mut n = 0;
-    let mut numeric = true;
-    for part in parts {
-        match part.parse::<f64>() {
-            Ok(v) if n < out.len() => out[n] = v,
-            Ok(_) => {}
-            Err(_) => numeric = false,
-        }
-        n += 1;
+    o += &format!(
+        "lines {} ({} header), skipped lines {}, samples {}{unused}, gaps {}, irregular intervals {}\n",
+        lines.read, lines.headers, lines.skipped, st.samples, st.gaps, st.irregular_intervals
+    );
+    let predicted = st.windows - st.failed_windows - st.withheld_windows;
+    o += &format!(
+        "windows {}: {predicted} predicted, {} withheld, {} failed; {rows} rows written\n",
+        st.windows, st.withheld_windows, st.failed_windows
+    );
+    o += &format!("command over the horizon: {command}\n");
+    let made = st.predicted_ahead + st.predicted_late;
+    if made > 0 {
+        o += &format!(
+            "predicted before their measurement arrived: {} of {made} predicted samples ({})\n",
+            st.predicted_ahead,
+            percent(st.predicted_ahead, made)
+        );
     }
-    if !numeric {
-        Err(FieldError::NotNumeric)
-    } else if n != out.len() {
-        Err(FieldError::Count)
+    if st.scored.samples > 0 {
+        o += &format!(
+            "scored {} of {} samples ({}): rms error {:.4e} m, max {:.4e} m; \
+             holding each window's last position on the same samples: rms {:.4e} m\n",
+            st.scored.samples,
+            st.samples,
+            percent(st.scored.samples, st.samples),
+            st.scored.rms,
+            st.scored.max_abs,
+            st.hold.rms
+        );
     } else {
-        Ok(())
+        o += "scored: no sample (no prediction was compared with a measurement)\n";
     }
+    o
 }

@@ -2,16 +2,14 @@
 //! order combination, in parallel, with a heat map and the best choice.
 
 use std::fmt::Write as _;
-use std::io::IsTerminal;
 
 use anyhow::{bail, Context, Result};
 use feedid::ident::{sweep, SweepConfig, SweepResult};
-use feedid::io::write_string_atomic;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::SweepArgs;
 use crate::cmd::method::{parse_orders, OrderOption};
-use crate::cmd::{recording, Outputs};
+use crate::cmd::progress::ProgressBar;
+use crate::cmd::{check_distinct, recording, Outputs};
 
 /// A comma-separated list of sample counts ≥ 1 (duplicates dropped, order kept).
 fn parse_counts(flag: &str, s: &str) -> Result<Vec<usize>> {
@@ -30,20 +28,6 @@ fn parse_counts(flag: &str, s: &str) -> Result<Vec<usize>> {
         }
     }
     Ok(out)
-}
-
-/// A progress bar on standard error when it is a terminal; hidden otherwise (pipes, CI).
-fn progress_bar() -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template(
-        "sweep [{bar:40.cyan/blue}] {pos}/{len} combinations, {elapsed} (eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
 }
 
 /// The text table: one line per method/order/horizon, one column per window.
@@ -98,6 +82,9 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     if a.hop == Some(0) {
         bail!("invalid --hop 0: must be at least 1 sample");
     }
+    let mut outs = vec![a.output.as_path()];
+    outs.extend(a.plot.as_deref());
+    check_distinct(&[a.input.as_path()], &outs)?;
     let rec = recording::load(&a.input, &a.recording)?;
     let cfg = SweepConfig {
         methods,
@@ -106,12 +93,11 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         orders,
         hop: a.hop,
     };
-    let bar = progress_bar();
+    let bar = ProgressBar::new("sweep", "combinations");
     let res = sweep(&rec, &cfg, &|done, total| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
+        bar.update(done as u64, total as u64);
     });
-    bar.finish_and_clear();
+    bar.finish();
     let res = res?;
     if !res.rows.iter().any(|r| r.ok()) {
         let why = res
@@ -127,11 +113,11 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         None => None,
     };
     let mut outputs = Outputs::default();
-    outputs.write(&a.output, |p| write_string_atomic(p, &csv))?;
-    if let (Some(p), Some(svg)) = (&a.plot, &svg) {
-        outputs.write(p, |p| write_string_atomic(p, svg))?;
+    if let (Some(p), Some(svg)) = (&a.plot, svg) {
+        outputs.add_text(p, svg)?;
     }
-    outputs.commit();
+    outputs.add_text(&a.output, csv)?;
+    outputs.commit()?;
 
     println!(
         "{}: {} samples at {:.2} Hz, {} combinations on {} threads",

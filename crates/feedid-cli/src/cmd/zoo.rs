@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use feedid::io::{write_atomic, write_string_atomic};
 use feedid::zoo::{MemberSpec, Zoo};
 use rayon::prelude::*;
+
+use crate::cmd::Outputs;
 
 /// `feedid zoo`.
 #[derive(Debug, Args)]
@@ -202,50 +203,28 @@ fn file_name(i: usize) -> String {
     format!("zoo-{i:03}.csv")
 }
 
-/// Write the members and the manifests; on failure remove what was written.
+/// Write the members and the manifests as one output set: the members are
+/// simulated in parallel into memory (the whole zoo is about 140 MB of text),
+/// then written together or not at all, the manifests last.
 fn write_members(zoo: &Zoo, specs: &[MemberSpec], dir: &Path) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         bail!("{}: exists and is not a directory", dir.display());
     }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("{}: cannot create directory", dir.display()))?;
-    let results: Vec<(PathBuf, Result<()>)> = specs
+    let members: Vec<(PathBuf, Vec<u8>)> = specs
         .par_iter()
         .map(|s| {
-            let path = dir.join(file_name(s.index));
-            let r = zoo
-                .member(s.index)
-                .map_err(anyhow::Error::from)
-                .and_then(|m| Ok(write_atomic(&path, |w| m.write_csv(w))?));
-            (path, r)
+            let m = zoo.member(s.index)?;
+            let mut text = Vec::new();
+            m.write_csv(&mut text)?;
+            Ok((dir.join(file_name(s.index)), text))
         })
-        .collect();
-    let mut written: Vec<PathBuf> = Vec::new();
-    let mut failure = None;
-    for (path, r) in results {
-        match r {
-            Ok(()) => written.push(path),
-            Err(e) if failure.is_none() => failure = Some(e),
-            Err(_) => {}
-        }
+        .collect::<Result<_>>()?;
+    let mut outputs = Outputs::default();
+    for (path, text) in members {
+        outputs.add(&path, move |w| w.write_all(&text))?;
     }
-    let manifests = failure.map_or_else(|| write_manifests(specs, dir, &mut written), Err);
-    if let Err(e) = manifests {
-        for p in &written {
-            let _ = std::fs::remove_file(p);
-        }
-        return Err(e);
-    }
-    println!(
-        "{}: {} members written (zoo-NNN.csv), manifest.csv, manifest.json",
-        dir.display(),
-        specs.len()
-    );
-    Ok(())
-}
-
-fn write_manifests(specs: &[MemberSpec], dir: &Path, written: &mut Vec<PathBuf>) -> Result<()> {
-    let json_path = dir.join("manifest.json");
     // every spec with `file` (its CSV, relative to the manifest) and
     // `readable` (false for dropped rows: `feedid identify` refuses those)
     let entries = specs
@@ -260,11 +239,14 @@ fn write_manifests(specs: &[MemberSpec], dir: &Path, written: &mut Vec<PathBuf>)
         })
         .collect::<Result<Vec<_>>>()?;
     let json = serde_json::to_string_pretty(&entries)?;
-    write_string_atomic(&json_path, &format!("{json}\n"))?;
-    written.push(json_path);
-    let csv_path = dir.join("manifest.csv");
-    write_atomic(&csv_path, |w| manifest_csv(specs, w))?;
-    written.push(csv_path);
+    outputs.add(&dir.join("manifest.csv"), |w| manifest_csv(specs, w))?;
+    outputs.add_text(&dir.join("manifest.json"), format!("{json}\n"))?;
+    outputs.commit()?;
+    println!(
+        "{}: {} members written (zoo-NNN.csv), manifest.csv, manifest.json",
+        dir.display(),
+        specs.len()
+    );
     Ok(())
 }
 

@@ -123,6 +123,37 @@ impl RecordingAnalysis {
     /// for short series), simulate the nominal model and fit the global
     /// models.
     pub fn run(name: &str, recording: Recording, opts: &ReportOptions) -> Result<Self> {
+        Self::run_with_progress(name, recording, opts, None)
+    }
+
+    /// [`RecordingAnalysis::run`], reporting `progress(done, total)` in
+    /// samples: every method's identification of every sample, then each
+    /// global model as one recording's worth (a plain callback; called from
+    /// the worker threads).
+    pub fn run_with_progress(
+        name: &str,
+        recording: Recording,
+        opts: &ReportOptions,
+        progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+    ) -> Result<Self> {
+        let n = recording.len() as u64;
+        let globals = if opts.global_models { 2 } else { 0 };
+        let total = n * (opts.methods.len() as u64 + globals);
+        let done: Vec<std::sync::atomic::AtomicU64> = opts
+            .methods
+            .iter()
+            .map(|_| std::sync::atomic::AtomicU64::new(0))
+            .collect();
+        let report = |i: usize, d: u64| {
+            if let Some(p) = progress {
+                done[i].store(d, std::sync::atomic::Ordering::Relaxed);
+                let sum: u64 = done
+                    .iter()
+                    .map(|a| a.load(std::sync::atomic::Ordering::Relaxed))
+                    .sum();
+                p(sum.min(total), total);
+            }
+        };
         let dt = recording.dt();
         let simulated = simulate_nominal(&opts.params, recording.command(), dt)?;
         let nominal =
@@ -135,12 +166,17 @@ impl RecordingAnalysis {
         let runs: Vec<feedid::Result<Identification>> = opts
             .methods
             .par_iter()
-            .map(|(method, cfg)| {
-                Pipeline::new(method.clone())
+            .enumerate()
+            .map(|(i, (method, cfg))| {
+                let hook = |d: u64, _: u64| report(i, d);
+                let mut p = Pipeline::new(method.clone())
                     .engine(*cfg)
                     .method_global_model(false)
-                    .residuals(None)
-                    .run(&recording)
+                    .residuals(None);
+                if progress.is_some() {
+                    p = p.progress(&hook);
+                }
+                p.run(&recording)
             })
             .collect();
         let mut out_runs = Vec::with_capacity(runs.len());
@@ -156,7 +192,7 @@ impl RecordingAnalysis {
             let (uu, ee) = prediction_errors(s, recording.command(), y, usize::MAX);
             let lag = opts.max_lag.min(ee.len().saturating_sub(2));
             let residuals = if lag >= 1 {
-                ResidualAnalysis::new(&uu, &ee, lag).ok()
+                ResidualAnalysis::for_horizon(&uu, &ee, lag, identification.config.horizon).ok()
             } else {
                 None
             };
@@ -182,6 +218,9 @@ impl RecordingAnalysis {
         } else {
             (Vec::new(), Vec::new())
         };
+        if let Some(p) = progress {
+            p(total, total);
+        }
         Ok(Self {
             name: name.to_string(),
             recording,

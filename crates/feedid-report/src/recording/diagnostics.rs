@@ -15,7 +15,8 @@ impl RecordingAnalysis {
         sec.blocks.push(Block::Paragraph(
             "Correlations of the prediction errors (residuals) e = measurement − prediction over all predicted samples. \
              Left: autocorrelation r_ee(τ); for a model that captured all predictable dynamics the residual is white and \
-             every bar for τ > 0 stays inside the grey 99 % band ±2.58/√N. Right: cross-correlation r_ue(τ) of the \
+             every bar for τ at or beyond the prediction horizon stays inside the grey 99 % band ±2.58/√N (errors of \
+             one prediction, from a common origin, are correlated below the horizon whatever the model). Right: cross-correlation r_ue(τ) of the \
              command and the residual; bars outside the band at τ > 0 mean part of the command's effect was missed."
                 .into(),
         ));
@@ -73,9 +74,9 @@ impl RecordingAnalysis {
             ue.y_range = Some((-1.1 * peak, 1.1 * peak));
             let verdict = |inside: bool| {
                 if inside {
-                    "inside the band"
+                    "independent of the command"
                 } else {
-                    "outside the band"
+                    "the residual depends on the command"
                 }
             };
             sec.blocks.push(Block::Grid(vec![
@@ -84,15 +85,20 @@ impl RecordingAnalysis {
                     &format!("{}: residual autocorrelation", m.label),
                     &ee,
                     &format!(
-                        "{} of {} lags outside the 99 % band (N = {}): {}.",
+                        "{} of the {} lags τ = {} … {} outside the 99 % band (N = {}): {}. \
+                         Lags below the horizon ({} samples) are correlated for any model: \
+                         errors predicted from one origin share its innovations.",
                         ra.ee_outside,
+                        ra.max_lag + 1 - ra.ee_first_lag,
+                        ra.ee_first_lag,
                         ra.max_lag,
                         ra.samples,
                         if ra.ee_inside {
-                            "white enough"
+                            "white enough beyond the horizon"
                         } else {
-                            "correlated — predictable structure is left in the error"
-                        }
+                            "correlated beyond the horizon — predictable structure is left in the error"
+                        },
+                        ra.ee_first_lag
                     ),
                 )?,
                 Self::figure(
@@ -100,7 +106,7 @@ impl RecordingAnalysis {
                     &format!("{}: command–residual cross-correlation", m.label),
                     &ue,
                     &format!(
-                        "{} of {} lags {} (τ > 0: residual after the command).",
+                        "{} of the {} lags outside the 99 % band: {} (τ > 0: residual after the command).",
                         ra.ue_outside,
                         2 * ra.max_lag + 1,
                         verdict(ra.ue_inside)

@@ -6,6 +6,7 @@ mod closed_loop;
 mod nominal;
 mod params;
 mod rig;
+mod stability;
 mod summary;
 
 pub use closed_loop::{
@@ -18,4 +19,5 @@ pub use params::{
     Geometry, Inertia, Material, Motor, RigParams, Stiffness, Table,
 };
 pub use rig::{Friction, PositionLoop, RigEffects, RigOutput, VirtualRig, DEFAULT_MAX_STEP};
+pub use stability::{check_model, require_stable, ModelCheck};
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

@@ -459,6 +459,29 @@ impl VirtualRig {
     /// As [`VirtualRig::simulate`], writing into `out` (resized to `command.len()`;
     /// allocation-free when `out` already has the capacity).
     pub fn simulate_into(&self, command: &[f64], rate_hz: f64, out: &mut RigOutput) -> Result<()> {
+        self.simulate_into_with_progress(command, rate_hz, out, None)
+    }
+
+    /// As [`VirtualRig::simulate`], reporting `progress(done, total)` in
+    /// samples about 500 times (a plain callback, e.g. for a progress bar).
+    pub fn simulate_with_progress(
+        &self,
+        command: &[f64],
+        rate_hz: f64,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<RigOutput> {
+        let mut out = RigOutput::default();
+        self.simulate_into_with_progress(command, rate_hz, &mut out, Some(progress))?;
+        Ok(out)
+    }
+
+    fn simulate_into_with_progress(
+        &self,
+        command: &[f64],
+        rate_hz: f64,
+        out: &mut RigOutput,
+        progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+    ) -> Result<()> {
         if !rate_hz.is_finite() || rate_hz <= 0.0 {
             return Err(Error::InvalidParameter {
                 name: "rate",
@@ -512,7 +535,11 @@ impl VirtualRig {
         let ff = plant.feed_forward;
 
         let mut x = [0.0f64; 7];
+        let every = (n / 500).max(1);
         for (k, &xs) in command.iter().enumerate() {
+            if let Some(p) = progress.filter(|_| k % every == 0) {
+                p(k as u64, n as u64);
+            }
             if x.iter().any(|v| !v.is_finite()) {
                 return Err(Error::InvalidModel {
                     reason: "virtual rig simulation diverged (non-finite state)",

@@ -60,8 +60,10 @@ pub struct ModelSummary {
     pub poles: Vec<[f64; 2]>,
     /// Poles with frequency and damping, sorted by frequency.
     pub pole_details: Vec<PoleInfo>,
+    /// Whether every pole has a negative real part ([`crate::drive::check_model`]).
+    pub stable: bool,
     /// −3 dB bandwidth of Xa/Xs \[Hz\]; `None` (JSON `null`) when outside the
-    /// scanned 0.01 Hz … 100 kHz (see [`bandwidth_hz`]).
+    /// scanned 0.01 Hz … 100 kHz (see [`bandwidth_hz`]) or the loop is unstable.
     pub bandwidth_hz: Option<f64>,
     /// DC gain (1 for the corrected coefficients).
     pub dc_gain: f64,
@@ -74,6 +76,7 @@ pub struct ModelSummary {
 impl ModelSummary {
     /// Summarise the nominal model of `params`.
     pub fn new(params: &RigParams, variant: D1Variant) -> Result<Self> {
+        let stable = crate::drive::check_model(params)?.stable;
         let c = closed_loop_coefficients(params, variant);
         let tf = c.transfer_function()?;
         let mut poles = tf.poles()?;
@@ -88,7 +91,8 @@ impl ModelSummary {
             den: c.den.to_vec(),
             poles: poles.iter().map(|p| [p.re, p.im]).collect(),
             pole_details: poles.iter().map(|&p| PoleInfo::new(p)).collect(),
-            bandwidth_hz: bandwidth_hz(&tf),
+            stable,
+            bandwidth_hz: if stable { bandwidth_hz(&tf) } else { None },
             dc_gain: c.dc_gain(),
             following_error_s: c.following_error_per_velocity(),
             d1_variant: match variant {
@@ -173,16 +177,35 @@ impl fmt::Display for ModelSummary {
                 p.re, p.im, p.freq_hz, p.damping
             )?;
         }
-        match self.bandwidth_hz {
-            Some(bw) => writeln!(f, "Bandwidth (−3 dB)         {bw:.1} Hz")?,
-            None => writeln!(f, "Bandwidth (−3 dB)         outside 0.01 Hz … 100 kHz")?,
+        if self.stable {
+            writeln!(
+                f,
+                "Stability                 stable (every pole has a negative real part)"
+            )?;
+        } else {
+            let n = self.poles.iter().filter(|p| p[0] >= 0.0).count();
+            writeln!(
+                f,
+                "Stability                 UNSTABLE: {n} poles with a positive real part; the axis \
+                 would run away, so the bandwidth and following error do not apply"
+            )?;
+        }
+        match (self.stable, self.bandwidth_hz) {
+            (false, _) => writeln!(f, "Bandwidth (−3 dB)         none (unstable)")?,
+            (true, Some(bw)) => writeln!(f, "Bandwidth (−3 dB)         {bw:.1} Hz")?,
+            (true, None) => writeln!(f, "Bandwidth (−3 dB)         outside 0.01 Hz … 100 kHz")?,
         }
         writeln!(f, "DC gain                   {:.9}", self.dc_gain)?;
         write!(
             f,
-            "Following error           {:.4} ms × velocity ({:.1} µm at 50 mm/s)",
+            "Following error           {:.4} ms × velocity ({:.1} µm at 50 mm/s){}",
             1e3 * self.following_error_s,
-            0.05 * self.following_error_s * 1e6
+            0.05 * self.following_error_s * 1e6,
+            if self.stable {
+                ""
+            } else {
+                " — not reached: unstable"
+            }
         )
     }
 }
@@ -206,6 +229,22 @@ mod tests {
     fn bandwidth_outside_the_scan_is_none_not_infinite() {
         assert_eq!(bandwidth_hz(&first_order(1e-4)), None);
         assert_eq!(bandwidth_hz(&first_order(1e7)), None);
+    }
+
+    #[test]
+    fn an_unstable_rig_says_so_and_has_no_bandwidth() {
+        let mut p = RigParams::default();
+        p.control.kv = 5000.0;
+        p.control.kp = 1e5;
+        let s = ModelSummary::new(&p, D1Variant::Corrected).unwrap();
+        assert!(!s.stable);
+        assert_eq!(s.bandwidth_hz, None);
+        let text = s.to_string();
+        assert!(text.contains("UNSTABLE: 2 poles"), "{text}");
+        let json = serde_json::to_value(&s).unwrap();
+        assert_eq!(json["stable"], serde_json::Value::Bool(false));
+        let ok = ModelSummary::new(&RigParams::default(), D1Variant::Corrected).unwrap();
+        assert!(ok.stable && ok.to_string().contains("stable (every pole"));
     }
 
     #[test]

@@ -152,6 +152,8 @@ pub fn fit_coefficients(
         current_residual_rms: None,
         fit_percent: None,
         residuals: RATIOS,
+        residual_structure: Vec::new(),
+        restarts: 0,
         params,
         effects,
     })

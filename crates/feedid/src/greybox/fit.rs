@@ -49,6 +49,7 @@ use super::identifiability::{
 };
 use super::model::{Dynamics, LoopModel, PhysicalModel};
 use super::names::PhysicalParameter;
+use super::whiteness::{residual_structure, ResidualStructure};
 use crate::drive::{RigEffects, RigParams};
 use crate::error::{Error, Result};
 use crate::solve::{LevenbergMarquardt, LmConfig, Termination};
@@ -74,6 +75,10 @@ pub struct GreyboxConfig {
     pub thresholds: IdentifiabilityThresholds,
     /// Refuse (with [`Error::NotIdentifiable`]) a set with a null direction at the start. Default true.
     pub refuse_unidentifiable: bool,
+    /// Fits restarted from the estimate moved by ±[`RESTART_STEP`] in every
+    /// log-parameter (alternating signs) to see whether the estimate is
+    /// pinned by the data. Default 2; 0 skips the check.
+    pub restarts: usize,
 }
 
 impl Default for GreyboxConfig {
@@ -86,9 +91,21 @@ impl Default for GreyboxConfig {
             tolerance: 1e-12,
             thresholds: IdentifiabilityThresholds::default(),
             refuse_unidentifiable: true,
+            restarts: 2,
         }
     }
 }
+
+/// Distance of a restart from the estimate in each log-parameter (0.2: ±22 %).
+pub const RESTART_STEP: f64 = 0.2;
+
+/// Residual rms, relative to the signal's, below which a fit counts as
+/// exact and its residuals are not tested for structure (1e-5).
+pub const EXACT_FIT: f64 = 1e-5;
+
+/// How far (in standard errors) a restarted fit may end from the estimate
+/// before the parameter is not identifiable.
+pub const RESTART_TOLERANCE_SE: f64 = 3.0;
 
 /// One estimated parameter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -107,6 +124,10 @@ pub struct ParameterEstimate {
     /// Standard error relative to the estimate.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub relative_std_error: Option<f64>,
+    /// Largest relative change of the estimate between the fit and its
+    /// restarts (`None` without restarts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start_spread: Option<f64>,
     /// How well the data determine it.
     pub verdict: Verdict,
 }
@@ -140,6 +161,11 @@ pub struct GreyboxFit {
     pub fit_percent: Option<f64>,
     /// Number of residuals (samples or coefficients).
     pub residuals: usize,
+    /// Structure left in the residual of each output (recordings only; empty
+    /// when the fit is exact).
+    pub residual_structure: Vec<ResidualStructure>,
+    /// Restarts made to test the estimates.
+    pub restarts: usize,
     /// The full rig parameters with the estimates in place.
     #[serde(skip)]
     pub params: RigParams,
@@ -158,20 +184,40 @@ impl GreyboxFit {
 
     /// One warning line per parameter that is not well determined.
     pub fn warnings(&self) -> Vec<String> {
-        let mut w: Vec<String> = self
-            .estimates
-            .iter()
-            .filter(|e| e.verdict != Verdict::Identifiable)
-            .map(|e| match e.relative_std_error {
-                Some(r) => format!(
-                    "{} is {} from these data (relative standard error {:.1} %)",
-                    e.name,
-                    e.verdict.label(),
-                    100.0 * r
-                ),
-                None => format!("{} is not identifiable from these data", e.name),
-            })
-            .collect();
+        let mut w: Vec<String> = Vec::new();
+        for s in self.residual_structure.iter().filter(|s| s.structured) {
+            w.push(format!(
+                "the {} residual is not white: {:.0} % of its variance is predictable from its own past (lag-1 correlation {:.2}); the model leaves out part of the dynamics (friction? --friction), so the standard errors understate the error and the estimates may be biased: every estimate is unreliable",
+                s.output,
+                100.0 * s.predictable_share,
+                s.lag1_correlation
+            ));
+        }
+        w.extend(
+            self.estimates
+                .iter()
+                .filter(|e| !matches!(e.verdict, Verdict::Identifiable | Verdict::Unreliable))
+                .map(|e| match (e.relative_std_error, e.start_spread) {
+                    (Some(r), Some(s)) if s > RESTART_TOLERANCE_SE * r => format!(
+                        "{} is {} from these data: started elsewhere, the fit ends {} away (relative standard error {:.2} %)",
+                        e.name,
+                        e.verdict.label(),
+                        if s < 1.0 {
+                            format!("{:.1} %", 100.0 * s)
+                        } else {
+                            format!("a factor {:.3e}", 1.0 + s)
+                        },
+                        100.0 * r
+                    ),
+                    (Some(r), _) => format!(
+                        "{} is {} from these data (relative standard error {:.1} %)",
+                        e.name,
+                        e.verdict.label(),
+                        100.0 * r
+                    ),
+                    (None, _) => format!("{} is not identifiable from these data", e.name),
+                }),
+        );
         for d in &self.null_directions {
             w.push(format!(
                 "the response does not change along {} (only other combinations are determined)",
@@ -289,6 +335,7 @@ pub(crate) fn estimates(
                 start: base[k],
                 std_error: rel.map(|r| r * value),
                 relative_std_error: rel,
+                start_spread: None,
                 verdict: analysis.verdicts[k],
             }
         })
@@ -434,6 +481,27 @@ pub fn fit_greybox(
     estimate: &[PhysicalParameter],
     cfg: &GreyboxConfig,
 ) -> Result<GreyboxFit> {
+    fit_greybox_with_progress(data, start, estimate, cfg, None)
+}
+
+/// [`fit_greybox`], reporting `progress(done, total)` in stages: the
+/// analysis at the start, each Levenberg–Marquardt pass, each restart and
+/// the analysis at the estimate (a plain callback, e.g. for a progress bar).
+pub fn fit_greybox_with_progress(
+    data: &Measurements<'_>,
+    start: &RigParams,
+    estimate: &[PhysicalParameter],
+    cfg: &GreyboxConfig,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> Result<GreyboxFit> {
+    let stages = 3 + u64::from(data.current.is_some()) + cfg.restarts as u64;
+    let mut stage = 0;
+    let mut step = || {
+        stage += 1;
+        if let Some(p) = progress {
+            p(stage.min(stages), stages);
+        }
+    };
     let base = check_set(
         estimate,
         start,
@@ -494,6 +562,7 @@ pub fn fit_greybox(
         }
     }
 
+    step();
     let mut lm = LevenbergMarquardt::new(m, n);
     let lm_cfg = LmConfig {
         ftol: cfg.tolerance,
@@ -507,6 +576,7 @@ pub fn fit_greybox(
         &mut theta,
         &lm_cfg,
     )?;
+    step();
     if data.current.is_some() {
         // second pass: each channel weighted by its residual level
         prob.eval(&theta, &mut r);
@@ -525,6 +595,52 @@ pub fn fit_greybox(
         report.evaluations += second.evaluations;
         report.termination = second.termination;
         report.residual_norm = second.residual_norm;
+        step();
+    }
+
+    // restarts: does the fit end where it started?
+    let mut ends: Vec<Vec<f64>> = Vec::new();
+    if cfg.restarts > 0 {
+        prob.eval(&theta, &mut r);
+        let mut best_ss: f64 = r.iter().map(|v| v * v).sum();
+        let main = theta.clone();
+        for k in 0..cfg.restarts {
+            let mut t: Vec<f64> = main
+                .iter()
+                .enumerate()
+                .map(|(j, v)| {
+                    let even = j % 2 == 0;
+                    let sign = match k % 4 {
+                        0 if even => 1.0,
+                        0 => -1.0,
+                        1 if even => -1.0,
+                        1 => 1.0,
+                        2 => 1.0,
+                        _ => -1.0,
+                    };
+                    v + sign * RESTART_STEP * (1.0 + (k / 4) as f64)
+                })
+                .collect();
+            let rep = lm.minimize(
+                |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+                &mut t,
+                &lm_cfg,
+            )?;
+            report.evaluations += rep.evaluations;
+            step();
+            prob.eval(&t, &mut r);
+            let ss_k: f64 = r.iter().map(|v| v * v).sum();
+            if ss_k < best_ss * (1.0 - 1e-9) {
+                // a better minimum: it becomes the estimate
+                best_ss = ss_k;
+                ends.push(std::mem::replace(&mut theta, t));
+            } else {
+                ends.push(t);
+            }
+        }
+        if theta != main {
+            ends.push(main);
+        }
     }
 
     central_jacobian(
@@ -536,8 +652,47 @@ pub fn fit_greybox(
     );
     prob.eval(&theta, &mut r);
     let ss: f64 = r.iter().map(|v| v * v).sum();
-    let analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
+    let mut analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
+    step();
     let (rms_y, rms_i) = prob.channel_rms();
+
+    // structure left in the residuals; not measured when the fit is exact to
+    // within EXACT_FIT of the signal (integration or rounding differences,
+    // which cannot bias an estimate by more than about that share)
+    let mut structure = Vec::new();
+    if rms_y > EXACT_FIT * y_scale {
+        structure.extend(residual_structure("position", &r[..len]));
+    }
+    if let (Some(ri), true) = (rms_i, data.current.is_some()) {
+        if ri > EXACT_FIT * i_scale {
+            structure.extend(residual_structure("current", &r[len..]));
+        }
+    }
+    let structured = structure.iter().any(|s| s.structured);
+    // spread of the restarts in log-parameters, against the standard error
+    let spread: Vec<Option<f64>> = (0..n)
+        .map(|j| {
+            (!ends.is_empty()).then(|| {
+                ends.iter()
+                    .map(|t| (t[j] - theta[j]).abs())
+                    .fold(0.0_f64, f64::max)
+                    .exp_m1()
+            })
+        })
+        .collect();
+    for (j, v) in analysis.verdicts.iter_mut().enumerate() {
+        let moved = match (spread[j], analysis.relative_std_errors[j]) {
+            // beyond the standard error, and beyond what the LM tolerance leaves
+            (Some(s), Some(se)) => s > RESTART_TOLERANCE_SE * se && s > 1e-4,
+            (Some(s), None) => s > 1e-4,
+            _ => false,
+        };
+        if moved {
+            *v = Verdict::NotIdentifiable;
+        } else if structured && *v != Verdict::NotIdentifiable {
+            *v = Verdict::Unreliable;
+        }
+    }
     let stats = ErrorStats::from_pairs(
         data.position
             .iter()
@@ -547,9 +702,13 @@ pub fn fit_greybox(
     let mut params = *start;
     let mut effects = cfg.effects;
     apply(estimate, &base, &theta, &mut params, &mut effects);
+    let mut ests = estimates(estimate, &base, &theta, &analysis);
+    for (e, s) in ests.iter_mut().zip(&spread) {
+        e.start_spread = *s;
+    }
     Ok(GreyboxFit {
         source: "recording",
-        estimates: estimates(estimate, &base, &theta, &analysis),
+        estimates: ests,
         correlation: analysis.correlation.clone(),
         condition_number: analysis.condition_number,
         null_directions: analysis.null_directions.clone(),
@@ -560,6 +719,8 @@ pub fn fit_greybox(
         current_residual_rms: rms_i,
         fit_percent: Some(stats.fit_percent),
         residuals: m,
+        residual_structure: structure,
+        restarts: cfg.restarts,
         params,
         effects,
     })
@@ -774,6 +935,98 @@ mod tests {
             assert!(se / want < 0.01, "{}: se {se}", e.name);
             assert_eq!(e.verdict, Verdict::Identifiable);
         }
+    }
+
+    #[test]
+    fn a_linear_model_of_data_with_friction_is_not_called_identifiable() {
+        // issue 15: the linear model started from the true values on the
+        // rig's data (friction, quantisation, noise) gave C2 and Ki far off
+        // (here C2 ≈ 780 vs 100, Ki ≈ 340 vs 471) with standard errors of
+        // about 1 %, labelled identifiable. The residuals are far from white.
+        let truth = RigParams::default();
+        let u = Scenario::Prbs.command(5000.0, 1.1, 2).unwrap();
+        let out = VirtualRig::new(truth)
+            .with_seed(2)
+            .simulate(&u, 5000.0)
+            .unwrap();
+        let set = [Kv, Kp, Ki, C2, M];
+        let fit = fit_greybox(
+            &Measurements::new(&u, &out.position, DT).with_current(&out.motor_current),
+            &truth,
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap();
+        let (ki, c2) = (&fit.estimates[2], &fit.estimates[3]);
+        // the estimates are biased far beyond their standard errors …
+        assert!((ki.value / 471.2 - 1.0).abs() > 10.0 * ki.relative_std_error.unwrap());
+        assert!((c2.value / 100.0 - 1.0).abs() > 10.0 * c2.relative_std_error.unwrap());
+        // … and not called identifiable
+        for e in &fit.estimates {
+            assert_ne!(e.verdict, Verdict::Identifiable, "{}", e.name);
+        }
+        assert!(fit.residual_structure.iter().all(|s| s.structured));
+        assert!(fit.warnings().iter().any(|w| w.contains("not white")));
+        // with the friction model the same data give white residuals and identifiable estimates
+        let cfg = GreyboxConfig {
+            dynamics: Dynamics::Nonlinear,
+            ..GreyboxConfig::default()
+        };
+        let good = fit_greybox(
+            &Measurements::new(&u, &out.position, DT).with_current(&out.motor_current),
+            &truth,
+            &set,
+            &cfg,
+        )
+        .unwrap();
+        for e in &good.estimates {
+            assert_eq!(e.verdict, Verdict::Identifiable, "{}", e.name);
+        }
+    }
+
+    #[test]
+    fn an_estimate_the_data_do_not_pin_is_found_by_the_restarts() {
+        // the stiffness from a jerk-limited move on the rig: the local
+        // analysis gives K a standard error of about 11 % ("poor"), but fits
+        // started ±22 % away end more than 3 standard errors from it
+        let u = Scenario::Scurve
+            .command(5000.0, Scenario::Scurve.default_duration(), 0)
+            .unwrap();
+        let y = VirtualRig::new(RigParams::default())
+            .simulate(&u, 5000.0)
+            .unwrap()
+            .position;
+        let cfg = GreyboxConfig {
+            refuse_unidentifiable: false,
+            ..GreyboxConfig::default()
+        };
+        let fit = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &RigParams::default(),
+            &[K, C1],
+            &cfg,
+        )
+        .unwrap();
+        let k = &fit.estimates[0];
+        let (se, spread) = (k.relative_std_error.unwrap(), k.start_spread.unwrap());
+        assert!(se < 1.0, "{k:?}");
+        assert!(spread > RESTART_TOLERANCE_SE * se, "{k:?}");
+        assert_eq!(k.verdict, Verdict::NotIdentifiable);
+        assert!(fit
+            .warnings()
+            .iter()
+            .any(|w| w.starts_with("K is not identifiable") && w.contains("started elsewhere")));
+        // without restarts only the local analysis speaks
+        let cfg0 = GreyboxConfig { restarts: 0, ..cfg };
+        let fit0 = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &RigParams::default(),
+            &[K, C1],
+            &cfg0,
+        )
+        .unwrap();
+        assert_eq!(fit0.estimates[0].start_spread, None);
+        assert_ne!(fit0.estimates[0].verdict, Verdict::NotIdentifiable);
     }
 
     #[test]

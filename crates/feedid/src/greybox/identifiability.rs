@@ -22,7 +22,11 @@
 //! (`|v_j| ≥ 0.05`) in a null direction or its relative standard error
 //! exceeds 100 %; *poor* if its relative standard error exceeds
 //! `poor_relative_std` (default 10 %); *identifiable* otherwise. On noise-free
-//! data the standard errors are 0 and only the rank test speaks.
+//! data the standard errors are 0 and only the rank test speaks. The fit
+//! ([`super::fit_greybox`]) then checks what this local analysis cannot see:
+//! an estimate that moves far beyond its standard error when the fit is
+//! started elsewhere becomes *not identifiable*, and every estimate of a fit
+//! whose residuals are structured ([`super::whiteness`]) *unreliable*.
 //!
 //! Reference: E. Walter, L. Pronzato, *Identification of Parametric Models
 //! from Experimental Data*, Springer 1997, ch. 2 (structural
@@ -43,8 +47,14 @@ pub enum Verdict {
     Identifiable,
     /// Determined, but with a large relative standard error.
     Poor,
-    /// Not determined by the data (a null direction, or a standard error above 100 %).
+    /// Not determined by the data (a null direction, a standard error above
+    /// 100 %, or an estimate that moves far beyond its standard error when
+    /// the fit starts elsewhere).
     NotIdentifiable,
+    /// Determined by the data through this model, but the model leaves
+    /// structure in the residuals (see [`super::whiteness`]): the standard
+    /// error does not bound the error, the estimate may be biased.
+    Unreliable,
 }
 
 impl Verdict {
@@ -54,6 +64,7 @@ impl Verdict {
             Verdict::Identifiable => "identifiable",
             Verdict::Poor => "poor",
             Verdict::NotIdentifiable => "not identifiable",
+            Verdict::Unreliable => "unreliable",
         }
     }
 }

@@ -22,10 +22,14 @@ pub mod identifiability;
 mod model;
 mod names;
 mod track;
+pub mod whiteness;
 
 pub use coefficients::fit_coefficients;
-pub use fit::{fit_greybox, GreyboxConfig, GreyboxFit, Measurements, ParameterEstimate};
+pub use fit::{
+    fit_greybox, fit_greybox_with_progress, GreyboxConfig, GreyboxFit, Measurements,
+    ParameterEstimate,
+};
 pub use identifiability::{Identifiability, IdentifiabilityThresholds, NullDirection, Verdict};
 pub use model::{linear_discrete, Dynamics, LoopModel, PhysicalModel};
 pub use names::{PhysicalParameter, PARAMETER_NAMES};
-pub use track::{track_greybox, TrackConfig, TrackWindow};
+pub use track::{track_greybox, track_greybox_with_progress, TrackConfig, TrackWindow};

@@ -2,9 +2,12 @@
 //!
 //! Format rules:
 //!
-//! - **Lines**: `\n` or `\r\n` endings; a UTF-8 byte-order mark is ignored;
-//!   blank lines and lines starting with `#` are skipped (line numbers in
-//!   errors are those of the file, 1-based).
+//! - **Lines**: `\n`, `\r\n` or `\r` endings; a UTF-8 byte-order mark is
+//!   ignored; blank lines and lines starting with `#` are skipped (line
+//!   numbers in errors are those of the file, 1-based). A line over 1 MiB, a
+//!   NUL byte or invalid UTF-8 is refused where it occurs, and so is more
+//!   than 256 MiB from a pipe or device ([`crate::io::MAX_STREAM_BYTES`]):
+//!   memory stays bounded whatever the input.
 //! - **Delimiter** ([`ReadOptions::delimiter`], default detected): the first of
 //!   tab, `;`, `,`, runs of whitespace that splits the first 50 rows into the
 //!   same number (> 1) of fields; failing that, the first that splits the first
@@ -16,7 +19,9 @@
 //!   a header when one of its cells is not a number while the cell below it is
 //!   (with a single row: when any cell is not a number).
 //! - **Columns** by header name (exact, else case-insensitive) or 1-based
-//!   index; defaults `time_s`, `command_m`, `position_m`. Without a time column,
+//!   index; defaults `time_s`, `command_m`, `position_m`. A name that
+//!   several columns carry is refused for time, command and position
+//!   ("ambiguous: select one by its number"), never resolved silently. Without a time column,
 //!   [`ReadOptions::rate_hz`] gives `t_k = k / rate`.
 //! - **Numbers** are parsed strictly (Rust `f64` syntax: `-1.5e-3`, `.5`;
 //!   `NaN`/`inf` are read and then refused as non-finite). A cell like `1,25`
@@ -24,7 +29,8 @@
 //!   Every row must have as many fields as the header (or the first row).
 //! - **Extra columns**: every other column whose cells are all finite numbers
 //!   is attached to the recording as an extra channel, unscaled, named by its
-//!   header (or `col<N>` without header); other columns are ignored.
+//!   header (or `col<N>` without header; `NAME@N` when several columns are
+//!   named `NAME`, with a note on the recording); other columns are ignored.
 //!
 //! Errors name the file and the 1-based line, and the column where one is
 //! concerned: [`Error::BadNumber`], [`Error::Malformed`],
@@ -40,15 +46,14 @@
 //! # Ok::<(), feedid::Error>(())
 //! ```
 
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::io::options::{
-    ChannelRef, ReadOptions, DEFAULT_COMMAND_COLUMN, DEFAULT_POSITION_COLUMN, DEFAULT_TIME_COLUMN,
-};
-use crate::io::read::{
-    build_recording, failing_sample, in_file, read_file, short_list, short_text, Role,
-};
+use crate::io::layout::{Headerless, TextLayout};
+use crate::io::options::{ChannelRef, ReadOptions};
+use crate::io::read::{build_recording, failing_sample, in_file, short_list, Role};
+use crate::io::source::{open_input, LineReader};
 use crate::recording::Recording;
 
 /// Hint appended to [`Error::BadNumber`] when a cell looks like a decimal comma.
@@ -59,21 +64,56 @@ const DETECT_ROWS: usize = 50;
 
 /// A field delimiter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Delim {
+pub(super) enum Delim {
     Byte(u8),
     Whitespace,
 }
 
 /// A non-blank, non-comment line with its 1-based number.
-struct Line<'a> {
+pub(super) struct Line<'a> {
+    pub(super) no: usize,
+    pub(super) text: &'a str,
+}
+
+/// An owned [`Line`] (the first rows, kept for the detection).
+struct OwnedLine {
     no: usize,
-    text: &'a str,
+    text: String,
+}
+
+impl OwnedLine {
+    fn view(&self) -> Line<'_> {
+        Line {
+            no: self.no,
+            text: &self.text,
+        }
+    }
 }
 
 /// Read a recording from a delimited text file (see the module doc for the format).
+///
+/// The file is read line by line with bounded memory
+/// ([`crate::io::source`]): a line beyond 1 MiB, a NUL byte, invalid UTF-8
+/// and, from a pipe or device, more than 256 MiB are refused where they occur;
+/// so are a ragged row, a cell that is not a number and a time that does not
+/// increase, without reading further.
 pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<Recording> {
-    let bytes = read_file(path)?;
-    read_csv_from_bytes(&bytes, path, opts)
+    opts.validate()?;
+    let (file, limit) = open_input(path)?;
+    let mut lines = LineReader::new(BufReader::with_capacity(1 << 16, file), path, limit);
+    parse_text(&mut lines, path, opts)
+}
+
+/// Read a recording from text coming from `reader` (at most `limit` bytes).
+pub(crate) fn read_csv_from_reader<R: std::io::Read>(
+    reader: R,
+    path: &Path,
+    opts: &ReadOptions,
+    limit: Option<u64>,
+) -> Result<Recording> {
+    opts.validate()?;
+    let mut lines = LineReader::new(BufReader::with_capacity(1 << 16, reader), path, limit);
+    parse_text(&mut lines, path, opts)
 }
 
 /// Read a recording from text in memory; `source` names it in errors.
@@ -84,130 +124,90 @@ pub fn read_csv_from_str(text: &str, source: &Path, opts: &ReadOptions) -> Resul
 /// Read a recording from bytes in memory (checked to be UTF-8 line by line); `source` names them in errors.
 pub fn read_csv_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> Result<Recording> {
     opts.validate()?;
-    let path = source;
-    let lines = split_lines(bytes, path)?;
-    let Some(first) = lines.first() else {
-        return Err(Error::Malformed {
-            path: path.to_path_buf(),
-            line: 1,
-            reason: "the file is empty (no header, no data rows)".into(),
-        });
-    };
-    let delim = match opts.delimiter {
-        None => detect_delimiter(&lines),
-        Some(b' ') => Delim::Whitespace,
-        Some(b) => Delim::Byte(b),
-    };
+    let mut lines = LineReader::new(bytes, source, None);
+    parse_text(&mut lines, source, opts)
+}
 
-    let mut fields: Vec<&str> = Vec::new();
-    let mut below: Vec<&str> = Vec::new();
-    split_checked(first, delim, path, &mut fields)?;
-    let has_header = match opts.header {
-        Some(h) => h,
-        None => {
-            if let Some(second) = lines.get(1) {
-                split_checked(second, delim, path, &mut below)?;
-                fields
-                    .iter()
-                    .enumerate()
-                    .any(|(i, c)| !number_like(c) && below.get(i).is_some_and(|b| number_like(b)))
-            } else {
-                fields.iter().any(|c| !number_like(c))
-            }
+/// The next line that is neither blank nor a comment.
+fn next_content<'r, R: BufRead>(lines: &'r mut LineReader<R>) -> Result<Option<Line<'r>>> {
+    Ok(lines
+        .next_content_line()?
+        .map(|(no, text)| Line { no, text }))
+}
+
+/// Parse the lines of a text recording (see the module doc for the format).
+fn parse_text<R: BufRead>(
+    lines: &mut LineReader<R>,
+    path: &Path,
+    opts: &ReadOptions,
+) -> Result<Recording> {
+    // the first rows, for the delimiter and the header
+    let mut head: Vec<OwnedLine> = Vec::new();
+    while head.len() < DETECT_ROWS {
+        match next_content(lines)? {
+            Some(l) => head.push(OwnedLine {
+                no: l.no,
+                text: l.text.to_string(),
+            }),
+            None => break,
         }
-    };
-    let header: Option<Vec<String>> =
-        has_header.then(|| fields.iter().map(|s| s.to_string()).collect());
-    let ncols = fields.len();
-    let data = if has_header {
-        lines.get(1..).unwrap_or_default()
+    }
+    let head_lines: Vec<Line<'_>> = head.iter().map(OwnedLine::view).collect();
+    let layout = TextLayout::detect(&head_lines, opts, path, Headerless::ByName)?;
+    let header_line = layout.first_line;
+    let data_head = if layout.has_header() {
+        head_lines.get(1..).unwrap_or_default()
     } else {
-        &lines[..]
+        &head_lines[..]
     };
-    if data.is_empty() {
+    if data_head.is_empty() {
         return Err(Error::Malformed {
             path: path.to_path_buf(),
-            line: first.no,
+            line: header_line,
             reason: "header only, no data rows".into(),
         });
     }
+    let (ncols, time_col, cmd_col, pos_col) = (
+        layout.ncols,
+        layout.time_col,
+        layout.cmd_col,
+        layout.pos_col,
+    );
+    let names = layout.header.as_deref();
+    let col_name = |i: usize| layout.col_name(i);
 
-    // Resolve the columns.
-    let names = header.as_deref();
-    let resolve = |r: &ChannelRef| resolve_column(r, names, ncols, path);
-    let default = |o: &Option<ChannelRef>, d: &str| {
-        o.clone().unwrap_or_else(|| ChannelRef::Name(d.to_string()))
-    };
-    let time_col = match (&opts.time, opts.rate_hz) {
-        (None, Some(_)) => None,
-        (t, _) => Some(resolve(&default(t, DEFAULT_TIME_COLUMN))?),
-    };
-    let cmd_col = resolve(&default(&opts.command, DEFAULT_COMMAND_COLUMN))?;
-    let pos_col = resolve(&default(&opts.position, DEFAULT_POSITION_COLUMN))?;
-    let col_name = |i: usize| match names.and_then(|n| n.get(i)) {
-        Some(n) if !n.is_empty() => n.clone(),
-        _ => (i + 1).to_string(),
-    };
-
-    // Parse the rows.
-    let n = data.len();
-    let mut time = time_col.map(|_| Vec::with_capacity(n));
-    let mut command = Vec::with_capacity(n);
-    let mut position = Vec::with_capacity(n);
-    let mut extras: Vec<Option<Vec<f64>>> = (0..ncols)
-        .map(|c| {
-            let used = Some(c) == time_col || c == cmd_col || c == pos_col;
-            (!used).then(|| Vec::with_capacity(n))
-        })
-        .collect();
-    let mut row_lines = Vec::with_capacity(n);
-    let reference_line = data.first().map_or(first.no, |l| l.no);
-    let reference_line = if has_header { first.no } else { reference_line };
-    for line in data {
-        split_checked(line, delim, path, &mut fields)?;
-        if fields.len() != ncols {
-            let hint = if delim == Delim::Byte(b',') && fields.len() > ncols {
-                "; if the file uses decimal commas, convert them to decimal points"
-            } else {
-                ""
-            };
-            return Err(Error::Malformed {
-                path: path.to_path_buf(),
-                line: line.no,
-                reason: format!(
-                    "{} fields, expected {} as in line {}{}",
-                    fields.len(),
-                    ncols,
-                    reference_line,
-                    hint
-                ),
-            });
-        }
-        let cell = |c: usize| -> Result<f64> {
-            let text = fields.get(c).copied().unwrap_or("");
-            parse_number(text).ok_or_else(|| Error::BadNumber {
-                path: path.to_path_buf(),
-                line: line.no,
-                column: col_name(c),
-                text: short_text(text),
-                hint: decimal_comma_hint(text, delim),
+    // Parse the rows as they are read.
+    let mut rows = Rows {
+        path,
+        layout: &layout,
+        time_factor: opts.time_unit.factor(),
+        time: time_col.map(|_| Vec::new()),
+        command: Vec::new(),
+        position: Vec::new(),
+        extras: (0..ncols)
+            .map(|c| {
+                let used = Some(c) == time_col || c == cmd_col || c == pos_col;
+                (!used).then(Vec::new)
             })
-        };
-        if let (Some(t), Some(c)) = (time.as_mut(), time_col) {
-            t.push(cell(c)?);
-        }
-        command.push(cell(cmd_col)?);
-        position.push(cell(pos_col)?);
-        for (c, slot) in extras.iter_mut().enumerate() {
-            if let Some(v) = slot {
-                match fields.get(c).and_then(|s| parse_number(s)) {
-                    Some(x) if crate::recording::is_usable(x) => v.push(x),
-                    _ => *slot = None,
-                }
-            }
-        }
-        row_lines.push(line.no);
+            .collect(),
+        row_lines: Vec::new(),
+    };
+    for line in data_head {
+        rows.push(line)?;
     }
+    drop(head_lines);
+    drop(head);
+    while let Some(line) = next_content(lines)? {
+        rows.push(&line)?;
+    }
+    let Rows {
+        time,
+        command,
+        position,
+        extras,
+        row_lines,
+        ..
+    } = rows;
 
     let mut rec = build_recording(time, command, position, opts).map_err(|e| {
         let location = match failing_sample(&e) {
@@ -228,43 +228,95 @@ pub fn read_csv_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
         };
         in_file(path, location, e)
     })?;
+    // extra channels; a name given to several columns gets `@column` on each
+    let name_of = |c: usize| match names.and_then(|n| n.get(c)) {
+        Some(n) if !n.is_empty() => n.clone(),
+        _ => format!("col{}", c + 1),
+    };
+    let kept: Vec<bool> = extras.iter().map(Option::is_some).collect();
     for (c, slot) in extras.into_iter().enumerate() {
-        if let Some(v) = slot {
-            let name = match names.and_then(|n| n.get(c)) {
-                Some(n) if !n.is_empty() => n.clone(),
-                _ => format!("col{}", c + 1),
-            };
+        let Some(v) = slot else { continue };
+        let name = name_of(c);
+        let same: Vec<usize> = (0..ncols)
+            .filter(|&i| names.is_some() && name_of(i) == name)
+            .collect();
+        if same.len() > 1 {
+            rec = rec.with_channel(&format!("{name}@{}", c + 1), v)?;
+            if same.iter().find(|&&i| kept[i]) == Some(&c) {
+                rec = rec.with_note(format!(
+                    "columns {} of the header are all named `{name}`: the extra channels are called {}",
+                    short_list(same.iter().map(|i| (i + 1).to_string())),
+                    short_list(
+                        same.iter()
+                            .filter(|&&i| kept[i])
+                            .map(|i| format!("{name}@{}", i + 1))
+                    )
+                ));
+            }
+        } else {
             rec = rec.with_channel(&name, v)?;
         }
     }
     Ok(rec)
 }
 
-/// Split into lines, checking UTF-8 and skipping blank and `#` lines.
-fn split_lines<'a>(bytes: &'a [u8], path: &Path) -> Result<Vec<Line<'a>>> {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    let mut out = Vec::new();
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let text = std::str::from_utf8(raw).map_err(|e| Error::Malformed {
-            path: path.to_path_buf(),
-            line: i + 1,
-            reason: format!(
-                "invalid UTF-8 at byte {} of the line (is this a text file?)",
-                e.valid_up_to() + 1
-            ),
-        })?;
-        let t = text.trim();
-        if t.is_empty() || t.starts_with('#') {
-            continue;
+/// The columns being collected, row by row.
+struct Rows<'p, 'l> {
+    path: &'p Path,
+    layout: &'l TextLayout,
+    time_factor: f64,
+    time: Option<Vec<f64>>,
+    command: Vec<f64>,
+    position: Vec<f64>,
+    extras: Vec<Option<Vec<f64>>>,
+    row_lines: Vec<usize>,
+}
+
+impl Rows<'_, '_> {
+    /// Parse one data row ([`TextLayout::row`]: field count, numbers) and
+    /// check that the time increases (here, so that a bad stream stops at
+    /// once; the other checks of [`Recording`] run once everything is read);
+    /// the extra columns are kept while all their cells are numbers.
+    fn push(&mut self, line: &Line<'_>) -> Result<()> {
+        let path = self.path;
+        let row = self.layout.row(line, path)?;
+        if let (Some(t), Some(v), Some(c)) = (self.time.as_mut(), row.time, self.layout.time_col) {
+            if let Some(&prev) = t.last() {
+                if v.is_finite() && prev.is_finite() && v <= prev {
+                    return Err(in_file(
+                        path,
+                        format!("line {}, column `{}`", line.no, self.layout.col_name(c)),
+                        Error::NonMonotoneTime {
+                            index: t.len(),
+                            previous: prev * self.time_factor,
+                            value: v * self.time_factor,
+                        },
+                    ));
+                }
+            }
+            t.push(v);
         }
-        out.push(Line { no: i + 1, text });
+        self.command.push(row.command);
+        self.position.push(row.position);
+        if self.extras.iter().any(Option::is_some) {
+            let mut fields: Vec<&str> = Vec::with_capacity(self.layout.ncols);
+            split_checked(line, self.layout.delim, path, &mut fields)?;
+            for (c, slot) in self.extras.iter_mut().enumerate() {
+                if let Some(v) = slot {
+                    match fields.get(c).and_then(|s| parse_number(s)) {
+                        Some(x) if crate::recording::is_usable(x) => v.push(x),
+                        _ => *slot = None,
+                    }
+                }
+            }
+        }
+        self.row_lines.push(line.no);
+        Ok(())
     }
-    Ok(out)
 }
 
 /// Pick the delimiter (see the module doc).
-fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
+pub(super) fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
     const CANDIDATES: [Delim; 4] = [
         Delim::Byte(b'\t'),
         Delim::Byte(b';'),
@@ -307,7 +359,12 @@ fn detect_delimiter<'a>(lines: &[Line<'a>]) -> Delim {
 }
 
 /// Split a line, mapping quote errors to [`Error::Malformed`].
-fn split_checked<'a>(line: &Line<'a>, d: Delim, path: &Path, out: &mut Vec<&'a str>) -> Result<()> {
+pub(super) fn split_checked<'a>(
+    line: &Line<'a>,
+    d: Delim,
+    path: &Path,
+    out: &mut Vec<&'a str>,
+) -> Result<()> {
     split_fields(line.text, d, out).map_err(|reason| Error::Malformed {
         path: path.to_path_buf(),
         line: line.no,
@@ -322,10 +379,19 @@ fn split_fields<'a>(
     out: &mut Vec<&'a str>,
 ) -> std::result::Result<(), &'static str> {
     out.clear();
+    for_each_field(line, d, |f| out.push(f))
+}
+
+/// Call `field` with each trimmed field of `line` in order (see [`split_fields`]).
+pub(super) fn for_each_field<'a>(
+    line: &'a str,
+    d: Delim,
+    mut field: impl FnMut(&'a str),
+) -> std::result::Result<(), &'static str> {
     let delim = match d {
         Delim::Whitespace => {
             for f in line.split_whitespace() {
-                out.push(unquote(f));
+                field(unquote(f));
             }
             return Ok(());
         }
@@ -343,7 +409,7 @@ fn split_fields<'a>(
             let Some(len) = bytes[start..].iter().position(|&b| b == b'"') else {
                 return Err("unterminated quoted field");
             };
-            out.push(line.get(start..start + len).unwrap_or(""));
+            field(line.get(start..start + len).unwrap_or(""));
             i = start + len + 1;
             while i < bytes.len() && is_space(bytes[i]) {
                 i += 1;
@@ -360,7 +426,7 @@ fn split_fields<'a>(
                 .iter()
                 .position(|&b| b == delim)
                 .map_or(bytes.len(), |p| i + p);
-            out.push(line.get(i..end).unwrap_or("").trim());
+            field(line.get(i..end).unwrap_or("").trim());
             if end >= bytes.len() {
                 return Ok(());
             }
@@ -376,12 +442,12 @@ fn unquote(f: &str) -> &str {
 }
 
 /// Strict number parse (trimmed Rust `f64` syntax).
-fn parse_number(s: &str) -> Option<f64> {
+pub(super) fn parse_number(s: &str) -> Option<f64> {
     s.trim().parse::<f64>().ok()
 }
 
 /// A number, or a number written with a decimal comma (for header detection).
-fn number_like(s: &str) -> bool {
+pub(super) fn number_like(s: &str) -> bool {
     parse_number(s).is_some() || looks_decimal_comma(s)
 }
 
@@ -395,7 +461,7 @@ fn looks_decimal_comma(s: &str) -> bool {
 ///
 /// With `,` as delimiter, decimal commas in a whitespace-separated file show up
 /// as cells like `5 1` (the tail of one number and the head of the next).
-fn decimal_comma_hint(text: &str, d: Delim) -> &'static str {
+pub(super) fn decimal_comma_hint(text: &str, d: Delim) -> &'static str {
     if looks_decimal_comma(text) || (d == Delim::Byte(b',') && split_number(text)) {
         DECIMAL_COMMA_HINT
     } else {
@@ -410,12 +476,16 @@ fn split_number(text: &str) -> bool {
     matches!((parts.next(), parts.next(), parts.next()), (Some(a), Some(b), None) if digits(a) && digits(b))
 }
 
-/// Find a column by name or 1-based index.
-fn resolve_column(
+/// Find a column by name (exact, else case-insensitive) or 1-based index.
+/// A name that several columns carry is refused (never the first taken
+/// silently); `role` (`time`, `command`, `position`) names the choice.
+pub(super) fn resolve_column(
     r: &ChannelRef,
     header: Option<&[String]>,
     ncols: usize,
     path: &Path,
+    role: &str,
+    header_line: usize,
 ) -> Result<usize> {
     let missing = |available: String| Error::MissingChannel {
         path: path.to_path_buf(),
@@ -424,6 +494,16 @@ fn resolve_column(
         available,
     };
     let by_index = || format!("columns 1 to {ncols} by index (the file has no header row)");
+    let ambiguous = |n: &str, cols: &[usize]| {
+        Error::Malformed {
+        path: path.to_path_buf(),
+        line: header_line,
+        reason: format!(
+            "the {role} column `{n}` is ambiguous: columns {} of the header are all named so; select one by its number",
+            short_list(cols.iter().map(|c| (c + 1).to_string()))
+        ),
+    }
+    };
     match (r, header) {
         (ChannelRef::Index(i), _) => {
             if (1..=ncols).contains(i) {
@@ -435,20 +515,21 @@ fn resolve_column(
                 }))
             }
         }
-        (ChannelRef::Name(n), Some(h)) => h
-            .iter()
-            .position(|c| c == n)
-            .or_else(|| {
-                let mut it = h
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, c)| c.eq_ignore_ascii_case(n));
-                match (it.next(), it.next()) {
-                    (Some((i, _)), None) => Some(i),
-                    _ => None,
-                }
-            })
-            .ok_or_else(|| missing(short_list(h))),
+        (ChannelRef::Name(n), Some(h)) => {
+            let exact: Vec<usize> = (0..h.len()).filter(|&i| h[i] == *n).collect();
+            let matches = if exact.is_empty() {
+                (0..h.len())
+                    .filter(|&i| h[i].eq_ignore_ascii_case(n))
+                    .collect()
+            } else {
+                exact
+            };
+            match matches.as_slice() {
+                [] => Err(missing(short_list(h))),
+                [i] => Ok(*i),
+                many => Err(ambiguous(n, many)),
+            }
+        }
         (ChannelRef::Name(_), None) => Err(missing(by_index())),
     }
 }
@@ -686,6 +767,116 @@ mod tests {
         assert_eq!(r.len(), 2);
         let e = read("time_s,command_m,position_m\n0,\"0,0\n").unwrap_err();
         assert!(matches!(e, Error::Malformed { line: 2, .. }), "{e}");
+    }
+
+    #[test]
+    fn cr_only_line_endings_are_read_like_newlines() {
+        let text = "time_s,command_m,position_m\r0,0,0\r0.001,1,0.5\r0.002,2,1.5\r";
+        let r = read(text).unwrap();
+        assert_eq!(r.command(), &[0.0, 1.0, 2.0]);
+        let e = read("time_s,command_m,position_m\r0,0,0\r0.001,x,0\r").unwrap_err();
+        assert!(matches!(e, Error::BadNumber { line: 3, .. }), "{e}");
+    }
+
+    #[test]
+    fn nul_bytes_are_named_with_line_and_byte() {
+        let bytes = b"time_s,command_m,position_m\n0,0,0\n0.001,\x001,0\n";
+        let e =
+            read_csv_from_bytes(bytes, Path::new("b.csv"), &ReadOptions::default()).unwrap_err();
+        assert!(matches!(e, Error::Malformed { line: 3, .. }), "{e}");
+        assert!(e.to_string().contains("NUL byte at byte 7"), "{e}");
+    }
+
+    #[test]
+    fn a_used_column_named_twice_is_refused_and_others_are_renamed() {
+        let text = "time_s,command_m,position_m,position_m\n0,0,0,9\n0.001,1,1,9\n";
+        let e = read(text).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(e, Error::Malformed { line: 1, .. })
+                && msg.contains("position column `position_m` is ambiguous")
+                && msg.contains("columns 3, 4"),
+            "{msg}"
+        );
+        // by index it is read, and the unused duplicate is named
+        let opts = ReadOptions {
+            position: Some(ChannelRef::Index(3)),
+            ..Default::default()
+        };
+        let r = read_with(text, opts).unwrap();
+        assert_eq!(r.position(), &[0.0, 1.0]);
+        assert_eq!(r.extra()[0].0, "position_m@4");
+        assert!(
+            r.notes()[0].contains("called position_m@4"),
+            "{:?}",
+            r.notes()
+        );
+        // two unused columns of one name: both kept, renamed, and a note says so
+        let text = "time_s,command_m,position_m,i,i\n0,0,0,1,2\n0.001,1,1,3,4\n";
+        let r = read(text).unwrap();
+        let names: Vec<&str> = r.extra().iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, vec!["i@4", "i@5"]);
+        assert_eq!(r.notes().len(), 1, "{:?}", r.notes());
+        assert!(r.notes()[0].contains("columns 4, 5"), "{:?}", r.notes());
+        // case-insensitive twins are ambiguous too
+        let e = read("time_s,Command_M,COMMAND_M,position_m\n0,0,0,0\n1,1,1,1\n").unwrap_err();
+        assert!(e.to_string().contains("ambiguous"), "{e}");
+    }
+
+    #[test]
+    fn an_endless_stream_stops_at_its_first_bad_row_or_at_the_limit() {
+        // `yes 0,0,0`: the time does not increase at the second row
+        struct Yes(&'static [u8], usize);
+        impl std::io::Read for Yes {
+            fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+                let mut n = 0;
+                while n < buf.len() {
+                    buf[n] = self.0[self.1 % self.0.len()];
+                    self.1 += 1;
+                    n += 1;
+                }
+                Ok(n)
+            }
+        }
+        let e = read_csv_from_reader(
+            Yes(b"0,0,0\n", 0),
+            Path::new("fifo"),
+            &ReadOptions {
+                time: Some(ChannelRef::Index(1)),
+                command: Some(ChannelRef::Index(2)),
+                position: Some(ChannelRef::Index(3)),
+                ..Default::default()
+            },
+            Some(1 << 30),
+        )
+        .unwrap_err();
+        assert!(
+            matches!(e.root(), Error::NonMonotoneTime { index: 1, .. })
+                && e.to_string().contains("line 2"),
+            "{e}"
+        );
+        // increasing time forever: refused at the limit
+        struct Counter(u64, Vec<u8>);
+        impl std::io::Read for Counter {
+            fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+                if self.1.is_empty() {
+                    self.0 += 1;
+                    self.1 = format!("{},0,0\n", self.0).into_bytes();
+                }
+                let n = buf.len().min(self.1.len());
+                buf[..n].copy_from_slice(&self.1[..n]);
+                self.1.drain(..n);
+                Ok(n)
+            }
+        }
+        let e = read_csv_from_reader(
+            Counter(0, b"time_s,command_m,position_m\n".to_vec()),
+            Path::new("fifo"),
+            &ReadOptions::default(),
+            Some(100_000),
+        )
+        .unwrap_err();
+        assert!(matches!(e, Error::InputTooLarge { .. }), "{e}");
     }
 
     #[test]

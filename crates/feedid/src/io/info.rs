@@ -12,10 +12,10 @@
 //!   pauses shorter than [`SEGMENT_MIN_STANDSTILL_S`] = 0.1 s do not split a
 //!   segment; each segment has its net distance, travel `Σ|Δc|` and peak speed.
 //!
-//! Warnings: the command or the position never moves (by more than 1 nm);
-//! the command moves from the first sample (no rest phase); position and
-//! command ranges differ by more than a factor 10, or the tracking error rms
-//! exceeds half the command range (unit, scale or sign mismatch?).
+//! Warnings: those of [`crate::plausibility::check_recording`] (a command
+//! that never moves, a frozen position, different units, implausible speed
+//! or lag, a sign or offset mismatch, what the reader decided), and a
+//! command that moves from the first sample (no rest phase).
 //!
 //! ```
 //! use feedid::{io::recording_info, Recording};
@@ -32,6 +32,7 @@ use std::fmt;
 
 use serde::Serialize;
 
+use crate::plausibility::check_recording;
 use crate::recording::{MotionSegment, Recording, MOTION_THRESHOLD};
 
 /// Motion threshold per step, relative to the command range.
@@ -103,35 +104,17 @@ pub fn recording_info(rec: &Recording) -> RecordingInfo {
     let e_rms = (se / n).sqrt();
 
     let c_range = channels[0].max - channels[0].min;
-    let x_range = channels[1].max - channels[1].min;
     let step = MOTION_THRESHOLD.max(SEGMENT_STEP_RELATIVE * c_range);
     let segments = rec.motion_segments(step, SEGMENT_MIN_STANDSTILL_S);
 
-    let mut warnings = Vec::new();
-    let c_moves = c_range > MOTION_THRESHOLD;
-    if !c_moves {
-        warnings.push("command never moves (range <= 1 nm): nothing to identify".to_string());
-    }
-    if x_range <= MOTION_THRESHOLD {
-        warnings.push("position never moves (range <= 1 nm)".to_string());
-    }
+    let mut warnings: Vec<String> = check_recording(rec)
+        .into_iter()
+        .map(|w| w.message)
+        .collect();
     if c.len() >= 2 && (c[1] - c[0]).abs() > MOTION_THRESHOLD {
         warnings.push(
             "command moves from the first sample: no rest phase before the motion".to_string(),
         );
-    }
-    if c_moves && x_range > MOTION_THRESHOLD {
-        let ratio = x_range / c_range;
-        if !(0.1..=10.0).contains(&ratio) {
-            warnings.push(format!(
-                "position range is {ratio:.3} × the command range: are both in the same unit?"
-            ));
-        } else if e_rms > 0.5 * c_range {
-            warnings.push(format!(
-                "tracking error rms ({}) exceeds half the command range: sign or offset mismatch?",
-                fmt_len(e_rms)
-            ));
-        }
     }
 
     RecordingInfo {
@@ -308,7 +291,7 @@ mod tests {
         let x: Vec<f64> = c.iter().map(|v| v * 1e3).collect();
         let i = recording_info(&rec(c, x));
         assert!(
-            i.warnings.iter().any(|w| w.contains("same unit")),
+            i.warnings.iter().any(|w| w.contains("different units")),
             "{:?}",
             i.warnings
         );

@@ -62,7 +62,8 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::io::options::{ChannelRef, ReadOptions};
-use crate::io::read::{build_recording, failing_sample, in_file, read_file, short_list, Role};
+use crate::io::read::{build_recording, failing_sample, in_file, short_list, Role};
+use crate::io::source::read_file;
 use crate::recording::Recording;
 
 const HEADER_LEN: usize = 128;

@@ -1,14 +1,21 @@
 //! Reading recordings from CSV/text and MATLAB v5 files ([`read_recording`]
 //! dispatches), the options that pick columns and units ([`ReadOptions`]),
-//! the summary a user checks before identifying ([`recording_info`]), and
-//! writing results without leaving partial files ([`write_atomic`]).
+//! the summary a user checks before identifying ([`recording_info`]), a
+//! live text stream read line by line with the same options
+//! ([`StreamReader`]), and writing results without destroying anything or
+//! leaving partial files ([`OutputSet`], [`write_atomic`]), and the CSV
+//! tables of results.
 
 mod csv;
 mod info;
+mod layout;
 mod mat;
 mod options;
 mod output;
 mod read;
+mod source;
+mod stream;
+mod table;
 
 pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
 pub use self::info::{recording_info, ChannelStats, RecordingInfo};
@@ -21,6 +28,12 @@ pub use self::options::{
     DEFAULT_TIME_COLUMN,
 };
 pub use self::output::{
-    cell, write_atomic, write_coefficients_csv, write_predictions_csv, write_string_atomic,
+    abandon_pending_outputs, destination, pending_output_count, write_atomic, write_string_atomic,
+    Destination, OutputSet,
 };
 pub use self::read::{read_recording, read_recording_from_bytes};
+pub use self::source::{read_small_text, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES};
+pub use self::stream::{
+    PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,
+};
+pub use self::table::{cell, write_coefficients_csv, write_predictions_csv, CoefficientRow};

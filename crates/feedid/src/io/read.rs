@@ -20,19 +20,51 @@
 //! # Ok::<(), feedid::Error>(())
 //! ```
 
+use std::io::{BufReader, Read};
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::io::csv::read_csv_from_bytes;
+use crate::io::csv::{read_csv_from_bytes, read_csv_from_reader};
 use crate::io::mat::{is_mat_bytes, read_mat_from_bytes};
 use crate::io::options::ReadOptions;
+use crate::io::source::{open_input, read_to_end_bounded};
 use crate::recording::Recording;
 
-/// Read a recording from a MAT-file or a text file (see the module doc for the dispatch rule).
+/// Read a recording from a MAT-file or a text file (see the module doc for
+/// the dispatch rule). Text is read line by line with bounded memory, a
+/// MAT-file whole; from a pipe or device at most
+/// [`crate::io::MAX_STREAM_BYTES`] (see [`crate::io::read_csv`]).
 pub fn read_recording(path: &Path, opts: &ReadOptions) -> Result<Recording> {
-    let bytes = read_file(path)?;
-    read_recording_from_bytes(&bytes, path, opts)
+    let mat_ext = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mat"));
+    let (file, limit) = open_input(path)?;
+    let mut reader = BufReader::with_capacity(1 << 16, file);
+    // the first bytes decide (a MAT-file's signatures end at byte 520)
+    let mut head = Vec::with_capacity(MAT_SIGNATURE_BYTES);
+    (&mut reader)
+        .take(MAT_SIGNATURE_BYTES as u64)
+        .read_to_end(&mut head)
+        .map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    if mat_ext || is_mat_bytes(&head) {
+        let rest = read_to_end_bounded(
+            reader,
+            limit.map(|l| l.saturating_sub(head.len() as u64)),
+            path,
+        )?;
+        head.extend_from_slice(&rest);
+        read_mat_from_bytes(&head, path, opts)
+    } else {
+        read_csv_from_reader(head.as_slice().chain(reader), path, opts, limit)
+    }
 }
+
+/// Bytes that decide between a MAT-file and text (the HDF5 signature of a
+/// v7.3 file may sit at byte 512).
+const MAT_SIGNATURE_BYTES: usize = 520;
 
 /// Like [`read_recording`] for file contents already in memory; `source` names them in errors.
 pub fn read_recording_from_bytes(
@@ -48,14 +80,6 @@ pub fn read_recording_from_bytes(
     } else {
         read_csv_from_bytes(bytes, source, opts)
     }
-}
-
-/// Read a whole file, mapping failures to [`Error::Io`].
-pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })
 }
 
 /// Which of the three signals an error concerns.

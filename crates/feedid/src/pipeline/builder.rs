@@ -8,6 +8,7 @@ use crate::ident::{
     OrderSearch, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
+use crate::plausibility::check_recording;
 use crate::recording::Recording;
 use crate::stats::ErrorStats;
 
@@ -214,7 +215,10 @@ impl<'a> Pipeline<'a> {
         };
         let config = self.engine_config(&method);
         let signals = recording.signals();
-        let mut warnings = Vec::new();
+        let mut warnings: Vec<Warning> = check_recording(recording)
+            .into_iter()
+            .map(Warning::Recording)
+            .collect();
         if let Method::Paper(paper) = &method {
             let g = paper.worst_shift_amplification(&signals, &config);
             if g > SHIFT_AMPLIFICATION_WARNING {
@@ -247,7 +251,13 @@ impl<'a> Pipeline<'a> {
             )
         });
         let residuals = self.residual_lags.and_then(|lags| {
-            prediction_residuals(&sliding, recording.command(), recording.position(), lags)
+            prediction_residuals(
+                &sliding,
+                recording.command(),
+                recording.position(),
+                lags,
+                config.horizon,
+            )
         });
 
         let method_kind = method.global_model().filter(|_| self.method_global_model);

@@ -91,9 +91,22 @@ impl Identification {
                 .as_ref()
                 .and_then(|g| g.identified_by.as_ref())
                 .map(|p| format!("{} {}", p.method, p.orders)),
-            sim_rms_error_m: self.simulation_stats.map(|x| x.rms),
-            sim_max_abs_error_m: self.simulation_stats.map(|x| x.max_abs),
-            nominal_fit_percent: self.simulation_stats.map(|x| x.fit_percent),
+            sim_rms_error_m: self
+                .simulation_stats
+                .map(|x| x.rms)
+                .filter(|v| v.is_finite()),
+            sim_max_abs_error_m: self
+                .simulation_stats
+                .map(|x| x.max_abs)
+                .filter(|v| v.is_finite()),
+            nominal_fit_percent: self
+                .simulation_stats
+                .map(|x| x.fit_percent)
+                .filter(|v| v.is_finite()),
+            simulation_diverged: self
+                .simulation_stats
+                .is_some_and(|x| !(x.rms.is_finite() && x.max_abs.is_finite())),
+            warnings: self.warnings.iter().map(|w| w.to_string()).collect(),
             identification_seconds: s.elapsed.as_secs_f64(),
             per_window_us: s.per_window_us(),
             residuals: self.residuals.clone(),

@@ -67,11 +67,20 @@ pub struct IdentifySummary {
     pub identification_seconds: f64,
     /// Mean wall time per window \[µs\].
     pub per_window_us: f64,
+    /// What the run found that the user should know: the recording's
+    /// plausibility warnings ([`crate::plausibility`]) and the method's.
+    pub warnings: Vec<String>,
+    /// The nominal simulation ran away (an unstable model allowed by the
+    /// caller); its error figures are left out (text only).
+    #[serde(skip)]
+    pub simulation_diverged: bool,
     /// Residual analysis of the prediction errors `y − ŷ` over the predicted
-    /// samples (at most the last 200 000) against the command, lags 0 … 25
-    /// (`None` when fewer than 52 samples were predicted). The k-step
-    /// errors of one horizon share the state they were predicted from, so
-    /// `r_ee` is expected to be positive for lags below the horizon.
+    /// samples (at most the last 200 000) against the command, lags
+    /// 0 … max(25, 2H) (`None` when fewer than 52 samples were predicted).
+    /// The k-step errors of one horizon share the state they were predicted
+    /// from, so `r_ee` is positive for lags below the horizon H whatever the
+    /// model: its verdict `ee_inside` tests the lags H … max(25, 2H) only
+    /// (`ee_first_lag`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residuals: Option<ResidualAnalysis>,
     /// Orders chosen from the recording, if asked (text only).
@@ -115,13 +124,26 @@ impl fmt::Display for IdentifySummary {
             self.samples_predicted,
             self.coverage_percent
         )?;
-        writeln!(
-            f,
-            "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %",
-            1e6 * self.rms_error_m,
-            1e6 * self.max_abs_error_m,
-            self.fit_percent
-        )?;
+        if self.samples_predicted == 0 {
+            // no figure over nothing
+            writeln!(
+                f,
+                "  prediction error: none (no sample was predicted; see the window, the tolerance and the warnings)"
+            )?;
+        } else {
+            writeln!(
+                f,
+                "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %{}",
+                1e6 * self.rms_error_m,
+                1e6 * self.max_abs_error_m,
+                self.fit_percent,
+                if self.warnings.is_empty() {
+                    ""
+                } else {
+                    " (see the warnings)"
+                }
+            )?;
+        }
         if let (Some(m), Some(fit)) = (&self.global_model, self.global_fit_percent) {
             writeln!(
                 f,
@@ -138,6 +160,8 @@ impl fmt::Display for IdentifySummary {
                 1e6 * r,
                 1e6 * m
             )?;
+        } else if self.simulation_diverged {
+            writeln!(f, "  simulation model:  diverged (unstable parameters)")?;
         }
         writeln!(
             f,

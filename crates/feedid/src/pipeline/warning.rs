@@ -6,9 +6,12 @@ use serde::{Serialize, Serializer};
 
 /// A warning of an identification run ([`crate::pipeline::Identification::warnings`];
 /// printed on standard error by the CLI). Serialises as its text.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum Warning {
+    /// The recording itself is implausible (a frozen position, different
+    /// units, …): see [`crate::plausibility`].
+    Recording(crate::plausibility::Warning),
     /// Paper method with the motion time origin: the windows lie so far
     /// from the origin that the change of basis to the coefficients `N`,
     /// `D` loses digits (see
@@ -23,6 +26,7 @@ pub enum Warning {
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            Warning::Recording(w) => write!(f, "{w}"),
             Warning::PaperCoefficientAccuracy { amplification: g } => write!(
                 f,
                 "paper method: windows lie far from the time origin; the coefficients N, D \

@@ -11,10 +11,18 @@
 //! (`τ > 0`: residual after input — a correlation there means the model
 //! missed part of the input's effect). For white residuals independent of the
 //! input, each normalised correlation is approximately `N(0, 1/N)`, so 99 %
-//! of them lie inside `±2.58/√N`. The flags count a set of `L` lags
-//! (τ ≠ 0 for `r_ee`) as *inside* when at most `1 + ⌊0.02·L⌋` of them leave
-//! the 99 % band (chance exceedances) and none leaves the 99.9 % band
-//! `±3.29/√N` (a strong single peak is a real correlation).
+//! of them lie inside `±2.58/√N`. The flags count a set of `L` lags as
+//! *inside* when at most `1 + ⌊0.02·L⌋` of them leave the 99 % band (chance
+//! exceedances) and none leaves the 99.9 % band `±3.29/√N` (a strong single
+//! peak is a real correlation).
+//!
+//! The `r_ee` verdict tests the lags `τ ≥ h` only ([`ResidualAnalysis::ee_first_lag`]):
+//! the errors of a prediction `h` samples ahead ([`ResidualAnalysis::for_horizon`])
+//! share the innovations since their common origin, so even a perfect
+//! model's errors are correlated up to lag `h − 1` (an MA(h−1) process,
+//! Ljung §16.6; Box & Jenkins §5.1). `h = 1` (one-step errors) tests every
+//! lag `τ ≥ 1`. The largest lag is raised to at least `2h` so that some lags
+//! are tested.
 //!
 //! Reference: L. Ljung, *System Identification*, 2nd ed., §16.6.
 //!
@@ -52,11 +60,14 @@ pub struct ResidualAnalysis {
     pub r_ue: Vec<f64>,
     /// Half-width of the 99 % band, `2.58/√N`.
     pub bound: f64,
-    /// Lags τ ≥ 1 with `|r_ee(τ)| > bound`.
+    /// First lag of the `r_ee` verdict: the prediction horizon `h` (1 for one-step errors).
+    pub ee_first_lag: usize,
+    /// Lags τ ≥ `ee_first_lag` with `|r_ee(τ)| > bound`.
     pub ee_outside: usize,
     /// Lags with `|r_ue(τ)| > bound`.
     pub ue_outside: usize,
-    /// Whether the residuals look white (see the module doc for the rule).
+    /// Whether the residuals look white at the lags `ee_first_lag … max_lag`
+    /// (see the module doc for the rule).
     pub ee_inside: bool,
     /// Whether the residuals look independent of the input (same rule over `2M+1` lags).
     pub ue_inside: bool,
@@ -69,6 +80,15 @@ impl ResidualAnalysis {
     /// residual (perfect fit) gives zero correlations (inside the bands);
     /// a constant input gives `r_ue = 0`.
     pub fn new(u: &[f64], e: &[f64], max_lag: usize) -> Result<Self> {
+        Self::for_horizon(u, e, max_lag, 1)
+    }
+
+    /// Analyse `h`-step-ahead prediction errors: as [`ResidualAnalysis::new`]
+    /// with the largest lag raised to `max(max_lag, 2h)` and the `r_ee`
+    /// verdict over the lags `τ ≥ h` (see the module doc).
+    pub fn for_horizon(u: &[f64], e: &[f64], max_lag: usize, horizon: usize) -> Result<Self> {
+        let first = horizon.max(1);
+        let max_lag = max_lag.max(2 * first).max(1);
         let n = e.len();
         if u.len() != n {
             return Err(Error::LengthMismatch {
@@ -129,7 +149,7 @@ impl ResidualAnalysis {
             })
             .collect();
         let bound = Z_99 / (n as f64).sqrt();
-        let ee_outside = r_ee.iter().skip(1).filter(|v| v.abs() > bound).count();
+        let ee_outside = r_ee.iter().skip(first).filter(|v| v.abs() > bound).count();
         let ue_outside = r_ue.iter().filter(|v| v.abs() > bound).count();
         let strong = Z_999 / (n as f64).sqrt();
         let inside = |r: &[f64], outside: usize| {
@@ -138,7 +158,8 @@ impl ResidualAnalysis {
         Ok(Self {
             samples: n,
             max_lag,
-            ee_inside: inside(&r_ee[1..], ee_outside),
+            ee_inside: inside(&r_ee[first..], ee_outside),
+            ee_first_lag: first,
             ue_inside: inside(&r_ue, ue_outside),
             r_ee,
             r_ue,
@@ -165,21 +186,23 @@ pub const RESIDUAL_SAMPLES: usize = 200_000;
 
 /// Residual analysis of the prediction errors `y − ŷ` of a sliding run over
 /// its predicted samples (at most the last [`RESIDUAL_SAMPLES`]) against the
-/// command, lags 0 … `max_lag`; `None` when at most `2·max_lag + 1` samples
-/// were predicted. The k-step errors of one horizon share the state they
-/// were predicted from, so `r_ee` is expected to be positive for lags below
-/// the horizon.
+/// command, lags 0 … max(`max_lag`, 2·`horizon`); `None` when at most
+/// `2·max_lag + 1` samples were predicted. The k-step errors of one horizon
+/// share the state they were predicted from, so `r_ee` is positive for lags
+/// below the horizon whatever the model: the verdict tests the lags from the
+/// horizon on ([`ResidualAnalysis::for_horizon`]).
 pub fn prediction_residuals(
     s: &SlidingResult,
     command: &[f64],
     position: &[f64],
     max_lag: usize,
+    horizon: usize,
 ) -> Option<ResidualAnalysis> {
     let (u, e) = prediction_errors(s, command, position, RESIDUAL_SAMPLES);
     if e.len() <= 2 * max_lag + 1 {
         return None;
     }
-    ResidualAnalysis::new(&u, &e, max_lag).ok()
+    ResidualAnalysis::for_horizon(&u, &e, max_lag, horizon).ok()
 }
 
 /// The command `u[k]` and the prediction error `y[k] − ŷ[k]` at the
@@ -258,6 +281,47 @@ mod tests {
         let peak = r2.r_ue_at(3).unwrap();
         assert!((peak - 0.5 / 1.25f64.sqrt()).abs() < 0.05, "{peak}");
         assert!(r2.r_ue_at(-3).unwrap().abs() < r2.bound);
+    }
+
+    #[test]
+    fn k_step_errors_of_a_perfect_model_pass_beyond_the_horizon_only() {
+        // h-step-ahead errors of a perfect predictor of a random walk: the sum
+        // of the innovations since the window's origin (an MA(h−1) process)
+        let h = 10;
+        let w = white(5, 6000);
+        let mut e = Vec::new();
+        for origin in (0..w.len() - h).step_by(h) {
+            let mut acc = 0.0;
+            for k in 1..=h {
+                acc += w[origin + k];
+                e.push(acc);
+            }
+        }
+        let u = white(6, e.len());
+        let one_step = ResidualAnalysis::new(&u, &e, 25).unwrap();
+        assert!(!one_step.ee_inside, "correlated at lags below h");
+        let r = ResidualAnalysis::for_horizon(&u, &e, 25, h).unwrap();
+        assert_eq!(r.ee_first_lag, h);
+        assert!(
+            r.ee_inside,
+            "outside {} of lags ≥ {h}: {:?}",
+            r.ee_outside,
+            &r.r_ee[h..]
+        );
+        // a residual correlated beyond the horizon still fails
+        let mut c = vec![0.0; e.len()];
+        for k in 1..e.len() {
+            c[k] = 0.97 * c[k - 1] + w[k % w.len()];
+        }
+        assert!(
+            !ResidualAnalysis::for_horizon(&u, &c, 25, h)
+                .unwrap()
+                .ee_inside
+        );
+        // a long horizon raises the largest lag
+        let r = ResidualAnalysis::for_horizon(&u, &e, 25, 20).unwrap();
+        assert_eq!(r.max_lag, 40);
+        assert_eq!(r.r_ee.len(), 41);
     }
 
     #[test]

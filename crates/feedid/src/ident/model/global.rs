@@ -214,7 +214,12 @@ impl ModelFile {
             path: path.to_path_buf(),
             source,
         })?;
-        Self::from_json(&text).map_err(|e| match e {
+        Self::from_json_file(&text, path)
+    }
+
+    /// [`ModelFile::from_json`] of the text of the file `path`; errors name the file.
+    pub fn from_json_file(text: &str, path: &Path) -> Result<Self> {
+        Self::from_json(text).map_err(|e| match e {
             Error::ParamsFile { message, .. } => Error::ParamsFile {
                 path: Some(path.to_path_buf()),
                 message,

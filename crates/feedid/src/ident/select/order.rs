@@ -339,7 +339,9 @@ pub struct FrolsResult {
     pub terms: Vec<FrolsTerm>,
     /// `1 − ΣERR` after the selection.
     pub remaining: f64,
-    /// Orders implied by the selected lags (`None` without an input term).
+    /// Orders implied by the selected lags (`None` without an input term;
+    /// left out of the JSON then).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub orders: Option<ArxOrders>,
 }
 

@@ -1,0 +1,1014 @@
+//! Tests of the streamer: the batch engine's windows and predictions where
+//! the stream has the same data, when predictions are made, extrapolation,
+//! gaps, scores and misuse.
+#![allow(clippy::needless_range_loop)]
+
+use std::ops::Range;
+
+use super::*;
+use crate::drive::{RigParams, VirtualRig};
+use crate::error::{Error, Result};
+use crate::ident::engine::{run, EngineConfig, SlidingResult};
+use crate::ident::{
+    Estimator, PaperConfig, PaperMethod, PredictStatus, Signals, Solver, WindowFit, WindowOutcome,
+};
+use crate::recording::MOTION_THRESHOLD;
+use crate::signal::Scenario;
+use crate::solve::Termination;
+use crate::stats::ErrorStats;
+use crate::Recording;
+
+/// Straight line through the last two window samples (window-end estimator).
+struct Linear;
+
+impl Estimator for Linear {
+    fn name(&self) -> &'static str {
+        "linear"
+    }
+    fn coefficient_names(&self) -> Vec<String> {
+        vec!["last".into(), "slope".into()]
+    }
+    fn uses_future_command(&self) -> bool {
+        false
+    }
+    fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, c: &mut [f64]) -> Result<WindowFit> {
+        let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
+        c[0] = y[1];
+        c[1] = y[1] - y[0];
+        Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+    }
+    fn predict(
+        &mut self,
+        s: &Signals<'_>,
+        w: Range<usize>,
+        _: Range<usize>,
+        out: &mut [f64],
+    ) -> Result<PredictStatus> {
+        let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);
+        }
+        Ok(PredictStatus::Predicted)
+    }
+}
+
+/// Last position plus the command change over the horizon; reads one
+/// sample before the window (warm-up 1) and fails on every `fail`-th window
+/// (never if 0).
+struct Follow {
+    k: usize,
+    fail: usize,
+}
+
+/// `Follow` failing on every 7th window.
+fn follow7() -> Follow {
+    Follow { k: 0, fail: 7 }
+}
+
+/// `Follow` that never fails.
+fn follow() -> Follow {
+    Follow { k: 0, fail: 0 }
+}
+
+impl Estimator for Follow {
+    fn name(&self) -> &'static str {
+        "follow"
+    }
+    fn coefficient_names(&self) -> Vec<String> {
+        vec!["gain".into()]
+    }
+    fn warm_up(&self) -> usize {
+        1
+    }
+    fn reset(&mut self) {
+        self.k = 0;
+    }
+    fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, c: &mut [f64]) -> Result<WindowFit> {
+        self.k += 1;
+        if self.fail > 0 && self.k % self.fail == 0 {
+            return Err(Error::Singular { context: "test" });
+        }
+        let u = s.window(w.start - 1..w.end, 0, "test").unwrap().command;
+        let y = s.window(w.start - 1..w.end, 0, "test").unwrap().position;
+        let du = u[u.len() - 1] - u[0];
+        c[0] = if du != 0.0 {
+            (y[y.len() - 1] - y[0]) / du
+        } else {
+            1.0
+        };
+        Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+    }
+    fn predict(
+        &mut self,
+        s: &Signals<'_>,
+        w: Range<usize>,
+        h: Range<usize>,
+        out: &mut [f64],
+    ) -> Result<PredictStatus> {
+        let y0 = s.window(w.end - 1..w.end, 0, "test").unwrap().position[0];
+        let u0 = s.window(w.end - 1..w.end, 0, "test").unwrap().command[0];
+        for (o, &u) in out.iter_mut().zip(s.window(h, 0, "test").unwrap().command) {
+            *o = y0 + (u - u0);
+        }
+        Ok(PredictStatus::Predicted)
+    }
+}
+
+/// How samples are fed.
+#[derive(Debug, Clone, Copy)]
+enum Feed {
+    /// `push(t, u, y)` lines with a command lead (0: each line's own command).
+    Lines(usize),
+    /// `push_command` `l` samples ahead of `push_position`.
+    Ahead(usize),
+}
+
+/// Window, horizon, outcome and coefficients of one processed window.
+type WindowSummary = (Range<usize>, Range<usize>, WindowOutcome, Vec<f64>);
+
+/// What a stream produced, in the batch engine's layout (sample indices of the stream).
+struct Collected {
+    windows: Vec<WindowSummary>,
+    predicted: Vec<f64>,
+    has: Vec<bool>,
+    /// Time stamp each prediction gave its sample.
+    time: Vec<f64>,
+    /// (samples measured when the prediction arrived, horizon start, already measured)
+    arrivals: Vec<(usize, usize, usize)>,
+    arrivals_at_gap: Vec<Interval>,
+    stats: StreamStats,
+}
+
+fn collect_from(out: &mut Collected, p: Prediction<'_>, measured: usize) {
+    assert_eq!(p.time.len(), p.horizon.len());
+    if p.is_ok() {
+        assert_eq!(p.position.len(), p.horizon.len());
+        for (j, k) in p.horizon.clone().enumerate() {
+            if k < out.predicted.len() {
+                out.predicted[k] = p.position[j];
+                out.time[k] = p.time[j];
+                out.has[k] = true;
+            }
+        }
+    }
+    out.arrivals
+        .push((measured, p.horizon.start, p.already_measured));
+    out.windows.push((
+        p.window.clone(),
+        p.horizon.clone(),
+        p.outcome,
+        p.coefficients.to_vec(),
+    ));
+}
+
+fn empty_stats() -> StreamStats {
+    let z = ErrorStats::from_pairs([]);
+    StreamStats {
+        lines: 0,
+        samples: 0,
+        commands: 0,
+        unused_positions: 0,
+        windows: 0,
+        failed_windows: 0,
+        withheld_windows: 0,
+        predicted_ahead: 0,
+        predicted_late: 0,
+        gaps: 0,
+        irregular_intervals: 0,
+        scored: z,
+        hold: z,
+    }
+}
+
+/// Stream `rec` (`Lines(l)`: its samples `l..` are the stream's, the lines
+/// carrying the commands `l` ahead; `Ahead(l)`: all its samples) and collect.
+fn stream<E: Estimator>(
+    est: E,
+    cfg: EngineConfig,
+    rec: &Recording,
+    feed: Feed,
+    extrapolation: CommandExtrapolation,
+) -> Collected {
+    let (t, u, y) = (rec.time(), rec.command(), rec.position());
+    let n = t.len();
+    let (opts, shift) = match feed {
+        Feed::Lines(l) => (
+            StreamOptions {
+                command_lead: l,
+                extrapolation,
+                ..StreamOptions::default()
+            },
+            l,
+        ),
+        Feed::Ahead(l) => (
+            StreamOptions {
+                lookahead: Some(l),
+                extrapolation,
+                ..StreamOptions::default()
+            },
+            0,
+        ),
+    };
+    // the stream's samples are rec's samples `shift..n − shift` (the lines
+    // stop `shift` before the end, where the commands run out)
+    let (ts, m) = (&t[shift..n - shift], n - 2 * shift);
+    let mut out = Collected {
+        windows: Vec::new(),
+        predicted: vec![0.0; m],
+        has: vec![false; m],
+        time: vec![0.0; m],
+        arrivals: Vec::new(),
+        arrivals_at_gap: Vec::new(),
+        stats: empty_stats(),
+    };
+    let mut s = Streamer::with_options(est, cfg, opts).unwrap();
+    match feed {
+        Feed::Lines(l) => {
+            // line i: time and position of sample i, command of sample i + l;
+            // the last lines would need commands past the recording: stop there
+            for i in 0..n - l {
+                let a = s.push(t[i], u[i + l], y[i]).unwrap();
+                if a.interval != Interval::Regular {
+                    out.arrivals_at_gap.push(a.interval);
+                }
+                if let (Interval::Gap(_), Some(k)) = (a.interval, a.sample) {
+                    // predictions made before the gap of samples after it are void
+                    out.has[k..].fill(false);
+                } else {
+                    assert_eq!(a.sample, i.checked_sub(l), "line {i}");
+                }
+                while let Some(p) = s.poll().unwrap() {
+                    collect_from(&mut out, p, s_np(i, l));
+                }
+            }
+        }
+        Feed::Ahead(l) => {
+            for k in 0..n + l {
+                if k < n {
+                    s.push_command(u[k]).unwrap();
+                    while let Some(p) = s.poll().unwrap() {
+                        collect_from(&mut out, p, k.saturating_sub(l));
+                    }
+                }
+                if k >= l {
+                    let a = s.push_position(t[k - l], y[k - l]).unwrap();
+                    assert_eq!(a.sample, Some(k - l));
+                    while let Some(p) = s.poll().unwrap() {
+                        collect_from(&mut out, p, k - l + 1);
+                    }
+                }
+            }
+        }
+    }
+    s.finish();
+    let measured = s.stats().samples;
+    while let Some(p) = s.poll().unwrap() {
+        collect_from(&mut out, p, measured);
+    }
+    out.stats = s.stats();
+    // time stamps: actual or extrapolated to rounding
+    for k in 0..m {
+        if out.has[k] {
+            let (a, b) = (out.time[k], ts[k]);
+            assert!(
+                (a - b).abs() < 1e-12 * b.abs().max(1.0),
+                "time of {k}: {a} vs {b}"
+            );
+        }
+    }
+    out
+}
+
+/// Samples measured after line `i` with lead `l`.
+fn s_np(i: usize, l: usize) -> usize {
+    (i + 1).saturating_sub(l)
+}
+
+/// Stream and batch give the same windows, coefficients and predictions
+/// (`batch` on the stream's samples; `cut`: samples of the stream at the end
+/// whose batch horizon is cut are not compared).
+fn assert_same(c: &Collected, b: &SlidingResult, rel: f64, what: &str) {
+    let n = c.predicted.len();
+    // a window-end estimator may also process the window ending at the
+    // last sample, which has nothing left to predict in batch
+    let ws: Vec<_> = c.windows.iter().filter(|w| w.0.end < n).collect();
+    let bws: Vec<_> = b.windows.iter().filter(|w| w.window.end < n).collect();
+    assert_eq!(ws.len(), bws.len(), "{what}: window count");
+    for (i, (w, bw)) in ws.iter().zip(&bws).enumerate() {
+        assert_eq!(w.0, bw.window, "{what}: window {i}");
+        assert_eq!(w.1.start, bw.horizon.start, "{what}: window {i}");
+        assert_eq!(w.1.end.min(n), bw.horizon.end.min(n), "{what}: window {i}");
+        assert_eq!(w.2, bw.outcome, "{what}: window {i}");
+        assert_eq!(&w.3[..], b.window_coefficients(i), "{what}: window {i}");
+    }
+    let scale = b.predicted.iter().fold(1e-300_f64, |m, v| m.max(v.abs()));
+    for k in 0..n {
+        assert_eq!(c.has[k], b.has_prediction[k], "{what}: sample {k}");
+        if c.has[k] {
+            let (a, e) = (c.predicted[k], b.predicted[k]);
+            assert!(
+                (a - e).abs() <= rel * scale,
+                "{what}: sample {k}: {a:e} vs {e:e}"
+            );
+        }
+    }
+    assert_eq!(c.stats.samples, n);
+    assert_eq!(
+        c.stats.failed_windows,
+        c.windows
+            .iter()
+            .filter(|w| w.2 == WindowOutcome::Failed)
+            .count()
+    );
+}
+
+/// The scores equal the batch engine's (same predictions, same samples).
+fn assert_same_score(c: &Collected, b: &SlidingResult, rel: f64, what: &str) {
+    let scale = b.predicted.iter().fold(1e-300_f64, |m, v| m.max(v.abs()));
+    assert_eq!(c.stats.scored.samples, b.stats.samples, "{what}");
+    assert!(
+        (c.stats.scored.rms - b.stats.rms).abs() <= 1e-9 * b.stats.rms + rel * scale,
+        "{what}: rms {} vs {}",
+        c.stats.scored.rms,
+        b.stats.rms
+    );
+}
+
+fn rig_recording(scenario: Scenario, duration: f64) -> Recording {
+    let rate = 5000.0;
+    let command = scenario.command(rate, duration, 1).unwrap();
+    let out = VirtualRig::new(RigParams::default())
+        .with_seed(7)
+        .simulate(&command, rate)
+        .unwrap();
+    Recording::new(out.time, out.command, out.position).unwrap()
+}
+
+/// Samples `from..` of `rec` as a recording.
+fn tail(rec: &Recording, from: usize) -> Recording {
+    Recording::new(
+        rec.time()[from..].to_vec(),
+        rec.command()[from..].to_vec(),
+        rec.position()[from..].to_vec(),
+    )
+    .unwrap()
+}
+
+fn configs() -> [EngineConfig; 4] {
+    [
+        EngineConfig::default(),
+        EngineConfig {
+            window: 9,
+            horizon: 3,
+            hop: Some(1),
+            warm_up: 5,
+        },
+        EngineConfig {
+            window: 12,
+            horizon: 6,
+            hop: Some(4),
+            warm_up: 0,
+        },
+        EngineConfig {
+            window: 5,
+            horizon: 8,
+            hop: Some(13),
+            warm_up: 2,
+        },
+    ]
+}
+
+use CommandExtrapolation::{Acceleration, Hold, Velocity, Wait};
+
+#[test]
+fn with_the_real_command_the_stream_equals_the_batch_engine() {
+    let rec = rig_recording(Scenario::Ramp, 0.08);
+    for cfg in configs() {
+        // the real command over every horizon: waiting for it, or a look-ahead ≥ H
+        let feeds = [
+            (Feed::Lines(0), Wait),
+            (Feed::Ahead(1), Wait),
+            (Feed::Ahead(3), Wait),
+            (Feed::Ahead(12), Velocity),
+            (Feed::Lines(12), Hold),
+            (Feed::Lines(cfg.horizon), Acceleration),
+        ];
+        for (feed, x) in feeds {
+            let what = format!("{cfg:?} {feed:?} {x:?}");
+            let shift = match feed {
+                Feed::Lines(l) => l,
+                Feed::Ahead(_) => 0,
+            };
+            // the stream's samples: rec's from `shift` on (the lines stop
+            // `shift` before the end, where the commands run out)
+            let end = rec.len() - shift;
+            let batch_rec = Recording::new(
+                rec.time()[shift..end].to_vec(),
+                rec.command()[shift..end].to_vec(),
+                rec.position()[shift..end].to_vec(),
+            )
+            .unwrap();
+            let b = run(&mut Linear, &batch_rec.signals(), &cfg).unwrap();
+            let c = stream(Linear, cfg, &rec, feed, x);
+            // extrapolated time stamps are not used by these estimators
+            assert_same(&c, &b, 0.0, &format!("linear {what}"));
+            assert_same_score(&c, &b, 0.0, &format!("linear {what}"));
+            // `Follow` reads the command over the horizon: with a lead its
+            // windows at the end of the lines see commands the batch
+            // recording does not have, so compare with batch on the longer data
+            let longer = tail(&rec, shift);
+            let b = run(&mut follow7(), &longer.signals(), &cfg).unwrap();
+            assert!(b.failed_windows() > 0);
+            let c = stream(follow7(), cfg, &rec, feed, x);
+            let mut b_cut = b.clone();
+            b_cut.predicted.truncate(end - shift);
+            b_cut.has_prediction.truncate(end - shift);
+            assert_same(&c, &b_cut, 0.0, &format!("follow {what}"));
+        }
+    }
+}
+
+fn paper(solver: Solver) -> PaperMethod {
+    PaperConfig {
+        solver,
+        ..PaperConfig::default()
+    }
+    .build()
+    .unwrap()
+}
+
+#[test]
+fn paper_method_streams_as_the_batch_engine_with_qr_and_simplex() {
+    // 10 ms of rest then the ramp: rest windows, the motion start and moving windows
+    let rec = rig_recording(Scenario::Ramp, 0.1);
+    let cases = [
+        (Solver::Qr, EngineConfig::default(), Feed::Lines(0)),
+        (Solver::Qr, configs()[1], Feed::Lines(0)),
+        (Solver::Qr, configs()[2], Feed::Ahead(3)),
+        (Solver::Simplex, EngineConfig::default(), Feed::Lines(0)),
+        // a lead: the motion start found from a command ahead of its position
+        (Solver::Qr, EngineConfig::default(), Feed::Lines(10)),
+    ];
+    for (solver, cfg, feed) in cases {
+        let what = format!("{solver:?} {cfg:?} {feed:?}");
+        let shift = match feed {
+            Feed::Lines(l) => l,
+            Feed::Ahead(_) => 0,
+        };
+        let sub = Recording::new(
+            rec.time()[shift..rec.len() - shift].to_vec(),
+            rec.command()[shift..rec.len() - shift].to_vec(),
+            rec.position()[shift..rec.len() - shift].to_vec(),
+        )
+        .unwrap();
+        let b = run(&mut paper(solver), &sub.signals(), &cfg).unwrap();
+        let rest = b
+            .windows
+            .iter()
+            .filter(|w| w.outcome == WindowOutcome::Fallback)
+            .count();
+        assert!(rest > 0 && rest < b.windows.len() / 2, "{what}: {rest}");
+        assert_eq!(b.failed_windows(), 0);
+        let c = stream(paper(solver), cfg, &rec, feed, Velocity);
+        // extrapolated horizon time stamps: equal to rounding
+        assert_same(&c, &b, 1e-12, &what);
+        assert_same_score(&c, &b, 1e-12, &what);
+        // window-end emission: each prediction arrives with the window's last sample
+        for &(at, h, already) in &c.arrivals {
+            assert!(at == h || at == c.stats.samples, "{what}: {at} {h}");
+            assert_eq!(already, at.min(h + cfg.horizon) - h.min(at), "{what}");
+        }
+    }
+}
+
+#[test]
+fn motion_start_is_found_causally_with_the_batch_value() {
+    let rec = rig_recording(Scenario::Ramp, 0.03);
+    let k0 = rec.motion_start_index(MOTION_THRESHOLD).unwrap();
+    // lines with the own command: found with the first moving command
+    let mut s = Streamer::new(Linear, EngineConfig::default()).unwrap();
+    for k in 0..rec.len() {
+        s.push(rec.time()[k], rec.command()[k], rec.position()[k])
+            .unwrap();
+        while s.poll().unwrap().is_some() {}
+        if k <= k0 {
+            assert_eq!(s.motion_start(), f64::INFINITY, "{k}");
+        } else {
+            assert_eq!(s.motion_start(), rec.motion_start_time());
+        }
+    }
+    // commands 5 ahead: the sample is known early, its time once measured
+    let opts = StreamOptions {
+        lookahead: Some(5),
+        ..StreamOptions::default()
+    };
+    let mut s = Streamer::with_options(Linear, EngineConfig::default(), opts).unwrap();
+    for k in 0..5 {
+        s.push_command(rec.command()[k]).unwrap();
+    }
+    for k in 0..rec.len() - 5 {
+        s.push_command(rec.command()[k + 5]).unwrap();
+        s.push_position(rec.time()[k], rec.position()[k]).unwrap();
+        while s.poll().unwrap().is_some() {}
+        if k < k0 {
+            assert_eq!(s.motion_start(), f64::INFINITY, "{k}");
+        } else {
+            assert_eq!(s.motion_start(), rec.motion_start_time(), "{k}");
+        }
+    }
+}
+
+#[test]
+fn without_extrapolation_predictions_wait_for_the_command_over_the_horizon() {
+    let rec = rig_recording(Scenario::Ramp, 0.05);
+    let cfg = EngineConfig::default();
+    let c = stream(follow7(), cfg, &rec, Feed::Lines(0), Wait);
+    assert!(!c.arrivals.is_empty());
+    for &(at, h, already) in &c.arrivals {
+        // H − 1 samples after the window end, or at the end of input
+        assert!(at == h + cfg.horizon || at == rec.len(), "{at} {h}");
+        assert_eq!(already, at - h);
+    }
+    assert_eq!(c.stats.predicted_ahead, 0);
+    assert!(c.stats.predicted_late > 0);
+    // with a look-ahead of H, at the window end
+    let c = stream(follow7(), cfg, &rec, Feed::Ahead(cfg.horizon), Wait);
+    for &(at, h, already) in &c.arrivals {
+        assert!(at == h || at == rec.len(), "{at} {h}");
+        assert!(already == 0 || at == rec.len());
+    }
+    let s = Streamer::new(follow7(), cfg).unwrap();
+    assert!(s.uses_future_command());
+    assert_eq!(
+        s.horizon_command(),
+        HorizonCommand::Extrapolated {
+            extrapolation: Acceleration,
+            known: 0
+        }
+    );
+    assert!(!Streamer::new(Linear, cfg).unwrap().uses_future_command());
+    assert_eq!(
+        Streamer::new(Linear, cfg).unwrap().horizon_command(),
+        HorizonCommand::NotRead
+    );
+}
+
+#[test]
+fn extrapolated_predictions_come_at_the_window_end_with_the_extrapolated_command() {
+    // a command that is a parabola (constant acceleration): acceleration is
+    // exact, velocity and hold are not; `Follow` predicts y0 + u[k] − u0
+    let n = 400;
+    let dt = 1e-3;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+    let u: Vec<f64> = (0..n).map(|k| 1e-6 * (k as f64).powi(2)).collect();
+    let y: Vec<f64> = (0..n).map(|k| 0.5e-6 * (k as f64).powi(2)).collect();
+    let rec = Recording::new(t, u.clone(), y.clone()).unwrap();
+    let cfg = EngineConfig::default();
+    let batch = run(&mut follow(), &rec.signals(), &cfg).unwrap();
+    let scale = 0.16;
+    for x in [Hold, Velocity, Acceleration] {
+        let c = stream(follow(), cfg, &rec, Feed::Lines(0), x);
+        assert_eq!(c.stats.predicted_late, 0, "{x:?}");
+        assert!(c.stats.predicted_ahead > n / 2, "{x:?}");
+        for &(at, h, already) in &c.arrivals {
+            assert_eq!((at, already), (h, 0), "{x:?}");
+        }
+        let mut checked = 0;
+        // hop = H: each sample is predicted by one window
+        for w in c.windows.iter().filter(|w| w.1.end <= n) {
+            let we = w.1.start;
+            // the command the estimator saw, from the three samples before the window end
+            let (a, b, d) = (u[we - 3], u[we - 2], u[we - 1]);
+            for (m, k) in w.1.clone().enumerate() {
+                let step = (m + 1) as f64;
+                let seen = match x {
+                    Hold => d,
+                    Velocity => d + step * (d - b),
+                    _ => d + step * (d - b) + 0.5 * step * (step + 1.0) * ((d - b) - (b - a)),
+                };
+                let want = y[we - 1] + seen - u[we - 1];
+                assert!(
+                    (c.predicted[k] - want).abs() < 1e-12 * scale,
+                    "{x:?}: {k}: {} vs {want}",
+                    c.predicted[k]
+                );
+                let exact = (c.predicted[k] - batch.predicted[k]).abs() < 1e-12 * scale;
+                assert_eq!(exact, x == Acceleration, "{x:?}: {k}");
+                checked += 1;
+            }
+        }
+        assert!(checked > n * 8 / 10, "{checked}");
+    }
+}
+
+#[test]
+fn finish_cuts_the_last_horizons_at_the_last_sample() {
+    let rec = rig_recording(Scenario::Ramp, 0.02); // 100 samples
+    let c = stream(
+        follow7(),
+        EngineConfig::default(),
+        &rec,
+        Feed::Lines(0),
+        Wait,
+    );
+    let last = c.windows.last().unwrap();
+    // windows at 1, 11, …, 71 (warm-up 1); the last one ends at 91 and its horizon is cut
+    assert_eq!(last.0, 71..91);
+    assert_eq!(last.1, 91..100);
+}
+
+#[test]
+fn rejected_samples_leave_the_stream_unchanged() {
+    let rec = rig_recording(Scenario::Ramp, 0.04);
+    let (t, u, y) = (rec.time(), rec.command(), rec.position());
+    let mut s = Streamer::new(paper(Solver::Qr), EngineConfig::default()).unwrap();
+    let mut got = Vec::new();
+    for k in 0..rec.len() {
+        if k == 37 {
+            assert!(matches!(
+                s.push(t[k - 1], u[k], y[k]),
+                Err(Error::NonMonotoneTime { index: 37, .. })
+            ));
+            assert!(matches!(
+                s.push(t[k], f64::NAN, y[k]),
+                Err(Error::NonFinite { index: 37, .. })
+            ));
+            assert!(matches!(
+                s.push(t[k], u[k], f64::INFINITY),
+                Err(Error::NonFinite { index: 37, .. })
+            ));
+        }
+        s.push(t[k], u[k], y[k]).unwrap();
+        while let Some(p) = s.poll().unwrap() {
+            got.push(p.position.to_vec());
+        }
+    }
+    let mut clean = Streamer::new(paper(Solver::Qr), EngineConfig::default()).unwrap();
+    let mut want = Vec::new();
+    for k in 0..rec.len() {
+        clean.push(t[k], u[k], y[k]).unwrap();
+        while let Some(p) = clean.poll().unwrap() {
+            want.push(p.position.to_vec());
+        }
+    }
+    assert_eq!(got, want);
+    assert_eq!(s.stats(), clean.stats());
+}
+
+#[test]
+fn values_a_recording_refuses_are_refused_per_sample() {
+    let mut s = Streamer::new(Linear, EngineConfig::default()).unwrap();
+    s.push(0.0, 0.0, 0.0).unwrap();
+    for (t, u, y) in [(1e-3, 1e101, 0.0), (1e-3, 0.0, -1e300), (1e200, 0.0, 0.0)] {
+        let e = s.push(t, u, y).unwrap_err();
+        assert!(matches!(e, Error::OutOfRange { .. }), "{e}");
+    }
+    assert_eq!(s.stats().samples, 1);
+    s.push(1e-3, 1e100, 0.0).unwrap();
+}
+
+/// Batch predictions of a recording split into segments at `cuts`, in the
+/// stream's sample indices (each segment run on its own).
+fn batch_by_segments<E: Estimator>(
+    make: impl Fn() -> E,
+    rec: &Recording,
+    cuts: &[usize],
+    cfg: &EngineConfig,
+) -> (Vec<Option<f64>>, usize) {
+    let n = rec.len();
+    let mut out = vec![None; n];
+    let mut scored = 0;
+    let mut bounds = vec![0];
+    bounds.extend_from_slice(cuts);
+    bounds.push(n);
+    for w in bounds.windows(2) {
+        let seg = Recording::new(
+            rec.time()[w[0]..w[1]].to_vec(),
+            rec.command()[w[0]..w[1]].to_vec(),
+            rec.position()[w[0]..w[1]].to_vec(),
+        )
+        .unwrap();
+        let b = run(&mut make(), &seg.signals(), cfg).unwrap();
+        for k in 0..seg.len() {
+            out[w[0] + k] = b.prediction(k);
+        }
+        scored += b.stats.samples;
+    }
+    (out, scored)
+}
+
+#[test]
+fn a_gap_restarts_the_windows_as_if_a_new_recording_began() {
+    // a rig ramp with 7 samples missing at 220 and a pause of 1 s at 505
+    let full = rig_recording(Scenario::Ramp, 0.16);
+    let keep: Vec<usize> = (0..full.len())
+        .filter(|k| !(220..227).contains(k))
+        .collect();
+    let mut t: Vec<f64> = keep.iter().map(|&k| full.time()[k]).collect();
+    let u: Vec<f64> = keep.iter().map(|&k| full.command()[k]).collect();
+    let y: Vec<f64> = keep.iter().map(|&k| full.position()[k]).collect();
+    // (a pause of 10 ms: a longer one shifts the times far from 0 and costs digits)
+    for v in &mut t[498..] {
+        *v += 0.01;
+    }
+    let rec = Recording::with_tolerance(t, u, y, 1e9).unwrap();
+    let cuts = [220, 498];
+    let cfg = EngineConfig::default();
+    for x in [Wait, Velocity] {
+        let c = stream(paper(Solver::Qr), cfg, &rec, Feed::Lines(0), x);
+        let gaps: Vec<_> = c
+            .arrivals_at_gap
+            .iter()
+            .filter_map(|i| match i {
+                Interval::Gap(j) => Some(*j),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(gaps.len(), 2, "{x:?}: {:?}", c.arrivals_at_gap);
+        assert_eq!(gaps[0].missing_samples(), 7);
+        assert!((gaps[0].expected - 2e-4).abs() < 1e-9);
+        assert_eq!(gaps[1].missing_samples(), 50);
+        assert_eq!(c.stats.gaps, 2);
+        let (want, scored) = batch_by_segments(|| paper(Solver::Qr), &rec, &cuts, &cfg);
+        let scale = rec.position().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for k in 0..rec.len() {
+            match (c.has[k], want[k]) {
+                (true, Some(b)) => assert!(
+                    (c.predicted[k] - b).abs() <= 1e-12 * scale,
+                    "{x:?}: {k}: {} vs {b}",
+                    c.predicted[k]
+                ),
+                (false, None) => {}
+                (a, b) => panic!("{x:?}: sample {k}: stream {a} batch {b:?}"),
+            }
+        }
+        // the first window after each gap starts at the gap
+        assert!(c.windows.iter().any(|w| w.0 == (220..240)));
+        assert!(c.windows.iter().any(|w| w.0 == (498..518)));
+        assert!(!c
+            .windows
+            .iter()
+            .any(|w| w.0.contains(&219) && w.0.contains(&220)));
+        assert_eq!(c.stats.scored.samples, scored);
+    }
+    // Follow waits for its command: its windows before the gap are cut there
+    let c = stream(follow7(), cfg, &rec, Feed::Lines(0), Wait);
+    let (want, _) = batch_by_segments(follow7, &rec, &cuts, &cfg);
+    for k in 0..rec.len() {
+        assert_eq!(c.has[k], want[k].is_some(), "{k}");
+        if let Some(b) = want[k] {
+            assert_eq!(c.predicted[k], b, "{k}");
+        }
+    }
+}
+
+#[test]
+fn a_gap_with_a_command_lead_leaves_the_next_lead_positions_unused() {
+    let rec = rig_recording(Scenario::Ramp, 0.08);
+    let (t, u, y) = (rec.time(), rec.command(), rec.position());
+    let lead = 10;
+    let opts = StreamOptions {
+        command_lead: lead,
+        ..StreamOptions::default()
+    };
+    let mut s = Streamer::with_options(paper(Solver::Qr), EngineConfig::default(), opts).unwrap();
+    let mut samples = Vec::new();
+    for i in 0..200 {
+        // a pause of 0.5 s before line 100
+        let ti = t[i] + if i >= 100 { 0.5 } else { 0.0 };
+        let a = s.push(ti, u[i + lead], y[i]).unwrap();
+        assert_eq!(matches!(a.interval, Interval::Gap(_)), i == 100, "{i}");
+        samples.push(a.sample);
+        while s.poll().unwrap().is_some() {}
+    }
+    // positions unused: lines 0..10 and 100..110
+    for (i, a) in samples.iter().enumerate() {
+        let unused = i < 10 || (100..110).contains(&i);
+        assert_eq!(a.is_none(), unused, "line {i}: {a:?}");
+    }
+    assert_eq!(samples[110], Some(90));
+    let st = s.stats();
+    assert_eq!((st.lines, st.samples, st.unused_positions), (200, 180, 20));
+    assert_eq!(st.predicted_late, 0);
+}
+
+#[test]
+fn a_gap_between_positions_keeps_the_commands_pushed_ahead() {
+    let rec = rig_recording(Scenario::Ramp, 0.06);
+    let (t, u, y) = (rec.time(), rec.command(), rec.position());
+    let n = rec.len();
+    let cut = 150;
+    let opts = StreamOptions {
+        lookahead: Some(4),
+        ..StreamOptions::default()
+    };
+    let cfg = EngineConfig::default();
+    let mut s = Streamer::with_options(paper(Solver::Qr), cfg, opts).unwrap();
+    let mut got = vec![None; n];
+    let take = |got: &mut Vec<Option<f64>>, p: Prediction<'_>| {
+        for (k, v) in p.horizon.clone().zip(p.position) {
+            if k < n {
+                got[k] = Some(*v);
+            }
+        }
+    };
+    for k in 0..4 {
+        s.push_command(u[k]).unwrap();
+    }
+    for k in 0..n {
+        if k + 4 < n {
+            s.push_command(u[k + 4]).unwrap();
+        }
+        let tk = t[k] + if k >= cut { 0.01 } else { 0.0 };
+        let a = s.push_position(tk, y[k]).unwrap();
+        assert_eq!(matches!(a.interval, Interval::Gap(_)), k == cut);
+        assert_eq!(a.sample, Some(k));
+        if k == cut {
+            // predictions made before the gap of samples after it are void
+            got[cut..].fill(None);
+        }
+        while let Some(p) = s.poll().unwrap() {
+            take(&mut got, p);
+        }
+    }
+    let shifted: Vec<f64> = (0..n)
+        .map(|k| t[k] + if k >= cut { 0.01 } else { 0.0 })
+        .collect();
+    let rec2 = Recording::with_tolerance(shifted, u.to_vec(), y.to_vec(), 1e9).unwrap();
+    let (want, _) = batch_by_segments(|| paper(Solver::Qr), &rec2, &[cut], &cfg);
+    let scale = rec.position().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for k in 0..n {
+        match (got[k], want[k]) {
+            (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-12 * scale, "{k}: {a} {b}"),
+            (None, None) => {}
+            (a, b) => panic!("{k}: {a:?} {b:?}"),
+        }
+    }
+}
+
+#[test]
+fn irregular_intervals_are_kept_and_a_change_of_rate_is_a_gap() {
+    let mut s = Streamer::new(Linear, EngineConfig::default()).unwrap();
+    let mut t = 0.0;
+    let mut push = |s: &mut Streamer<Linear>, dt: f64| {
+        t += dt;
+        let i = s.push(t, 0.0, 0.0).unwrap().interval;
+        while s.poll().unwrap().is_some() {}
+        i
+    };
+    for _ in 0..30 {
+        assert_eq!(push(&mut s, 1e-3), Interval::Regular);
+    }
+    // 5 % long: irregular, kept
+    assert!(
+        matches!(push(&mut s, 1.05e-3), Interval::Irregular(j) if (j.expected - 1e-3).abs() < 1e-12)
+    );
+    assert_eq!(push(&mut s, 1e-3), Interval::Regular);
+    // half the interval: the sampling changed
+    assert!(matches!(push(&mut s, 0.5e-3 - 1e-9), Interval::Gap(j) if j.missing_samples() == 0));
+    // the new segment learns its interval from its first one
+    assert_eq!(push(&mut s, 0.5e-3), Interval::Regular);
+    assert_eq!(push(&mut s, 0.5e-3), Interval::Regular);
+    assert!((s.dt().unwrap() - 0.5e-3).abs() < 1e-12);
+    let st = s.stats();
+    assert_eq!((st.gaps, st.irregular_intervals, st.samples), (1, 1, 35));
+    // a given interval is the reference from the start
+    let opts = StreamOptions {
+        dt: Some(1e-3),
+        ..StreamOptions::default()
+    };
+    let mut s = Streamer::with_options(Linear, EngineConfig::default(), opts).unwrap();
+    s.push(0.0, 0.0, 0.0).unwrap();
+    assert!(matches!(
+        s.push(3e-3, 0.0, 0.0).unwrap().interval,
+        Interval::Gap(j) if j.missing_samples() == 2
+    ));
+}
+
+#[test]
+fn predictions_due_before_a_gap_must_be_polled_first() {
+    let rec = rig_recording(Scenario::Ramp, 0.04);
+    let (t, u, y) = (rec.time(), rec.command(), rec.position());
+    let opts = StreamOptions {
+        extrapolation: Wait,
+        ..StreamOptions::default()
+    };
+    let mut s = Streamer::with_options(follow7(), EngineConfig::default(), opts).unwrap();
+    // windows at 1, 11, …: the one ending at 51 waits for the command to 60
+    for k in 0..55 {
+        s.push(t[k], u[k], y[k]).unwrap();
+        while s.poll().unwrap().is_some() {}
+    }
+    assert!(matches!(
+        s.push(t[55] + 1.0, u[55], y[55]).unwrap().interval,
+        Interval::Gap(_)
+    ));
+    let e = s.push(t[56] + 1.0, u[56], y[56]).unwrap_err();
+    assert!(e.to_string().contains("poll"), "{e}");
+    let p = s.poll().unwrap().unwrap();
+    assert_eq!((p.window.clone(), p.horizon.clone()), (31..51, 51..55));
+    assert!(s.poll().unwrap().is_none());
+    assert_eq!(s.stats().samples, 56);
+    s.push(t[56] + 1.0, u[56], y[56]).unwrap();
+}
+
+#[test]
+fn the_hold_baseline_is_scored_on_the_same_samples() {
+    let rec = rig_recording(Scenario::Ramp, 0.1);
+    let cfg = EngineConfig {
+        hop: Some(3),
+        ..EngineConfig::default()
+    };
+    let b = run(&mut paper(Solver::Qr), &rec.signals(), &cfg).unwrap();
+    // independent: the latest window predicting each sample holds its last position
+    let y = rec.position();
+    let mut hold = vec![None; rec.len()];
+    for w in &b.windows {
+        if w.outcome.predicted() {
+            for k in w.horizon.clone() {
+                hold[k] = Some(y[w.window.end - 1]);
+            }
+        }
+    }
+    let want = ErrorStats::from_pairs((0..rec.len()).filter_map(|k| hold[k].map(|h| (y[k], h))));
+    let c = stream(paper(Solver::Qr), cfg, &rec, Feed::Lines(0), Velocity);
+    assert_eq!(c.stats.hold.samples, want.samples);
+    assert!((c.stats.hold.rms - want.rms).abs() <= 1e-12 * want.rms);
+    assert_eq!(c.stats.hold.max_abs, want.max_abs);
+}
+
+#[test]
+fn misuse_is_reported() {
+    let cfg = EngineConfig::default();
+    let mut s = Streamer::new(Linear, cfg).unwrap();
+    assert!(s.push_position(0.0, 0.0).is_err());
+    for _ in 0..=cfg.horizon {
+        s.push_command(0.0).unwrap();
+    }
+    assert!(matches!(
+        s.push_command(0.0),
+        Err(Error::InvalidParameter {
+            name: "command look-ahead",
+            ..
+        })
+    ));
+    s.finish();
+    assert!(s.push(100.0, 0.0, 0.0).is_err());
+    s.reset();
+    s.push(0.0, 0.0, 0.0).unwrap();
+    assert!(s.poll().unwrap().is_none());
+    // unpolled predictions eventually overflow the buffer instead of growing it
+    let mut s = Streamer::with_options(
+        Linear,
+        EngineConfig {
+            hop: Some(1),
+            ..cfg
+        },
+        StreamOptions {
+            lookahead: Some(0),
+            dt: Some(1.0),
+            ..StreamOptions::default()
+        },
+    )
+    .unwrap();
+    let r: Result<()> = (0..10_000).try_for_each(|k| {
+        s.push_command(0.0)?;
+        s.push_position(k as f64, 0.0).map(|_| ())
+    });
+    assert!(matches!(
+        r,
+        Err(Error::InvalidParameter {
+            name: "stream buffer",
+            ..
+        })
+    ));
+    let zero = EngineConfig { window: 0, ..cfg };
+    assert!(Streamer::new(Linear, zero).is_err());
+    let bad_dt = StreamOptions {
+        dt: Some(0.0),
+        ..StreamOptions::default()
+    };
+    assert!(Streamer::with_options(Linear, cfg, bad_dt).is_err());
+}
+
+#[test]
+fn boxed_estimators_stream_like_concrete_ones() {
+    let rec = rig_recording(Scenario::Ramp, 0.04);
+    let boxed: Box<dyn Estimator> = Box::new(paper(Solver::Qr));
+    let a = stream(
+        boxed,
+        EngineConfig::default(),
+        &rec,
+        Feed::Lines(0),
+        Velocity,
+    );
+    let b = stream(
+        paper(Solver::Qr),
+        EngineConfig::default(),
+        &rec,
+        Feed::Lines(0),
+        Velocity,
+    );
+    assert_eq!(a.predicted, b.predicted);
+    assert_eq!(a.stats, b.stats);
+}

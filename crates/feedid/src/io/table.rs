@@ -1,0 +1,165 @@
+//! The CSV tables of `feedid identify`: predictions per sample and
+//! coefficients per window, from plain columns.
+//!
+//! Numbers are written with Rust's shortest round-trip formatting, so a value
+//! read back is bit-identical. A missing or non-finite value is an empty
+//! cell: no `NaN` or `inf` is ever written.
+
+use std::io::Write;
+
+/// Format an optional value as a CSV cell (empty when missing or non-finite).
+pub fn cell(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x}"),
+        _ => String::new(),
+    }
+}
+
+/// Write `time_s,command_m,measured_m,predicted_m,simulated_m`, one row per
+/// sample of `time`; `predicted[k]` counts only where `has_prediction[k]`;
+/// empty cells where nothing was predicted or simulated (or a value is not
+/// finite).
+pub fn write_predictions_csv(
+    w: &mut dyn Write,
+    time: &[f64],
+    command: &[f64],
+    measured: &[f64],
+    predicted: &[f64],
+    has_prediction: &[bool],
+    simulated: Option<&[f64]>,
+) -> std::io::Result<()> {
+    writeln!(w, "time_s,command_m,measured_m,predicted_m,simulated_m")?;
+    let at = |v: &[f64], k: usize| v.get(k).copied();
+    for (k, t) in time.iter().enumerate() {
+        let p = match has_prediction.get(k) {
+            Some(true) => at(predicted, k),
+            _ => None,
+        };
+        writeln!(
+            w,
+            "{},{},{},{},{}",
+            cell(Some(*t)),
+            cell(at(command, k)),
+            cell(at(measured, k)),
+            cell(p),
+            cell(simulated.and_then(|s| at(s, k))),
+        )?;
+    }
+    Ok(())
+}
+
+/// One window's row of the coefficients table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoefficientRow<'a> {
+    /// Time of the window's first sample \[s\].
+    pub start_s: Option<f64>,
+    /// Time of the window's last sample \[s\].
+    pub end_s: Option<f64>,
+    /// RMS of the fit residuals \[m\].
+    pub residual_rms_m: f64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// Why the solver stopped (`converged`, `fallback`, …).
+    pub termination: &'a str,
+    /// The coefficients, in the order of the names.
+    pub coefficients: &'a [f64],
+}
+
+/// Write `window,start_s,end_s,residual_rms_m,iterations,termination,<names…>`,
+/// one row per window.
+pub fn write_coefficients_csv<'a, I>(
+    w: &mut dyn Write,
+    names: &[String],
+    rows: I,
+) -> std::io::Result<()>
+where
+    I: IntoIterator<Item = CoefficientRow<'a>>,
+{
+    write!(
+        w,
+        "window,start_s,end_s,residual_rms_m,iterations,termination"
+    )?;
+    for n in names {
+        write!(w, ",{n}")?;
+    }
+    writeln!(w)?;
+    for (i, r) in rows.into_iter().enumerate() {
+        write!(
+            w,
+            "{},{},{},{},{},{}",
+            i,
+            cell(r.start_s),
+            cell(r.end_s),
+            cell(Some(r.residual_rms_m)),
+            r.iterations,
+            r.termination
+        )?;
+        for c in r.coefficients {
+            write!(w, ",{}", cell(Some(*c)))?;
+        }
+        writeln!(w)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cells_are_empty_for_missing_or_nonfinite() {
+        assert_eq!(cell(None), "");
+        assert_eq!(cell(Some(f64::NAN)), "");
+        assert_eq!(cell(Some(f64::INFINITY)), "");
+        assert_eq!(cell(Some(0.1)), "0.1");
+    }
+
+    #[test]
+    fn predictions_leave_unpredicted_and_nonfinite_cells_empty() {
+        let mut out = Vec::new();
+        write_predictions_csv(
+            &mut out,
+            &[0.0, 0.5, 1.0],
+            &[1.0, 2.0, 3.0],
+            &[1.0, 2.0, 3.0],
+            &[9.0, 2.5, f64::NAN],
+            &[false, true, true],
+            Some(&[1.0, f64::INFINITY, 3.0]),
+        )
+        .unwrap();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "time_s,command_m,measured_m,predicted_m,simulated_m\n0,1,1,,1\n0.5,2,2,2.5,\n1,3,3,,3\n"
+        );
+    }
+
+    #[test]
+    fn coefficients_have_one_row_per_window() {
+        let mut out = Vec::new();
+        let names = vec!["a1".to_string(), "b1".to_string()];
+        let rows = [
+            CoefficientRow {
+                start_s: Some(0.0),
+                end_s: Some(0.1),
+                residual_rms_m: 1e-6,
+                iterations: 3,
+                termination: "converged",
+                coefficients: &[0.5, f64::NAN],
+            },
+            CoefficientRow {
+                start_s: None,
+                end_s: None,
+                residual_rms_m: 0.0,
+                iterations: 0,
+                termination: "failed",
+                coefficients: &[1.0, 2.0],
+            },
+        ];
+        write_coefficients_csv(&mut out, &names, rows).unwrap();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "window,start_s,end_s,residual_rms_m,iterations,termination,a1,b1\n\
+             0,0,0.1,0.000001,3,converged,0.5,\n1,,,0,0,failed,1,2\n"
+        );
+    }
+}

@@ -1,0 +1,469 @@
+//! Plausibility of a recording: what would make every figure computed from
+//! it meaningless although the file is well formed. Shared by every command
+//! that reads a recording; the warnings go to standard error and into the
+//! summaries (`warnings: [...]`).
+//!
+//! With `c` the command, `x` the measured position, `Δt` the sample interval:
+//!
+//! - **command still** — `c` never moves by more than 1 nm: nothing to identify.
+//! - **frozen position** (a dead encoder, a wrong column) — the longest run
+//!   of samples with exactly the same `x` while the command moves over it by
+//!   more than [`FROZEN_SHARE`] of its whole range *and* by more than
+//!   [`FROZEN_QUANTA`] position steps (the smallest non-zero `|Δx|` of the
+//!   recording: its resolution). A model that predicts a constant scores
+//!   "rms 0, fit 100 %" there; the warning says that this means nothing.
+//! - **unit mismatch** — the standard deviations of `x` and `c` differ by a
+//!   factor outside 1/10 … 10 (a loop follows its command); near 10³ or 10⁶
+//!   the two are in different units (mm and m, µm and m).
+//! - **sign or offset** — units agree, but the rms of the tracking error
+//!   `c − x` exceeds half the command's range: a sign, an offset or the
+//!   wrong axis.
+//! - **implausible speed** — the position moves faster than
+//!   [`MAX_PLAUSIBLE_SPEED`] (the 99th percentile of `|Δx|/Δt`), far beyond
+//!   any feed drive: lengths in mm or µm read as metres.
+//! - **implausible lag** — the least-squares lag `τ` of the position behind
+//!   the command, from `c − x ≈ a + τ·ċ` (a position loop follows a ramp with
+//!   the lag 1/Kv), lies outside [`LAG_RANGE`] while it explains the tracking
+//!   error (correlation of `c − x` and `ċ` above 0.5) and spans at least half
+//!   a sample: times in ms or µs read as seconds, or the reverse. Checked
+//!   only when no frozen position, unit mismatch or sign/offset warning
+//!   came first (each of those makes the lag meaningless, and the one found
+//!   first hides the later ones of that group).
+//! - **read notes** — what the reader had to decide (e.g. duplicate column
+//!   names, see [`Recording::notes`]).
+//!
+//! A uniform error of the length or time unit changes no ratio of the
+//! recording, so the last two checks compare with the physics of feed drives
+//! instead (documented bounds, not tuning); the others are relative to the
+//! recording's own range and resolution.
+//!
+//! ```
+//! use feedid::{plausibility::check_recording, Recording};
+//! let t: Vec<f64> = (0..200).map(|k| k as f64 * 1e-3).collect();
+//! let c: Vec<f64> = t.iter().map(|&t| (t - 0.05).max(0.0) * 0.05).collect();
+//! let dead = vec![0.0; 200]; // the encoder never counts
+//! let rec = Recording::new(t, c, dead).unwrap();
+//! let w = check_recording(&rec);
+//! assert!(w.iter().any(|w| w.kind == feedid::plausibility::WarningKind::FrozenPosition));
+//! ```
+
+use serde::Serialize;
+
+use crate::recording::{Recording, MOTION_THRESHOLD};
+
+/// Share of the command's range it must cover while the position stays frozen.
+pub const FROZEN_SHARE: f64 = 0.1;
+
+/// Position steps (resolution) the command must cover while the position stays frozen.
+pub const FROZEN_QUANTA: f64 = 100.0;
+
+/// Fastest plausible position speed of a feed drive \[m/s\] (linear-motor axes reach about 5 m/s).
+pub const MAX_PLAUSIBLE_SPEED: f64 = 20.0;
+
+/// Plausible lag of a position loop behind its command \[s\]: 1/Kv of feed
+/// drives lies between about 1 ms and 100 ms (Kv 10 … 1000 1/s); the bounds
+/// 0.1 ms and 0.5 s leave room on either side and still catch a factor 1000
+/// (ms read as s: 1 ms becomes 1 s; s read as ms: 100 ms becomes 0.1 ms).
+pub const LAG_RANGE: (f64, f64) = (1e-4, 0.5);
+
+/// What a warning is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WarningKind {
+    /// The command never moves.
+    CommandStill,
+    /// The position stays constant while the command moves.
+    FrozenPosition,
+    /// Position and command seem to be in different units.
+    UnitMismatch,
+    /// The tracking error is as large as the motion (sign, offset, wrong axis).
+    SignOrOffset,
+    /// The position moves faster than a feed drive can.
+    ImplausibleSpeed,
+    /// The position lags the command by an implausible time.
+    ImplausibleLag,
+    /// Something the reader decided (e.g. renamed duplicate columns).
+    ReadNote,
+}
+
+/// One plausibility warning.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Warning {
+    /// What it is about.
+    pub kind: WarningKind,
+    /// One line for people, with the numbers and what to check.
+    pub message: String,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// The warnings of a recording (see the module doc), in the order of the list above.
+pub fn check_recording(rec: &Recording) -> Vec<Warning> {
+    let mut out = Vec::new();
+    let (t, c, x) = (rec.time(), rec.command(), rec.position());
+    let warn = |kind, message| Warning { kind, message };
+    let range = |v: &[f64]| {
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &a| {
+                (lo.min(a), hi.max(a))
+            });
+        hi - lo
+    };
+    let c_range = range(c);
+    let moves = rec.command_moves();
+    if !moves {
+        out.push(warn(
+            WarningKind::CommandStill,
+            "command never moves (range <= 1 nm): there is nothing to identify".to_string(),
+        ));
+    }
+    // the first of these that applies: each makes the later ones meaningless
+    let mut tracking_ok = moves;
+    if moves {
+        if let Some(w) = frozen_position(t, c, x, c_range) {
+            out.push(warn(WarningKind::FrozenPosition, w));
+            tracking_ok = false;
+        } else if let Some(w) = unit_mismatch(c, x) {
+            out.push(warn(WarningKind::UnitMismatch, w));
+            tracking_ok = false;
+        } else if let Some(w) = sign_or_offset(c, x, c_range) {
+            out.push(warn(WarningKind::SignOrOffset, w));
+            tracking_ok = false;
+        }
+    }
+    if let Some(w) = implausible_speed(x, rec.dt()) {
+        out.push(warn(WarningKind::ImplausibleSpeed, w));
+    }
+    if tracking_ok {
+        if let Some(w) = implausible_lag(c, x, rec.dt()) {
+            out.push(warn(WarningKind::ImplausibleLag, w));
+        }
+    }
+    for n in rec.notes() {
+        out.push(warn(WarningKind::ReadNote, n.clone()));
+    }
+    out
+}
+
+/// A length for a message: mm with µm resolution, or e-notation when tiny or huge.
+fn length(m: f64) -> String {
+    let a = m.abs();
+    if (1e-7..1e4).contains(&a) {
+        format!("{:.4} mm", 1e3 * m)
+    } else {
+        format!("{m:.3e} m")
+    }
+}
+
+/// The longest run of identical positions while the command moves (see the module doc).
+fn frozen_position(t: &[f64], c: &[f64], x: &[f64], c_range: f64) -> Option<String> {
+    let quantum = x
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|d| *d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let quantum = if quantum.is_finite() { quantum } else { 0.0 };
+    // (start, end inclusive, command range over the run)
+    let mut best: Option<(usize, usize, f64)> = None;
+    let mut start = 0;
+    let (mut lo, mut hi) = (c[0], c[0]);
+    for k in 1..=x.len() {
+        if k < x.len() && x[k] == x[start] {
+            lo = lo.min(c[k]);
+            hi = hi.max(c[k]);
+            continue;
+        }
+        let r = hi - lo;
+        if best.map_or(true, |b| r > b.2) {
+            best = Some((start, k - 1, r));
+        }
+        if k < x.len() {
+            start = k;
+            lo = c[k];
+            hi = c[k];
+        }
+    }
+    let (a, b, r) = best?;
+    if !(r > FROZEN_SHARE * c_range && r > FROZEN_QUANTA * quantum && r > MOTION_THRESHOLD) {
+        return None;
+    }
+    let what = "a dead encoder or a wrong column? Predictions of a constant score \"rms 0, fit 100 %\" there, which means nothing";
+    Some(if a == 0 && b + 1 == x.len() {
+        format!(
+            "the position never changes (stays at {}) while the command moves over {}: {what}",
+            length(x[a]),
+            length(c_range)
+        )
+    } else {
+        format!(
+            "the position stays at {} from {:.6} s to {:.6} s ({} samples) while the command moves over {} ({:.0} % of its range): {what}",
+            length(x[a]),
+            t[a],
+            t[b],
+            b - a + 1,
+            length(r),
+            100.0 * r / c_range
+        )
+    })
+}
+
+/// Standard deviation.
+fn std_dev(v: &[f64]) -> f64 {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    (v.iter().map(|a| (a - mean) * (a - mean)).sum::<f64>() / n).sqrt()
+}
+
+/// Position and command in different units (see the module doc).
+fn unit_mismatch(c: &[f64], x: &[f64]) -> Option<String> {
+    let (sc, sx) = (std_dev(c), std_dev(x));
+    if !(sc > 0.0 && sx > 0.0) {
+        return None;
+    }
+    let ratio = sx / sc;
+    if (0.1..=10.0).contains(&ratio) {
+        return None;
+    }
+    let decade = ratio.log10();
+    let near = [3.0_f64, 6.0, -3.0, -6.0]
+        .into_iter()
+        .find(|k| (decade - k).abs() < 0.5);
+    Some(match near {
+        Some(k) => format!(
+            "the position varies {ratio:.3e} times as much as the command, near 10^{k}: the two are in different units (mm and m? µm and m?); convert one of them (--unit and --scale apply to both)"
+        ),
+        None => format!(
+            "the position varies {ratio:.3e} times as much as the command: are both in the same unit, and is this the command of this axis?"
+        ),
+    })
+}
+
+/// A tracking error as large as the motion (see the module doc).
+fn sign_or_offset(c: &[f64], x: &[f64], c_range: f64) -> Option<String> {
+    let n = c.len() as f64;
+    let e_rms = (c.iter().zip(x).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / n).sqrt();
+    (e_rms > 0.5 * c_range).then(|| {
+        format!(
+            "the tracking error (command − position) has an rms of {}, more than half the command's range {}: a sign, an offset or another axis?",
+            length(e_rms),
+            length(c_range)
+        )
+    })
+}
+
+/// The position faster than a feed drive (see the module doc).
+fn implausible_speed(x: &[f64], dt: f64) -> Option<String> {
+    if x.len() < 3 {
+        return None;
+    }
+    let mut speeds: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs() / dt).collect();
+    let k = ((speeds.len() - 1) as f64 * 0.99).round() as usize;
+    let (_, p99, _) = speeds.select_nth_unstable_by(k, f64::total_cmp);
+    let v = *p99;
+    (v > MAX_PLAUSIBLE_SPEED).then(|| {
+        format!(
+            "the position moves at {v:.3e} m/s (99th percentile), far beyond any feed drive (about 5 m/s at most): are the lengths in mm or µm (--unit mm, --unit um), or the times in another unit (--time-unit)?"
+        )
+    })
+}
+
+/// The lag of the position behind the command, if it explains the tracking
+/// error: `(τ [s], correlation)`.
+pub fn following_lag(c: &[f64], x: &[f64], dt: f64) -> Option<(f64, f64)> {
+    let n = c.len();
+    if n < 5 {
+        return None;
+    }
+    // central differences of the command; e = c − x
+    let (mut sv, mut se, mut svv, mut see, mut sve, mut m) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for k in 1..n - 1 {
+        let v = (c[k + 1] - c[k - 1]) / (2.0 * dt);
+        let e = c[k] - x[k];
+        sv += v;
+        se += e;
+        svv += v * v;
+        see += e * e;
+        sve += v * e;
+        m += 1.0;
+    }
+    let cov = sve / m - (sv / m) * (se / m);
+    let var_v = svv / m - (sv / m) * (sv / m);
+    let var_e = see / m - (se / m) * (se / m);
+    if !(var_v > 0.0 && var_e > 0.0) {
+        return None;
+    }
+    let tau = cov / var_v;
+    let rho = cov / (var_v * var_e).sqrt();
+    (tau.is_finite() && rho.is_finite()).then_some((tau, rho))
+}
+
+/// A lag outside the range of feed drives (see the module doc).
+fn implausible_lag(c: &[f64], x: &[f64], dt: f64) -> Option<String> {
+    let (tau, rho) = following_lag(c, x, dt)?;
+    if rho < 0.5 || tau < 0.5 * dt {
+        return None;
+    }
+    let (lo, hi) = LAG_RANGE;
+    let plausible = |t: f64| (lo..=hi).contains(&t);
+    let hint = if tau > hi {
+        if plausible(tau * 1e-3) {
+            "are the times in ms? (--time-unit ms)"
+        } else if plausible(tau * 1e-6) {
+            "are the times in µs? (--time-unit us)"
+        } else {
+            "check the time unit (--time-unit) and the columns"
+        }
+    } else if tau < lo {
+        if plausible(tau * 1e3) {
+            "are the times in s or ms rather than the unit given? (--time-unit)"
+        } else {
+            "check the time unit (--time-unit) and the columns"
+        }
+    } else {
+        return None;
+    };
+    Some(format!(
+        "the position lags the command by {tau:.3e} s at a sampling rate of {:.4e} Hz; the following lag 1/Kv of a feed drive lies between about 1 ms and 100 ms: {hint}",
+        1.0 / dt
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A first-order loop (lag `tau`) following a ramp that starts at 10 % of the recording.
+    fn ramp(n: usize, dt: f64, tau: f64, speed: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+        let t0 = 0.1 * n as f64 * dt;
+        let c: Vec<f64> = t.iter().map(|&t| speed * (t - t0).max(0.0)).collect();
+        let mut x = vec![0.0; n];
+        let a = (-dt / tau).exp();
+        for k in 1..n {
+            x[k] = a * x[k - 1] + (1.0 - a) * c[k - 1];
+        }
+        (t, c, x)
+    }
+
+    fn kinds(rec: &Recording) -> Vec<WarningKind> {
+        check_recording(rec).into_iter().map(|w| w.kind).collect()
+    }
+
+    #[test]
+    fn a_good_recording_gives_no_warning_at_any_plausible_scale() {
+        for scale in [1.0, 0.1, 1e-3] {
+            let (t, c, x) = ramp(2000, 2e-4, 1.4e-3, 0.05 * scale);
+            let rec = Recording::new(t, c, x).unwrap();
+            assert!(
+                kinds(&rec).is_empty(),
+                "{scale}: {:?}",
+                check_recording(&rec)
+            );
+        }
+    }
+
+    #[test]
+    fn the_lag_of_a_first_order_loop_is_its_time_constant() {
+        let (_, c, x) = ramp(5000, 2e-4, 2e-3, 0.05);
+        let (tau, rho) = following_lag(&c, &x, 2e-4).unwrap();
+        // the discrete loop lags by τ plus half a sample
+        assert!((tau / (2e-3 + 1e-4) - 1.0).abs() < 0.05, "{tau}");
+        assert!(rho > 0.9, "{rho}");
+    }
+
+    #[test]
+    fn a_dead_encoder_is_found_whole_or_in_part() {
+        let (t, c, x) = ramp(2000, 2e-4, 1.4e-3, 0.05);
+        let dead = Recording::new(t.clone(), c.clone(), vec![1e-3; 2000]).unwrap();
+        let w = check_recording(&dead);
+        assert!(
+            w.iter()
+                .any(|w| w.kind == WarningKind::FrozenPosition
+                    && w.message.contains("never changes")),
+            "{w:?}"
+        );
+        // frozen from the middle on (the encoder cable comes loose)
+        let mut x2 = x.clone();
+        let v = x2[1200];
+        x2[1200..].iter_mut().for_each(|a| *a = v);
+        let rec = Recording::new(t.clone(), c.clone(), x2).unwrap();
+        let w = check_recording(&rec);
+        assert!(
+            w.iter().any(|w| w.kind == WarningKind::FrozenPosition
+                && w.message.contains("800 samples")),
+            "{w:?}"
+        );
+        // the position upside down
+        let neg: Vec<f64> = x.iter().map(|v| -v).collect();
+        let rec = Recording::new(t.clone(), c.clone(), neg).unwrap();
+        assert!(kinds(&rec).contains(&WarningKind::SignOrOffset));
+        // a quantised position that rests while the command rests: no warning
+        let xq: Vec<f64> = x.iter().map(|v| (v / 1e-6).round() * 1e-6).collect();
+        let rec = Recording::new(t, c, xq).unwrap();
+        assert!(!kinds(&rec).contains(&WarningKind::FrozenPosition));
+    }
+
+    #[test]
+    fn a_position_in_mm_against_a_command_in_m_is_named() {
+        let (t, c, x) = ramp(2000, 2e-4, 1.4e-3, 0.05);
+        for (f, needle) in [
+            (1e3, "10^3"),
+            (1e6, "10^6"),
+            (1e-3, "10^-3"),
+            (50.0, "same unit"),
+        ] {
+            let xs: Vec<f64> = x.iter().map(|v| v * f).collect();
+            let rec = Recording::new(t.clone(), c.clone(), xs).unwrap();
+            let w = check_recording(&rec);
+            assert!(
+                w.iter()
+                    .any(|w| w.kind == WarningKind::UnitMismatch && w.message.contains(needle)),
+                "{f}: {w:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn times_in_ms_read_as_seconds_are_named_and_so_are_mm_read_as_m() {
+        // the same recording with its time stamps 1000× too large
+        let (t, c, x) = ramp(2000, 2e-4, 1.4e-3, 0.05);
+        let slow: Vec<f64> = t.iter().map(|v| v * 1e3).collect();
+        let rec = Recording::new(slow, c.clone(), x.clone()).unwrap();
+        let w = check_recording(&rec);
+        assert!(
+            w.iter()
+                .any(|w| w.kind == WarningKind::ImplausibleLag && w.message.contains("ms")),
+            "{w:?}"
+        );
+        let fast: Vec<f64> = t.iter().map(|v| v * 1e-3).collect();
+        let rec = Recording::new(fast, c.clone(), x.clone()).unwrap();
+        assert!(kinds(&rec).contains(&WarningKind::ImplausibleLag));
+        // lengths in mm read as metres: 50 m/s
+        let cm: Vec<f64> = c.iter().map(|v| v * 1e3).collect();
+        let xm: Vec<f64> = x.iter().map(|v| v * 1e3).collect();
+        let rec = Recording::new(t, cm, xm).unwrap();
+        let w = check_recording(&rec);
+        assert!(
+            w.iter()
+                .any(|w| w.kind == WarningKind::ImplausibleSpeed && w.message.contains("--unit mm")),
+            "{w:?}"
+        );
+    }
+
+    #[test]
+    fn a_still_command_and_read_notes_are_reported() {
+        let t: Vec<f64> = (0..10).map(|k| k as f64).collect();
+        let rec = Recording::new(t, vec![1.0; 10], vec![1.0; 10])
+            .unwrap()
+            .with_note("columns 4, 5 …".into());
+        assert_eq!(
+            kinds(&rec),
+            vec![WarningKind::CommandStill, WarningKind::ReadNote]
+        );
+    }
+}

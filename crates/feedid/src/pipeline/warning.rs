@@ -21,6 +21,15 @@ pub enum Warning {
         /// The largest growth factor of the change of basis over the windows.
         amplification: f64,
     },
+    /// No sample was predicted: no error figure is reported.
+    NothingPredicted {
+        /// Windows visited.
+        windows: usize,
+        /// Windows whose fit or prediction failed.
+        failed: usize,
+        /// Windows whose prediction the method withheld.
+        withheld: usize,
+    },
 }
 
 impl fmt::Display for Warning {
@@ -34,6 +43,24 @@ impl fmt::Display for Warning {
                  not affected (the time origin `window` keeps the coefficients accurate)",
                 g.log10().min(16.0)
             ),
+            Warning::NothingPredicted {
+                windows,
+                failed,
+                withheld,
+            } => {
+                write!(f, "no sample was predicted, so no error is reported: ")?;
+                if *windows == 0 {
+                    write!(f, "the recording is too short for one window and its horizon")
+                } else {
+                    write!(
+                        f,
+                        "of {windows} windows, {failed} failed (the method could not fit or \
+                         predict them: too little motion, an unstable or non-finite model) and \
+                         {withheld} were withheld; try another method, a longer window or \
+                         `--method auto`, which always predicts"
+                    )
+                }
+            }
         }
     }
 }

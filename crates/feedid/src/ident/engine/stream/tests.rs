@@ -8,7 +8,7 @@ use std::ops::Range;
 use super::*;
 use crate::drive::{RigParams, VirtualRig};
 use crate::error::{Error, Result};
-use crate::ident::engine::{run, EngineConfig, SlidingResult};
+use crate::ident::engine::{run_with, EngineConfig, GuardConfig, SlidingResult};
 use crate::ident::{
     Estimator, PaperConfig, PaperMethod, PredictStatus, Signals, Solver, WindowFit, WindowOutcome,
 };
@@ -17,6 +17,19 @@ use crate::signal::Scenario;
 use crate::solve::Termination;
 use crate::stats::ErrorStats;
 use crate::Recording;
+
+/// The batch engine without outlier rejection (the stream has none).
+fn run<E: Estimator + ?Sized>(
+    est: &mut E,
+    signals: &Signals<'_>,
+    cfg: &EngineConfig,
+) -> Result<SlidingResult> {
+    let guard = GuardConfig {
+        outlier: None,
+        ..GuardConfig::default()
+    };
+    run_with(est, signals, cfg, &guard, None)
+}
 
 /// Straight line through the last two window samples (window-end estimator).
 struct Linear;

@@ -272,6 +272,7 @@ fn unstable_window_model_is_rejected() {
     let mut est = ArxConfig {
         orders: ArxOrders::new(1, 1, 1),
         dc_gain_bounds: (f64::NEG_INFINITY, f64::INFINITY),
+        max_pole_radius: 1.0,
         offset: true,
         ..ArxConfig::default()
     }

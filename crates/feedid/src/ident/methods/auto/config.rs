@@ -100,6 +100,16 @@ impl AutoConfig {
         Ok(())
     }
 
+    /// Set the ridge of every windowed candidate (relative, ≥ 0; checked
+    /// by [`AutoConfig::validate`]).
+    pub fn set_ridge(&mut self, ridge: f64) {
+        for c in &mut self.candidates {
+            if let Candidate::Windowed { ridge: r, .. } = c {
+                *r = ridge;
+            }
+        }
+    }
+
     /// Validate and build the estimator.
     pub fn build(&self) -> Result<AutoEstimator> {
         self.validate()?;

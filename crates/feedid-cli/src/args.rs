@@ -336,6 +336,9 @@ pub struct StreamArgs {
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
+    /// Probability of the prediction intervals (lower_m, upper_m) [%], in (0, 100).
+    #[arg(long, value_name = "P", default_value_t = 95.0)]
+    pub interval: f64,
     /// How to read the lines (as a recording file; without a header and
     /// without column options: time, command, position are columns 1, 2, 3).
     #[command(flatten)]

@@ -90,10 +90,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
                 fit,
                 s.coverage_percent
             ),
-            _ => println!(
-                "  {:<32} no sample predicted (no error reported)",
-                m.label
-            ),
+            _ => println!("  {:<32} no sample predicted (no error reported)", m.label),
         }
     }
     println!(

@@ -4,8 +4,8 @@ use crate::drive::{simulate_nominal, RigParams};
 use crate::error::{Error, Result};
 use crate::ident::engine::{run_with, Progress};
 use crate::ident::{
-    fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind, Method,
-    GuardConfig, OrderSearch, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
+    fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind,
+    GuardConfig, Method, OrderSearch, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
 use crate::plausibility::check_recording;
@@ -331,7 +331,7 @@ impl<'a> Pipeline<'a> {
 mod tests {
     use super::*;
     use crate::drive::VirtualRig;
-    use crate::ident::{engine, ArxOrders};
+    use crate::ident::engine;
     use crate::signal::Scenario;
 
     fn ramp() -> Recording {
@@ -392,7 +392,9 @@ mod tests {
         let hook = |d: u64, n: u64| calls.lock().unwrap().push((d, n));
         let p = Pipeline::new("arx".parse().unwrap())
             .nominal(RigParams::default())
-            .extra_model(GlobalModelKind::Arx(crate::ident::ArxConfig::default().orders))
+            .extra_model(GlobalModelKind::Arx(
+                crate::ident::ArxConfig::default().orders,
+            ))
             .progress(&hook);
         let a = p.run(&rec).unwrap();
         let b = p

@@ -50,7 +50,10 @@ impl fmt::Display for Warning {
             } => {
                 write!(f, "no sample was predicted, so no error is reported: ")?;
                 if *windows == 0 {
-                    write!(f, "the recording is too short for one window and its horizon")
+                    write!(
+                        f,
+                        "the recording is too short for one window and its horizon"
+                    )
                 } else {
                     write!(
                         f,

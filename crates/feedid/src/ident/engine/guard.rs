@@ -224,8 +224,15 @@ impl Guard {
         &self.config
     }
 
-    /// Forget everything (a new recording or segment).
+    /// Forget everything (a new recording).
     pub fn reset(&mut self) {
+        self.reset_segment();
+        self.outliers = 0;
+    }
+
+    /// Forget the errors and pending predictions but keep the outlier count
+    /// (a new segment of a stream).
+    pub fn reset_segment(&mut self) {
         self.trackers.fill(Tracker::NEW);
         self.first = 0;
         self.count = 0;
@@ -236,6 +243,10 @@ impl Guard {
         self.mean_square.fill(0.0);
         self.resolution = f64::INFINITY;
         self.last = None;
+    }
+
+    /// Set the outlier count to 0.
+    pub fn reset_outliers(&mut self) {
         self.outliers = 0;
     }
 

@@ -869,7 +869,11 @@ mod tests {
                 last_stable = Some(rls.theta().to_vec());
             }
             let r = rls.predict(&s, end - 20..end, end..end + 5, &mut out);
-            assert_eq!(r.is_ok(), last_stable.is_some(), "window ending at {end}: {coef:?}");
+            assert_eq!(
+                r.is_ok(),
+                last_stable.is_some(),
+                "window ending at {end}: {coef:?}"
+            );
             assert!(r.is_err() || out.iter().all(|v| v.is_finite()));
             unstable += usize::from(!stable);
         }

@@ -20,6 +20,24 @@ pub const REGIMES: usize = 3;
 /// Relative change of the command's speed below which it counts as constant.
 const CONSTANT_SPEED: f64 = 1e-3;
 
+/// Relative margin by which a candidate's score must beat the current
+/// choice's to replace it (hysteresis). Scores of candidates that predict
+/// alike cross often, and near a crossing the last bits of the data (a
+/// recording read in mm instead of m) would decide between them: the
+/// margin makes such switches rare, so the predictions do not depend on
+/// the unit, and keeps the choice from chattering.
+const TIE: f64 = 0.02;
+
+/// Whether score `a` beats score `b` (a scored candidate beats an
+/// unscored one; scores within [`TIE`] are a tie, which `a` loses).
+fn beats(a: Option<f64>, b: Option<f64>) -> bool {
+    match (a, b) {
+        (Some(_), None) => true,
+        (Some(a), Some(b)) => a < b * (1.0 - TIE),
+        _ => false,
+    }
+}
+
 /// A candidate, its pending prediction and its scores.
 #[derive(Debug, Clone)]
 struct Member {
@@ -184,22 +202,20 @@ impl AutoEstimator {
     }
 
     /// The ready candidate with the lowest score in the current regime
-    /// (unscored candidates last, in the order of the settings).
+    /// (unscored candidates last); ties ([`TIE`]) keep the previous choice,
+    /// else the first in the order of the settings.
     fn choose(&self) -> Option<usize> {
         let r = self.regime;
-        let mut choice: Option<(usize, Option<f64>)> = None;
+        let mut choice: Option<(usize, Option<f64>)> = self
+            .selected
+            .filter(|&i| self.members[i].ready)
+            .map(|i| (i, self.members[i].score_in(r)));
         for (i, m) in self.members.iter().enumerate() {
-            if !m.ready {
+            if !m.ready || choice.is_some_and(|(c, _)| c == i) {
                 continue;
             }
             let s = m.score_in(r);
-            let better = match (choice, s) {
-                (None, _) => true,
-                (Some((_, None)), Some(_)) => true,
-                (Some((_, Some(b))), Some(a)) => a < b,
-                _ => false,
-            };
-            if better {
+            if choice.is_none_or(|(_, b)| beats(s, b)) {
                 choice = Some((i, s));
             }
         }
@@ -365,12 +381,7 @@ impl Estimator for AutoEstimator {
                 let mut best: Option<(usize, Option<f64>)> = None;
                 for (i, m) in self.members.iter().enumerate().filter(|(_, m)| usable(m)) {
                     let s = m.score_in(r);
-                    let better = match (best, s) {
-                        (None, _) | (Some((_, None)), Some(_)) => true,
-                        (Some((_, Some(b))), Some(a)) => a < b,
-                        _ => false,
-                    };
-                    if better {
+                    if best.is_none_or(|(_, b)| beats(s, b)) {
                         best = Some((i, s));
                     }
                 }

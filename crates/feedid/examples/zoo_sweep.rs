@@ -1,4 +1,20 @@
-//! Exploration: many method settings on the drive zoo (scratch).
+//! A settings sweep on the drive zoo: the tool that chose the defaults of
+//! `arx`, `rls` and `auto`'s candidates (issue 13). A development tool, not
+//! a benchmark: it panics on a bad configuration line.
+//!
+//! ```sh
+//! cargo run --release -p feedid --example zoo_sweep -- SET configs.txt sweep.csv
+//! ```
+//!
+//! `SET` is `all` (the regular members), `even`, `odd` (halves: choose on
+//! one, check on the other) or `emps` (the EMPS recording, printed). Each
+//! line of `configs.txt` is a method and its settings, e.g.
+//! `arx o=3,3,0 w=100 ridge=1e-10 dc=1`, `rls o=8,8,0 lambda=0.999`,
+//! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995 mem=0.1`, or `arx220 100`
+//! (the benchmark's plain ARX(2,2,0) baseline); `#` starts a comment. The
+//! CSV has per member and configuration the rms over the predicted samples,
+//! the coverage, and the rms of the configuration and of `arx220` on the
+//! samples both predict.
 
 use std::time::Instant;
 

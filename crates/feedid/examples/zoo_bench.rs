@@ -80,6 +80,9 @@ struct Predictions {
     error: Option<String>,
 }
 
+/// Predictions, their flags, the interval bounds and the first predicted sample.
+type RunOutput = (Vec<f64>, Vec<bool>, (Vec<f64>, Vec<f64>), usize);
+
 /// Every use of the identification API: the five library methods with their
 /// defaults (window per method, H = 10, hop = H), as `feedid identify` runs
 /// them. Keep the library calls here and nowhere else in this file.
@@ -90,7 +93,7 @@ fn run_library_methods(rec: &Recording) -> Vec<Predictions> {
         .iter()
         .map(|&name| {
             let t = Instant::now();
-            let run = || -> feedid::Result<(Vec<f64>, Vec<bool>, (Vec<f64>, Vec<f64>), usize)> {
+            let run = || -> feedid::Result<RunOutput> {
                 let spec: Method = name.parse()?;
                 let mut est = spec.build()?;
                 let cfg = EngineConfig {

@@ -2,6 +2,9 @@
 //! prediction intervals, and an isolated glitch neither is fitted nor ends
 //! the predictions of any regressor method.
 
+// Index loops mirror the sample indices of the checks.
+#![allow(clippy::needless_range_loop)]
+
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::{engine, EngineConfig, Method, Signals, SlidingResult};
 use feedid::signal::Scenario;

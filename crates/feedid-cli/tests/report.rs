@@ -67,7 +67,6 @@ fn report_writes_one_self_contained_page_with_every_figure() {
         "coef-paper1",
         "coef-paper1-2",
         "coef-arx2",
-        "coef-arx2-2",
         "ree-paper1",
         "rue-paper1",
         "ree-arx2",

@@ -51,7 +51,6 @@ fn report_has_every_section_and_figure_and_no_external_reference() {
         "rec-coef-paper1",
         "rec-coef-paper1-2",
         "rec-coef-arx2",
-        "rec-coef-arx2-2",
     ]
     .into_iter()
     .map(String::from)

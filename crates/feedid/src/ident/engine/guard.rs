@@ -5,13 +5,21 @@
 //! # Prediction intervals
 //!
 //! Every prediction of a window is *scored* once its samples are measured:
-//! the absolute error `|y[k] − ŷ[k]|` of the prediction `j` samples ahead
-//! (`j = 0 … H−1`) joins the `j`-th history of the last
-//! [`GuardConfig::memory`] such errors. A new prediction `ŷ` at `j` samples
-//! ahead gets the interval `ŷ ± q_j`, where `q_j` is the conformal quantile
-//! of that history: its `⌈(n+1)·P⌉`-th smallest value for `n` errors and
-//! probability `P` ([`GuardConfig::interval`]; for exchangeable errors the
-//! new error lies within `q_j` with probability ≥ `P`). Until
+//! the absolute error `e = |y[k] − ŷ[k]|` of the prediction `j` samples
+//! ahead (`j = 0 … H−1`) updates the half-width `q_j` of that step ahead,
+//! an online estimate of the `P`-quantile of the errors there
+//! ([`GuardConfig::interval`]):
+//!
+//! ```text
+//! q_j ← q_j · e^{η·P}        if e > q_j,
+//! q_j ← q_j · e^{−η·(1−P)}   otherwise        (η = GuardConfig::adaptation)
+//! ```
+//!
+//! (the first error sets `q_j`). In the long run a share `1 − P` of the
+//! errors lies beyond `q_j`, whatever their scale (the updates are
+//! multiplicative: a recording in other units gives proportional widths),
+//! and a jump of the errors is followed within tens of horizons. A new
+//! prediction `ŷ` at `j` samples ahead gets the interval `ŷ ± q_j`. Until
 //! [`MIN_HISTORY`] errors are known at `j`, the half-width is the distance
 //! from the last measured position to the prediction plus the range of the
 //! measured position over the window (wide, not calibrated). The share of
@@ -40,8 +48,8 @@
 //! the measured positions.
 //!
 //! All buffers are allocated in [`Guard::new`]; the per-sample work is a
-//! binary search and a shift in a sorted history of at most
-//! [`GuardConfig::memory`] values.
+//! constant number of operations per pending prediction (at most
+//! `⌈H / hop⌉ + 1`).
 
 // Negated comparisons are deliberate (they reject NaN).
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -57,9 +65,10 @@ pub const MIN_HISTORY: usize = 20;
 pub struct GuardConfig {
     /// Probability `P` of the prediction interval, in (0, 1); default 0.95.
     pub interval: f64,
-    /// A measured sample whose error exceeds this many interval half-widths
-    /// is an outlier (see the module doc); `None` keeps every sample;
-    /// default `Some(8.0)`.
+    /// A measured sample whose error exceeds this many times the recent rms
+    /// error at its step ahead (at least the data's resolution), its
+    /// neighbours' not, is an outlier (see the module doc); `None` keeps
+    /// every sample; default `Some(8.0)`.
     pub outlier: Option<f64>,
     /// Rate η of the interval's adaptation, in (0, 1]: after a scored error
     /// its half-width is multiplied by `e^{η·P}` (error beyond it) or

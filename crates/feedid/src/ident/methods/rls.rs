@@ -132,7 +132,7 @@ impl Default for RlsConfig {
             min_excitation: 0.0,
             scale: None,
             frame_span: 1.0,
-            max_pole_radius: 1.05,
+            max_pole_radius: 1.0,
         }
     }
 }

@@ -10,8 +10,8 @@ use crate::ident::methods::regressor::ArxOrders;
 /// Configuration of the windowed ARX estimator.
 ///
 /// The defaults (orders 3,3,0 with the current command sample, engine
-/// window W = 100, a small ridge, no DC-gain or excitation gate, poles up to
-/// radius 1.05) were chosen on the drive zoo ([`crate::zoo`], example
+/// window W = 100, a small ridge, no DC-gain or excitation gate) were chosen
+/// on the drive zoo ([`crate::zoo`], example
 /// `zoo_sweep`), not on one rig: the command is a planned trajectory, so its
 /// value at the predicted instant is known and nk = 0 uses it; a gate or a
 /// gain bound withholds predictions on drives unlike the rig.
@@ -21,8 +21,8 @@ pub struct ArxConfig {
     pub orders: ArxOrders,
     /// Relative ridge `ρ` on the column-normalised coefficients; default 1e-10.
     pub ridge: f64,
-    /// Poles must lie strictly inside this radius; default 1.05 (a slightly
-    /// unstable model still predicts the next H samples well).
+    /// Poles must lie strictly inside this radius; default 1.0 (stable).
+    /// `f64::INFINITY` disables the stability check.
     /// `f64::INFINITY` disables the stability check.
     pub max_pole_radius: f64,
     /// Accepted DC gain `B(1)/A(1)` interval (a position
@@ -55,7 +55,7 @@ impl Default for ArxConfig {
         Self {
             orders: ArxOrders::new(3, 3, 0),
             ridge: 1e-10,
-            max_pole_radius: 1.05,
+            max_pole_radius: 1.0,
             dc_gain_bounds: (f64::NEG_INFINITY, f64::INFINITY),
             min_excitation: 0.0,
             max_condition: f64::INFINITY,

@@ -288,8 +288,15 @@ impl Estimator for AutoEstimator {
     }
 
     fn reset(&mut self) {
+        // in place: a stream resets at every gap and allocates nothing after warm-up
         for m in &mut self.members {
-            *m = Member::new(*m.predictor.spec());
+            m.predictor.reset();
+            m.pending_len = 0;
+            m.pending_start = 0;
+            m.pending_regime = 2;
+            m.score = [0.0; REGIMES];
+            m.scored = [0; REGIMES];
+            m.ready = false;
         }
         self.selected = None;
         self.start = None;

@@ -30,6 +30,18 @@ pub enum Warning {
         /// Windows whose prediction the method withheld.
         withheld: usize,
     },
+    /// Paper method with `--prediction tf`: in these windows the identified
+    /// `N(s)/D(s)` was unstable (or not realisable) and the prediction fell
+    /// back to the polynomial one (see
+    /// [`crate::ident::PaperMethod::tf_fallbacks`]). The identified `D(s)`
+    /// holds the command's Taylor coefficients, which rarely form a Hurwitz
+    /// polynomial, so on most recordings most windows fall back.
+    PaperTfFallback {
+        /// Windows whose transfer-function prediction fell back.
+        fallbacks: usize,
+        /// Windows predicted.
+        windows: usize,
+    },
 }
 
 impl fmt::Display for Warning {
@@ -64,6 +76,13 @@ impl fmt::Display for Warning {
                     )
                 }
             }
+            Warning::PaperTfFallback { fallbacks, windows } => write!(
+                f,
+                "paper method, prediction tf: the identified transfer function was unstable in \
+                 {fallbacks} of {windows} windows ({:.1} %), which were predicted by the \
+                 polynomial instead (as --prediction polynomial)",
+                100.0 * *fallbacks as f64 / (*windows).max(1) as f64
+            ),
         }
     }
 }

@@ -727,8 +727,12 @@ fn compensate_with(
     let (candidate, sigma, sigma_p, limit_fallback) = match search_limits(&problem, cfg)? {
         Search::Met(c, s, sp) => (Some(c), s, sp, None),
         Search::Unreachable(best) => {
+            // quote the quantity the trajectory itself exceeds, if any
+            let plain_v = plain_peaks.velocity > cfg.max_velocity * (1.0 + 1e-9);
+            let plain_a = plain_peaks.acceleration > cfg.max_acceleration * (1.0 + 1e-9);
+            let comp_v = best.velocity > cfg.max_velocity * (1.0 + 1e-9);
             let (quantity, achievable, limit, unit, at, plain) =
-                if best.velocity > cfg.max_velocity * (1.0 + 1e-9) {
+                if plain_v || (!plain_a && comp_v) {
                     (
                         "velocity",
                         best.velocity,

@@ -20,8 +20,11 @@
 //! * the model: `fit_global_model(.., Auto)` (the best of arx 8,8,1, oe 7,2
 //!   and oe 5,1 by free-run error), its free-run position fit and
 //!   following-error fit on that run ([`ModelQuality::from_run`]);
-//! * limits: velocity `2·v`, acceleration `3·a` (the command may exceed the
-//!   desired's own figures by that much);
+//! * limits: velocity `max(2·v, 1.5·v_plain)`, acceleration
+//!   `max(3·a, 1.5·a_plain)` (`v_plain`, `a_plain`: the plain command's own
+//!   finite-difference peaks — limits the axis already accepts; a ramp's
+//!   velocity step asks `v/Δt`); `--max-smoothing S` (default the library's
+//!   0.02 s);
 //! * tracking error: rms of the **true** (noise-free) position minus the
 //!   desired over the whole recording, plain command vs the command the tool
 //!   sends (compensated or, on a fall-back, the plain one), same noise seed.
@@ -77,7 +80,20 @@ fn references(spec: &MemberSpec, desired: &[f64], dt: f64) -> (f64, f64) {
     (v, a)
 }
 
-fn run(zoo: &Zoo, index: usize) -> Result<Row, String> {
+/// Peak finite-difference velocity and acceleration of a command.
+fn command_peaks(u: &[f64], dt: f64) -> (f64, f64) {
+    let v = u
+        .windows(2)
+        .map(|w| ((w[1] - w[0]) / dt).abs())
+        .fold(0.0, f64::max);
+    let a = u
+        .windows(3)
+        .map(|w| ((w[2] - 2.0 * w[1] + w[0]) / (dt * dt)).abs())
+        .fold(0.0, f64::max);
+    (v, a)
+}
+
+fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
     let member = zoo.member(index).map_err(|e| e.to_string())?;
     let spec = &member.spec;
     let desired = &member.command;
@@ -116,9 +132,13 @@ fn run(zoo: &Zoo, index: usize) -> Result<Row, String> {
     let file = fit_global_model(&rec, &GlobalModelKind::Auto).map_err(|e| e.to_string())?;
     let quality = ModelQuality::from_run(&file.model, rec.command(), rec.position(), dt)
         .map_err(|e| e.to_string())?;
+    // limits the axis already accepts: the plain command's own peaks (a
+    // ramp's velocity step is v/Δt) and some headroom
+    let (pv, pa) = command_peaks(desired, dt);
     let cfg = CompensateConfig {
-        max_velocity: 2.0 * v,
-        max_acceleration: 3.0 * a,
+        max_velocity: (2.0 * v).max(1.5 * pv),
+        max_acceleration: (3.0 * a).max(1.5 * pa),
+        max_smoothing,
         quality,
         ..CompensateConfig::default()
     };
@@ -198,12 +218,20 @@ fn summary(name: &str, rows: &[&Row]) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut limit = usize::MAX;
+    let mut max_smoothing = CompensateConfig::default().max_smoothing;
     let mut csv: Option<PathBuf> = None;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
             "--limit" => {
                 limit = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(limit);
+                i += 1;
+            }
+            "--max-smoothing" => {
+                max_smoothing = args
+                    .get(i + 1)
+                    .and_then(|s| s.parse().ok())
+                    .unwrap_or(max_smoothing);
                 i += 1;
             }
             "--csv" => {
@@ -235,7 +263,10 @@ fn main() {
         .collect();
     let start = std::time::Instant::now();
     let results: Vec<(usize, Result<Row, String>)> =
-        indices.par_iter().map(|&i| (i, run(&zoo, i))).collect();
+        indices
+            .par_iter()
+            .map(|&i| (i, run(&zoo, i, max_smoothing)))
+            .collect();
     let mut rows = Vec::new();
     for (i, r) in results {
         match r {
@@ -260,7 +291,10 @@ fn main() {
         .iter()
         .filter(|r| r.fit >= 95.0 && r.feed_forward != "none")
         .collect();
-    let poor: Vec<&Row> = rows.iter().filter(|r| !(r.fit >= 95.0)).collect();
+    let poor: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.fit.is_nan() || r.fit < 95.0)
+        .collect();
     summary("fit ≥ 95 %, no feed-forward", &good_noff);
     summary("fit ≥ 95 %, feed-forward", &good_ff);
     summary("fit < 95 %", &poor);
@@ -293,7 +327,7 @@ fn main() {
         );
         for r in &rows {
             text.push_str(&format!(
-                "{},{},{},{},{:.3},{:.3},{:e},{:e},{:.4},{:.4},\"{}\",\"{}\"\n",
+                "{},{},{},\"{}\",{:.3},{:.3},{:e},{:e},{:.4},{:.4},\"{}\",\"{}\"\n",
                 r.index,
                 r.kind,
                 r.feed_forward,

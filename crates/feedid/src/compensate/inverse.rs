@@ -24,8 +24,9 @@
 //!    `||z| − 1| ≤ δ` for a zero in the left half plane (`Re z < 0`, where
 //!    the exact inverse would ring at up to the Nyquist frequency with gain
 //!    `1/||z| − 1|`: the spurious zeros of an identified model lie there),
-//!    and `||z| − 1| ≤ 1e-6` elsewhere (a slow zero near `z = 1` is inverted
-//!    exactly: the approximation would be poor at low frequency);
+//!    and `||z| − 1| ≤ 2e-4` elsewhere (a slow zero near `z = 1` is inverted
+//!    exactly unless its inverse would take more than 200 000 samples to
+//!    settle: the approximation is poor at low frequency);
 //! 5. zeros outside (`|z| > 1 + δ`, e.g. the sampling zeros of a model of
 //!    relative degree ≥ 3): anti-causal recursion run backwards from the end,
 //!    `u[k−1] = (u[k] − w[k])/z`, started at the steady state — the exact
@@ -56,7 +57,12 @@ use crate::lti::{poly_roots, DiscreteStateSpace, StateSpace};
 const SETTLE: f64 = 1e-17;
 
 /// Longest extension of the trajectory \[samples\].
-const MAX_TAIL: usize = 2_000_000;
+const MAX_TAIL: usize = 200_000;
+
+/// Half-width of the band around the unit circle where a zero in the right
+/// half plane gets the zero-phase approximation: closer, its exact inverse
+/// would take more than [`MAX_TAIL`] samples to settle.
+const SLOW_BAND: f64 = 2e-4;
 
 /// How one zero of the model is inverted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -120,9 +126,9 @@ impl Factor {
 /// part `re` gets the zero-phase approximation (see the module doc).
 fn band_of(re: f64, margin: f64) -> f64 {
     if re < 0.0 {
-        margin
+        margin.max(SLOW_BAND)
     } else {
-        margin.min(1e-6)
+        SLOW_BAND
     }
 }
 

@@ -18,10 +18,13 @@
 //!   member's amplitude, command speed and acceleration — for a ramp
 //!   `a = v·Kv`), as long as the member's recording, noise seed + 1;
 //! * the model: `fit_global_model(.., Auto)` (the best of arx 8,8,1, oe 7,2
-//!   and oe 5,1 by free-run error), its free-run position fit and
-//!   following-error fit on that run ([`ModelQuality::from_run`]);
+//!   and oe 5,1 by free-run error) and its free-run position fit on the
+//!   chirp run; the share of the following error it explains
+//!   ([`ModelQuality::from_run`]) on the member's own recording — the plain
+//!   program run once, with its noise and glitches, as `compensate --check`
+//!   uses it;
 //! * limits: velocity `max(2·v, 1.5·v_plain)`, acceleration
-//!   `max(3·a, 1.5·a_plain)` (`v_plain`, `a_plain`: the plain command's own
+//!   `max(1.5·a, 1.5·a_plain)` (`v_plain`, `a_plain`: the plain command's own
 //!   finite-difference peaks — limits the axis already accepts; a ramp's
 //!   velocity step asks `v/Δt`); `--max-smoothing S` (default the library's
 //!   0.02 s);
@@ -130,14 +133,31 @@ fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
     let rec = Recording::from_rate(rate, ident.command.clone(), ident.position.clone())
         .map_err(|e| e.to_string())?;
     let file = fit_global_model(&rec, &GlobalModelKind::Auto).map_err(|e| e.to_string())?;
-    let quality = ModelQuality::from_run(&file.model, rec.command(), rec.position(), dt)
+    // the identification fit (what `identify` reports), and the share of the
+    // following error the model explains on the member's own recording (the
+    // plain program run once, as `compensate --check` would use it)
+    let on_chirp = ModelQuality::from_run(&file.model, rec.command(), rec.position(), dt)
         .map_err(|e| e.to_string())?;
+    // the glitches (wild samples) of the recording are known: hold the
+    // previous sample there
+    let mut measured = member.position.clone();
+    for g in &spec.glitches {
+        if g.index > 0 && g.index < measured.len() {
+            measured[g.index] = measured[g.index - 1];
+        }
+    }
+    let on_plain = ModelQuality::from_run(&file.model, desired, &measured, dt)
+        .map_err(|e| e.to_string())?;
+    let quality = ModelQuality {
+        position_fit_percent: on_chirp.position_fit_percent,
+        error_fit_percent: on_plain.error_fit_percent,
+    };
     // limits the axis already accepts: the plain command's own peaks (a
     // ramp's velocity step is v/Δt) and some headroom
     let (pv, pa) = command_peaks(desired, dt);
     let cfg = CompensateConfig {
         max_velocity: (2.0 * v).max(1.5 * pv),
-        max_acceleration: (3.0 * a).max(1.5 * pa),
+        max_acceleration: (1.5 * a).max(1.5 * pa),
         max_smoothing,
         quality,
         ..CompensateConfig::default()

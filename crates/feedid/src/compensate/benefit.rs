@@ -48,7 +48,8 @@ pub struct ModelQuality {
 }
 
 impl ModelQuality {
-    /// Both fits of `model` run free (deviations from the first sample) on
+    /// Both fits of `model` run free (deviations from the first sample,
+    /// the model rescaled to unit DC gain as the compensation uses it) on
     /// the `command` of a recording of the axis at interval `dt` \[s\],
     /// against its measured `position`.
     ///
@@ -83,7 +84,14 @@ impl ModelQuality {
         }
         let (u0, y0) = (command[0], position[0]);
         let dev: Vec<f64> = command.iter().map(|u| u - u0).collect();
-        let yd = model.simulate_at(&dev, dt)?;
+        let mut yd = model.simulate_at(&dev, dt)?;
+        // as the compensation uses it: rescaled to unit DC gain
+        let g = model.discrete_state_space(Some(dt))?.dc_gain()?;
+        if g.is_finite() && g.abs() > 1e-12 {
+            for v in &mut yd {
+                *v /= g;
+            }
+        }
         let n = command.len() as f64;
         let mean_y = position.iter().sum::<f64>() / n;
         let mean_f = position

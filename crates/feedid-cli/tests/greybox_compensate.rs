@@ -609,7 +609,10 @@ fn compensate_succeeds_on_segments_moving_at_their_end_or_from_their_first_sampl
         let quoted = v["peak_velocity"].as_f64().unwrap();
         assert!(quoted <= 1.0, "{name}: {quoted}");
         if name != "segment.csv" {
-            assert!((vmax - quoted).abs() < 1e-6 * quoted.max(1e-3), "{name}: {vmax} vs {quoted}");
+            assert!(
+                (vmax - quoted).abs() < 1e-6 * quoted.max(1e-3),
+                "{name}: {vmax} vs {quoted}"
+            );
         }
     }
     // a velocity step at t = 0 from rest is refused with the figures, plain's included
@@ -617,7 +620,9 @@ fn compensate_succeeds_on_segments_moving_at_their_end_or_from_their_first_sampl
     let step = desired_file(
         dir.path(),
         "step.csv",
-        &(0..1000).map(|k| 0.05 * k as f64 * 2e-4).collect::<Vec<_>>(),
+        &(0..1000)
+            .map(|k| 0.05 * k as f64 * 2e-4)
+            .collect::<Vec<_>>(),
     );
     assert_fails(
         &feedid(&[
@@ -629,6 +634,10 @@ fn compensate_succeeds_on_segments_moving_at_their_end_or_from_their_first_sampl
             "-o",
             p(&step_cmd),
         ]),
-        &["acceleration", "limit 30", "desired trajectory itself at 250"],
+        &[
+            "acceleration",
+            "limit 30",
+            "desired trajectory itself at 250",
+        ],
     );
 }

@@ -146,8 +146,8 @@ fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
             measured[g.index] = measured[g.index - 1];
         }
     }
-    let on_plain = ModelQuality::from_run(&file.model, desired, &measured, dt)
-        .map_err(|e| e.to_string())?;
+    let on_plain =
+        ModelQuality::from_run(&file.model, desired, &measured, dt).map_err(|e| e.to_string())?;
     let quality = ModelQuality {
         position_fit_percent: on_chirp.position_fit_percent,
         error_fit_percent: on_plain.error_fit_percent,
@@ -244,7 +244,10 @@ fn main() {
     while i < args.len() {
         match args[i].as_str() {
             "--limit" => {
-                limit = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(limit);
+                limit = args
+                    .get(i + 1)
+                    .and_then(|s| s.parse().ok())
+                    .unwrap_or(limit);
                 i += 1;
             }
             "--max-smoothing" => {
@@ -282,11 +285,10 @@ fn main() {
         .take(limit)
         .collect();
     let start = std::time::Instant::now();
-    let results: Vec<(usize, Result<Row, String>)> =
-        indices
-            .par_iter()
-            .map(|&i| (i, run(&zoo, i, max_smoothing)))
-            .collect();
+    let results: Vec<(usize, Result<Row, String>)> = indices
+        .par_iter()
+        .map(|&i| (i, run(&zoo, i, max_smoothing)))
+        .collect();
     let mut rows = Vec::new();
     for (i, r) in results {
         match r {

@@ -285,7 +285,10 @@ pub struct Compensation {
 #[cfg(test)]
 fn peaks(u: &[f64], dt: f64) -> ((f64, usize), (f64, usize)) {
     let p = Peaks::of(u, 1, dt);
-    ((p.velocity, p.velocity_at), (p.acceleration, p.acceleration_at))
+    (
+        (p.velocity, p.velocity_at),
+        (p.acceleration, p.acceleration_at),
+    )
 }
 
 /// Peaks of a command sent from extended index `from` on.
@@ -609,9 +612,8 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
     for _ in 0..MAX_ROUNDS {
         let c = p.command(&sigma, &sigma_p)?;
         let pk = p.peaks(&c.sent);
-        let score = |q: &Peaks| {
-            (q.velocity / cfg.max_velocity).max(q.acceleration / cfg.max_acceleration)
-        };
+        let score =
+            |q: &Peaks| (q.velocity / cfg.max_velocity).max(q.acceleration / cfg.max_acceleration);
         if best.as_ref().is_none_or(|b| score(&pk) < score(b)) {
             best = Some(pk);
         }
@@ -731,26 +733,26 @@ fn compensate_with(
             let plain_v = plain_peaks.velocity > cfg.max_velocity * (1.0 + 1e-9);
             let plain_a = plain_peaks.acceleration > cfg.max_acceleration * (1.0 + 1e-9);
             let comp_v = best.velocity > cfg.max_velocity * (1.0 + 1e-9);
-            let (quantity, achievable, limit, unit, at, plain) =
-                if plain_v || (!plain_a && comp_v) {
-                    (
-                        "velocity",
-                        best.velocity,
-                        cfg.max_velocity,
-                        "m/s",
-                        best.velocity_at,
-                        plain_peaks.velocity,
-                    )
-                } else {
-                    (
-                        "acceleration",
-                        best.acceleration,
-                        cfg.max_acceleration,
-                        "m/s²",
-                        best.acceleration_at,
-                        plain_peaks.acceleration,
-                    )
-                };
+            let (quantity, achievable, limit, unit, at, plain) = if plain_v || (!plain_a && comp_v)
+            {
+                (
+                    "velocity",
+                    best.velocity,
+                    cfg.max_velocity,
+                    "m/s",
+                    best.velocity_at,
+                    plain_peaks.velocity,
+                )
+            } else {
+                (
+                    "acceleration",
+                    best.acceleration,
+                    cfg.max_acceleration,
+                    "m/s²",
+                    best.acceleration_at,
+                    plain_peaks.acceleration,
+                )
+            };
             let plain_ok = plain_peaks.velocity <= cfg.max_velocity * (1.0 + 1e-9)
                 && plain_peaks.acceleration <= cfg.max_acceleration * (1.0 + 1e-9);
             if !(plain_ok && cfg.fallback) {
@@ -808,12 +810,10 @@ fn compensate_with(
                     fit_percent: f,
                     min_percent: cfg.min_fit_percent,
                 }),
-                _ if benefit.expected_benefit < cfg.min_benefit => {
-                    Some(Fallback::SmallBenefit {
-                        expected: benefit.expected_benefit,
-                        min: cfg.min_benefit,
-                    })
-                }
+                _ if benefit.expected_benefit < cfg.min_benefit => Some(Fallback::SmallBenefit {
+                    expected: benefit.expected_benefit,
+                    min: cfg.min_benefit,
+                }),
                 _ => None,
             };
         }
@@ -861,14 +861,13 @@ fn rms_error(e: &[f64], y: &[f64], scale: f64) -> f64 {
     (s / e.len() as f64).sqrt()
 }
 
-const LIMIT_HINT: &str =
-    "allow smoothing (--smooth auto, --max-smoothing) or raise the limit";
+const LIMIT_HINT: &str = "allow smoothing (--smooth auto, --max-smoothing) or raise the limit";
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::drive::{closed_loop_coefficients, simulate_nominal, D1Variant};
     use crate::compensate::ModelQuality;
+    use crate::drive::{closed_loop_coefficients, simulate_nominal, D1Variant};
     use crate::signal::{Ramp, Scenario, Scurve};
 
     const DT: f64 = 2e-4;
@@ -1051,7 +1050,10 @@ mod tests {
         // at the end the command leads by the ramp's following error v/Kv
         // (the zero-order hold adds half a sample: v·(1/Kv + Δt/2))
         let lead = c.command[n - 1] - desired[n - 1];
-        assert!((lead - 0.05 * (1.0 / 700.0 + DT / 2.0)).abs() < 0.01e-6, "{lead}");
+        assert!(
+            (lead - 0.05 * (1.0 / 700.0 + DT / 2.0)).abs() < 0.01e-6,
+            "{lead}"
+        );
         assert!((c.end_velocity - 0.05).abs() < 1e-9);
         // and the prediction is exact there (the start corner is long gone)
         let tail = max_abs_diff(&c.predicted[n - 200..], &desired[n - 200..]);
@@ -1091,10 +1093,17 @@ mod tests {
         let c = compensate_model(&rig_model(), &ramp, DT, &cfg).unwrap();
         assert!(c.fallback.is_none());
         assert_eq!(c.smoothing_s, 0.0);
-        assert!(c.predicted_error.max_abs < 1e-10, "{}", c.predicted_error.max_abs);
+        assert!(
+            c.predicted_error.max_abs < 1e-10,
+            "{}",
+            c.predicted_error.max_abs
+        );
         // the plain command lags by v·(1/Kv + Δt/2) from the first sample on
         let lag = c.predicted_plain_error.max_abs;
-        assert!((lag - 0.05 * (1.0 / 700.0 + DT / 2.0)).abs() < 1e-8, "{lag}");
+        assert!(
+            (lag - 0.05 * (1.0 / 700.0 + DT / 2.0)).abs() < 1e-8,
+            "{lag}"
+        );
         // the same ramp from rest at t = 0 within its own figures
         let rest = CompensateConfig {
             max_acceleration: f64::INFINITY,
@@ -1144,7 +1153,11 @@ mod tests {
         desired.extend(ramp.iter().map(|v| top + v));
         let c = compensate_model(&rig_model(), &desired, DT, &CompensateConfig::default()).unwrap();
         assert!(c.fallback.is_none());
-        assert!(c.smoothing_s > 0.0 && c.smoothed_share < 0.3, "{}", c.smoothed_share);
+        assert!(
+            c.smoothing_s > 0.0 && c.smoothed_share < 0.3,
+            "{}",
+            c.smoothed_share
+        );
         // the jerk-limited move is followed exactly
         let first = max_abs_diff(&c.predicted[..1400], &desired[..1400]);
         assert!(first < 1e-10, "{first}");
@@ -1190,8 +1203,8 @@ mod tests {
     #[test]
     fn the_plain_command_is_sent_when_the_model_expects_little_or_fits_poorly() {
         let desired = Scenario::Scurve.command(5000.0, 0.4, 0).unwrap();
-        let good = compensate_model(&rig_model(), &desired, DT, &CompensateConfig::default())
-            .unwrap();
+        let good =
+            compensate_model(&rig_model(), &desired, DT, &CompensateConfig::default()).unwrap();
         assert!(good.fallback.is_none());
         let b = good.benefit;
         assert!(b.expected_benefit > 100.0);

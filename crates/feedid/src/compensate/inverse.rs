@@ -620,11 +620,16 @@ mod tests {
     #[test]
     fn only_left_half_plane_zeros_near_the_circle_are_approximated() {
         // zeros −0.97 (ZPETC with margin 0.05) and 0.97 (exact, causal)
-        let beta = crate::lti::poly_from_roots(&[Complex::new(-0.97, 0.0), Complex::new(0.97, 0.0)]);
+        let beta =
+            crate::lti::poly_from_roots(&[Complex::new(-0.97, 0.0), Complex::new(0.97, 0.0)]);
         let mut b = vec![0.0];
         b.extend_from_slice(&beta);
         let inv = StableInverse::from_polynomials(&b, &[1.0, -0.5], 0.05).unwrap();
-        let h: Vec<_> = inv.zeros().iter().map(|z| (z.re > 0.0, z.handling)).collect();
+        let h: Vec<_> = inv
+            .zeros()
+            .iter()
+            .map(|z| (z.re > 0.0, z.handling))
+            .collect();
         assert!(h.contains(&(false, ZeroHandling::ZeroPhase)));
         assert!(h.contains(&(true, ZeroHandling::Causal)));
         // an anti-causal zero's settle length covers its decay, 1e-17 = 1.5^−n

@@ -614,7 +614,7 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
         let pk = p.peaks(&c.sent);
         let score =
             |q: &Peaks| (q.velocity / cfg.max_velocity).max(q.acceleration / cfg.max_acceleration);
-        if best.as_ref().is_none_or(|b| score(&pk) < score(b)) {
+        if best.as_ref().map_or(true, |b| score(&pk) < score(b)) {
             best = Some(pk);
         }
         // every violating sample of the sent command

@@ -82,7 +82,7 @@ def _array(x: Any, name: str) -> np.ndarray:
     return a
 
 
-_METHOD_OPTIONS = ("solver", "time_origin", "prediction", "lambda", "lambda_", "tolerance")
+_METHOD_OPTIONS = ("solver", "time_origin", "prediction", "simplex_start", "lambda", "lambda_", "ridge")
 
 
 def _method_options(order: Any, options: Mapping[str, Any]) -> Dict[str, Any]:
@@ -92,7 +92,8 @@ def _method_options(order: Any, options: Mapping[str, Any]) -> Dict[str, Any]:
         if key not in _METHOD_OPTIONS:
             raise TypeError(
                 f"unknown option {key!r}; method options are: "
-                "solver, time_origin, prediction (paper), lambda (rls), tolerance (auto)"
+                "solver, time_origin, prediction, simplex_start (paper), lambda (rls), "
+                "ridge (arx, auto)"
             )
         out["lambda_" if key == "lambda" else key] = value
     if order is not None:
@@ -186,8 +187,8 @@ class Identification:
         Predicted position per sample [m]; NaN where nothing was predicted
         (before the first window's horizon, failed or withheld windows).
     lower, upper : numpy.ndarray
-        Prediction interval per sample [m]; NaN where nothing was predicted
-        or the library gives no interval.
+        Prediction interval per sample [m] (probability ``interval``, 95 %
+        by default); NaN where nothing was predicted.
     coefficients : numpy.ndarray
         Per-window coefficients, shape (windows, len(coefficient_names)).
     coefficient_names : list of str
@@ -288,6 +289,7 @@ def identify(
     nominal: bool = True,
     global_model: bool = True,
     residuals: bool = True,
+    interval: float = 95.0,
     **options: Any,
 ) -> Identification:
     """Identify a recording in short sliding windows and predict the next
@@ -331,9 +333,13 @@ def identify(
         (``residuals``). On long recordings they cost several times the
         sliding identification (README, "Python"): False leaves them out
         and their keys out of the summary.
+    interval : float
+        Probability of the prediction intervals ``lower``/``upper`` [%],
+        in (0, 100); default 95 (``--interval``).
     **options
-        Method options: ``solver``, ``time_origin``, ``prediction`` (paper),
-        ``lambda`` (rls forgetting factor), ``tolerance`` (auto, [µm]).
+        Method options: ``solver``, ``time_origin``, ``prediction``,
+        ``simplex_start`` (paper), ``lambda`` (rls forgetting factor),
+        ``ridge`` (arx, auto: ridge of the least squares).
 
     Returns
     -------
@@ -368,6 +374,7 @@ def identify(
         nominal=nominal,
         global_model=global_model,
         residuals=residuals,
+        interval=interval,
         **_params(params),
         **_method_options(order, options),
     )
@@ -403,11 +410,13 @@ class Streamer:
         Relative interval deviation reported as irregular (default 0.01).
     order : str or (na, nb, nk), optional
         ARX orders (``"auto"`` is refused: a stream needs them given).
+    interval : float
+        Probability of the prediction intervals [%]; default 95.
     **options
         Method options as for :func:`identify`.
 
     ``push`` and ``finish`` return lists of ``(time [s], predicted [m],
-    lower [m], upper [m])``, the bounds NaN where the method gives none.
+    lower [m], upper [m])``.
     """
 
     def __init__(
@@ -422,9 +431,11 @@ class Streamer:
         extrapolate: Optional[str] = None,
         jitter_tol: float = 0.01,
         order: Optional[Union[str, Sequence[int]]] = None,
+        interval: float = 95.0,
         **options: Any,
     ):
         self._s = _feedid.Streamer(
+            interval=interval,
             rate=rate,
             method=method,
             window=window,
@@ -459,7 +470,7 @@ class Streamer:
         """Counters and scores so far: lines, samples, windows,
         predicted_ahead, predicted_late, gaps, rms_error_m (None before any
         sample was scored), hold_rms_error_m (the hold baseline on the same
-        samples), ..."""
+        samples), interval_coverage_percent, outliers, ..."""
         return self._s.stats
 
     @property

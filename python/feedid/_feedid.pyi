@@ -62,8 +62,10 @@ class Streamer:
         solver: Optional[str] = None,
         time_origin: Optional[str] = None,
         prediction: Optional[str] = None,
+        simplex_start: Optional[str] = None,
         lambda_: Optional[float] = None,
-        tolerance: Optional[float] = None,
+        ridge: Optional[float] = None,
+        interval: float = 95.0,
     ) -> None: ...
     def push(self, t: float, u: float, y: float) -> List[_Row]: ...
     def push_many(
@@ -103,8 +105,10 @@ def identify(
     solver: Optional[str] = None,
     time_origin: Optional[str] = None,
     prediction: Optional[str] = None,
+    simplex_start: Optional[str] = None,
     lambda_: Optional[float] = None,
-    tolerance: Optional[float] = None,
+    ridge: Optional[float] = None,
+    interval: float = 95.0,
     params_path: Optional[str] = None,
     params_json: Optional[str] = None,
     allow_unstable: bool = False,

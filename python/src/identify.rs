@@ -21,8 +21,8 @@ use crate::recording::PyRecording;
 /// `model_json`, `warnings`).
 #[pyfunction]
 #[pyo3(signature = (recording, *, method = "auto", window = None, horizon = 10, hop = None,
-    order = None, solver = None, time_origin = None, prediction = None, lambda_ = None,
-    tolerance = None, params_path = None, params_json = None, allow_unstable = false,
+    order = None, solver = None, time_origin = None, prediction = None, simplex_start = None, lambda_ = None,
+    ridge = None, interval = 95.0, params_path = None, params_json = None, allow_unstable = false,
     nominal = true, global_model = true, residuals = true))]
 #[allow(clippy::too_many_arguments)]
 pub fn identify<'py>(
@@ -36,8 +36,10 @@ pub fn identify<'py>(
     solver: Option<String>,
     time_origin: Option<String>,
     prediction: Option<String>,
+    simplex_start: Option<String>,
     lambda_: Option<f64>,
-    tolerance: Option<f64>,
+    ridge: Option<f64>,
+    interval: f64,
     params_path: Option<String>,
     params_json: Option<String>,
     allow_unstable: bool,
@@ -50,10 +52,12 @@ pub fn identify<'py>(
         solver,
         time_origin,
         prediction,
+        simplex_start,
         lambda: lambda_,
-        tolerance,
+        ridge,
     };
     let method = options.method(method)?;
+    let interval = crate::method::interval(interval)?;
     let select = matches!(options.order_option()?, Some(OrderOption::Select));
     let params = crate::params::load(
         params_path.as_deref(),
@@ -67,6 +71,7 @@ pub fn identify<'py>(
                 .window_or_default(window)
                 .horizon(horizon)
                 .hop(hop)
+                .interval(interval)
                 .method_global_model(global_model)
                 .residuals(if residuals { Some(RESIDUAL_LAGS) } else { None });
             if nominal {
@@ -82,16 +87,16 @@ pub fn identify<'py>(
     let summary_json = serde_json::to_string(&summary)
         .map_err(|e| crate::errors::input(format!("summary: {e}")))?;
     let s = run.sliding;
-    let n = s.predicted.len();
-    let mut predicted = s.predicted;
-    for (p, &has) in predicted.iter_mut().zip(&s.has_prediction) {
+    let (mut predicted, mut lower, mut upper) = (s.predicted, s.lower, s.upper);
+    for (k, &has) in s.has_prediction.iter().enumerate() {
         if !has {
-            *p = f64::NAN;
+            for v in [&mut predicted, &mut lower, &mut upper] {
+                if let Some(x) = v.get_mut(k) {
+                    *x = f64::NAN;
+                }
+            }
         }
     }
-    // prediction intervals: none from this library version
-    let lower = vec![f64::NAN; n];
-    let upper = vec![f64::NAN; n];
     let nc = s.coefficient_names.len();
     let nw = s.windows.len();
     let coefficients = PyArray1::from_vec(py, s.coefficients).reshape([nw, nc])?;

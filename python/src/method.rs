@@ -1,6 +1,6 @@
 //! Method options (keyword arguments) → a library [`Method`], as the
 //! command-line tool's `--order`, `--solver`, `--time-origin`,
-//! `--prediction`, `--lambda` and `--tolerance` do: an option the method does
+//! `--prediction`, `--simplex-start`, `--lambda` and `--ridge` do: an option the method does
 //! not have is an error naming the methods it applies to.
 
 use feedid::ident::{ArxOrders, Method};
@@ -19,10 +19,12 @@ pub struct MethodOptions {
     pub time_origin: Option<String>,
     /// Paper method: prediction mode name.
     pub prediction: Option<String>,
+    /// Paper method: simplex start name.
+    pub simplex_start: Option<String>,
     /// RLS forgetting factor.
     pub lambda: Option<f64>,
-    /// Auto method: tolerance \[µm\].
-    pub tolerance: Option<f64>,
+    /// ARX and auto: ridge of the least squares.
+    pub ridge: Option<f64>,
 }
 
 /// What `order` asks for.
@@ -87,6 +89,13 @@ impl MethodOptions {
                 _ => return Err(refuse("prediction", "paper", &m)),
             }
         }
+        if let Some(s) = &self.simplex_start {
+            let v = s.parse().py_err()?;
+            match &mut m {
+                Method::Paper(c) => c.simplex_start = v,
+                _ => return Err(refuse("simplex_start", "paper", &m)),
+            }
+        }
         match self.order_option()? {
             Some(OrderOption::Orders(o)) => match m.set_orders(o) {
                 Ok(()) => {}
@@ -111,13 +120,26 @@ impl MethodOptions {
                 _ => return Err(refuse("lambda", "rls", &m)),
             }
         }
-        if let Some(t) = self.tolerance {
+        if let Some(r) = self.ridge {
             match &mut m {
-                Method::Auto(c) => c.tolerance = t * 1e-6,
-                _ => return Err(refuse("tolerance", "auto", &m)),
+                Method::Arx(c) => c.ridge = r,
+                Method::Auto(c) => c.set_ridge(r),
+                _ => return Err(refuse("ridge", "arx, auto", &m)),
             }
         }
         m.validate().py_err()?;
         Ok(m)
     }
+}
+
+/// The probability of the prediction intervals \[%\] → a fraction, checked
+/// as `--interval` is.
+pub fn interval(percent: f64) -> PyResult<f64> {
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // rejects NaN
+    if !(percent > 0.0 && percent < 100.0) {
+        return Err(input(format!(
+            "invalid interval {percent}: the probability of the prediction intervals must be in (0, 100) % (e.g. 95)"
+        )));
+    }
+    Ok(percent / 100.0)
 }

@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use feedid::compensate::{compensate_model, compensate_params, CompensateConfig, Smoothing};
+use feedid::compensate::{
+    compensate_model, compensate_params, CompensateConfig, ModelQuality, Smoothing,
+};
 use feedid::drive::{D1Variant, ModelSummary, RigEffects, VirtualRig};
 use feedid::greybox::LoopModel;
 use feedid::ident::ModelFile;
@@ -98,6 +100,15 @@ pub fn model(
     serde_json::to_string(&summary).map_err(|e| input(format!("model: {e}")))
 }
 
+/// What is known of an identified model's quality without a check
+/// recording: its free-run fit (as `feedid compensate --model` without `--check`).
+fn quality(file: &ModelFile) -> ModelQuality {
+    ModelQuality {
+        position_fit_percent: file.identified_by.as_ref().map(|p| p.fit_percent),
+        error_fit_percent: None,
+    }
+}
+
 /// The command that makes a model follow `desired` (`feedid compensate`):
 /// returns `(command, predicted, summary_json)`.
 #[pyfunction]
@@ -124,7 +135,7 @@ pub fn compensate<'py>(
     let (t, x) = (slice(&time, "time")?, slice(&desired, "desired")?);
     // the desired trajectory is checked as a recording (time increasing, finite)
     let rec = Recording::new(t.to_vec(), x.to_vec(), x.to_vec()).py_err()?;
-    let cfg = CompensateConfig {
+    let mut cfg = CompensateConfig {
         smoothing: smooth.map_or(Smoothing::Auto, Smoothing::Fixed),
         max_velocity,
         max_acceleration,
@@ -137,12 +148,14 @@ pub fn compensate<'py>(
     let comp = match (model_json, model_path) {
         (Some(text), _) => {
             let file = ModelFile::from_json(&text).py_err()?;
+            cfg.quality = quality(&file);
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))
                 .py_err()?
         }
         (None, Some(path)) => {
             let text = feedid::io::read_small_text(Path::new(&path)).py_err()?;
             let file = ModelFile::from_json_file(&text, Path::new(&path)).py_err()?;
+            cfg.quality = quality(&file);
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))
                 .map_err(|e| input(format!("{path}: {e}")))?
         }

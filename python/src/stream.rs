@@ -3,7 +3,7 @@
 //! the predictions that became due.
 
 use feedid::ident::stream::{CommandExtrapolation, StreamOptions, StreamStats};
-use feedid::ident::{EngineConfig, Estimator, Streamer};
+use feedid::ident::{EngineConfig, Estimator, GuardConfig, Streamer};
 use std::sync::{Mutex, MutexGuard};
 
 use numpy::PyReadonlyArray1;
@@ -35,7 +35,8 @@ fn drain(s: &mut Inner, out: &mut Vec<Row>) -> feedid::Result<()> {
                 p.time
                     .iter()
                     .zip(p.position)
-                    .map(|(&t, &y)| (t, y, f64::NAN, f64::NAN)),
+                    .zip(p.lower.iter().zip(p.upper))
+                    .map(|((&t, &y), (&lo, &hi))| (t, y, lo, hi)),
             );
         }
     }
@@ -70,6 +71,8 @@ fn stats_dict<'py>(py: Python<'py>, s: &StreamStats) -> PyResult<Bound<'py, PyDi
     d.set_item("rms_error_m", some(s.scored.rms))?;
     d.set_item("max_abs_error_m", some(s.scored.max_abs))?;
     d.set_item("hold_rms_error_m", some(s.hold.rms))?;
+    d.set_item("interval_coverage_percent", s.interval_coverage_percent())?;
+    d.set_item("outliers", s.outliers)?;
     Ok(d)
 }
 
@@ -78,7 +81,8 @@ impl PyStreamer {
     #[new]
     #[pyo3(signature = (*, rate = None, method = "auto", window = None, horizon = 10, hop = None,
         command_lead = 0, extrapolate = None, jitter_tol = 0.01, order = None, solver = None,
-        time_origin = None, prediction = None, lambda_ = None, tolerance = None))]
+        time_origin = None, prediction = None, simplex_start = None, lambda_ = None, ridge = None,
+        interval = 95.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         rate: Option<f64>,
@@ -93,16 +97,19 @@ impl PyStreamer {
         solver: Option<String>,
         time_origin: Option<String>,
         prediction: Option<String>,
+        simplex_start: Option<String>,
         lambda_: Option<f64>,
-        tolerance: Option<f64>,
+        ridge: Option<f64>,
+        interval: f64,
     ) -> PyResult<Self> {
         let options = MethodOptions {
             order,
             solver,
             time_origin,
             prediction,
+            simplex_start,
             lambda: lambda_,
-            tolerance,
+            ridge,
         };
         if matches!(options.order_option()?, Some(OrderOption::Select)) {
             return Err(input(
@@ -110,6 +117,7 @@ impl PyStreamer {
             ));
         }
         let method = options.method(method)?;
+        let interval = crate::method::interval(interval)?;
         if let Some(r) = rate {
             if !(r.is_finite() && r > 0.0) {
                 return Err(input(format!(
@@ -132,6 +140,10 @@ impl PyStreamer {
             extrapolation,
             dt: rate.map(|r| 1.0 / r),
             jitter_tolerance: jitter_tol,
+            guard: GuardConfig {
+                interval,
+                ..GuardConfig::default()
+            },
             ..StreamOptions::default()
         };
         let inner = Streamer::with_options(method.build().py_err()?, config, opts).py_err()?;

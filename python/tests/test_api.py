@@ -34,6 +34,8 @@ def test_errors_are_value_and_os_errors_with_the_cli_messages(tmp_path):
         feedid.identify(t, np.zeros(100), np.zeros(100), method="arx", **{"lambda": 0.9})
     with pytest.raises(TypeError, match="unknown option"):
         feedid.identify(t, np.zeros(100), np.zeros(100), lamda=0.9)
+    with pytest.raises(feedid.InputError, match="interval"):
+        feedid.identify(t, np.zeros(100), np.zeros(100), interval=100)
     with pytest.raises(feedid.InputError, match="scenario"):
         feedid.simulate("sawtooth")
 
@@ -68,9 +70,17 @@ def test_identification_has_its_arrays_and_frames():
     assert predicted.sum() == run.summary["samples_predicted"]
     # where nothing was predicted the bounds are NaN too
     assert np.all(np.isnan(run.lower[~predicted])) and np.all(np.isnan(run.upper[~predicted]))
-    inside = predicted & ~np.isnan(run.lower)
-    assert np.all(run.lower[inside] <= run.predicted[inside])
-    assert np.all(run.predicted[inside] <= run.upper[inside])
+    # every predicted sample has its interval around the prediction
+    assert not np.any(np.isnan(run.lower[predicted])) and not np.any(np.isnan(run.upper[predicted]))
+    assert np.all(run.lower[predicted] <= run.predicted[predicted])
+    assert np.all(run.predicted[predicted] <= run.upper[predicted])
+    y = rec.position[predicted]
+    inside = (run.lower[predicted] <= y) & (y <= run.upper[predicted])
+    assert 100 * inside.mean() == pytest.approx(run.summary["interval_coverage_percent"], rel=1e-9)
+    narrow = feedid.identify(rec, interval=50)
+    w95 = run.upper[predicted] - run.lower[predicted]
+    w50 = narrow.upper[predicted] - narrow.lower[predicted]
+    assert np.median(w50) < np.median(w95)
     err = run.predicted[predicted] - rec.position[predicted]
     assert np.sqrt(np.mean(err**2)) == pytest.approx(run.summary["rms_error_m"], rel=1e-9)
     df = run.to_pandas()

@@ -20,6 +20,8 @@ def cli_identify(cli, tmp_path, recording, *args):
 def check(run, pred, coef, summ):
     scale = float(np.ptp(run.position))
     assert_same_predictions(run.predicted, pred["predicted_m"], scale)
+    assert_same_predictions(run.lower, pred["lower_m"], scale)
+    assert_same_predictions(run.upper, pred["upper_m"], scale)
     np.testing.assert_array_equal(run.time, pred["time_s"])
     np.testing.assert_array_equal(run.position, pred["measured_m"])
     sim = pred["simulated_m"]
@@ -73,6 +75,8 @@ def test_options_reach_the_method_as_on_the_command_line(cli, tmp_path):
          {"method": "rls", "lambda": 0.99, "hop": 3}),
         (["--method", "arx", "--order", "auto"], dict(method="arx", order="auto")),
         (["--method", "paper", "--solver", "simplex"], dict(method="paper", solver="simplex")),
+        (["--method", "arx", "--ridge", "1e-6", "--interval", "80"],
+         dict(method="arx", ridge=1e-6, interval=80)),
     ]
     for args, kw in cases:
         pred, coef, summ = cli_identify(cli, tmp_path, rec_path, *args)

@@ -10,12 +10,14 @@ import pytest
 import feedid
 
 
-def by_sample(t, rows):
-    """Predictions keyed by sample index (the latest wins, as in batch);
-    forecasts past the last sample (the last window's horizon) left out."""
+def by_sample(t, rows, column=1):
+    """Predictions (or bounds: column 2, 3) keyed by sample index (the latest
+    wins, as in batch); forecasts past the last sample (the last window's
+    horizon) left out."""
     t = np.asarray(t)
     out = {}
-    for time, y, lo, hi in rows:
+    for row in rows:
+        time, y = row[0], row[column]
         if time > t[-1] + 0.5 * (t[-1] - t[-2]):
             continue
         # measured samples carry their time; horizons not yet measured carry
@@ -43,9 +45,12 @@ def test_streamer_waiting_for_its_command_predicts_what_identify_predicts(method
     scale = float(np.ptp(rec.position))
     err = max(abs(got[k] - want[k]) for k in want)
     assert err <= 1e-12 * scale, err
-    # bounds are NaN or around the prediction
+    # the same intervals as identify's, around the prediction
+    for col, arr in [(2, run.lower), (3, run.upper)]:
+        b = by_sample(rec.time, rows, col)
+        assert max(abs(b[k] - arr[k]) for k in want) <= 1e-12 * scale
     for _, y, lo, hi in rows:
-        assert (math.isnan(lo) and math.isnan(hi)) or lo <= y <= hi
+        assert lo <= y <= hi
     st = s.stats
     assert st["lines"] == len(rec) and st["samples_scored"] == len(want)
     assert st["rms_error_m"] == pytest.approx(run.summary["rms_error_m"], rel=1e-9)

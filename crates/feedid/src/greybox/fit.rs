@@ -254,14 +254,17 @@ pub(crate) fn check_set(
             return Err(Error::InvalidChoice {
                 what: "parameter for the linear model (friction levels need the nonlinear model)",
                 value: p.name().to_string(),
-                expected: "Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K",
+                expected: super::names::LINEAR_PARAMETER_NAMES,
             });
         }
     }
     estimate
         .iter()
         .map(|p| {
-            let v = p.get(start, effects);
+            let v = match p.get(start, effects) {
+                v if v == 0.0 && p.is_feed_forward() => super::names::FEED_FORWARD_START,
+                v => v,
+            };
             if v.is_finite() && v > 0.0 {
                 Ok(v)
             } else {

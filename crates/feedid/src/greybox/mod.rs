@@ -21,6 +21,7 @@ mod fit;
 pub mod identifiability;
 mod model;
 mod names;
+pub mod omitted;
 mod track;
 pub mod whiteness;
 
@@ -31,6 +32,7 @@ pub use fit::{
 };
 pub use identifiability::{Identifiability, IdentifiabilityThresholds, NullDirection, Verdict};
 pub use model::{linear_discrete, Dynamics, LoopModel, PhysicalModel};
+pub use omitted::{MissingFeedForward, FEED_FORWARD_LIMIT};
 pub use names::{
     PhysicalParameter, FEED_FORWARD_START, LINEAR_PARAMETER_NAMES, PARAMETER_NAMES,
 };

@@ -425,7 +425,7 @@ pub struct GreyboxArgs {
     /// Starting (nominal) rig parameters; the others stay fixed at these values [default: the built-in rig].
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
-    /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc.
+    /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc.
     #[arg(long, value_name = "LIST")]
     pub estimate: String,
     /// Measured motor-current column/variable [A], used as a second output.

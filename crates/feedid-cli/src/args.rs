@@ -292,6 +292,9 @@ pub struct ReproduceArgs {
     /// Methods compared with the paper's in report.html (comma-separated).
     #[arg(long, default_value = "arx,rls,oe,auto", value_name = "LIST")]
     pub compare: String,
+    /// Measured axis: nominal (the rig is the simulation model plus its effects) or real (off the nominal model: mass ×1.25, stiffness ×0.75, C2 ×1.5, Kt and Ke ×0.92, table friction ×1.6, 2 samples dead time).
+    #[arg(long, default_value = "nominal", value_name = "AXIS")]
+    pub axis: String,
 }
 
 /// `feedid order`.

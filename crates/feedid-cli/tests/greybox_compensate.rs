@@ -195,7 +195,10 @@ fn greybox_estimates_feed_forward_and_says_when_it_is_missing() {
     );
     assert!(out.contains("feed-forward probably missing"), "{out}");
     let j = json(&summary);
-    assert!(j["missing_feed_forward"]["likely"].as_bool().unwrap(), "{j}");
+    assert!(
+        j["missing_feed_forward"]["likely"].as_bool().unwrap(),
+        "{j}"
+    );
     assert_ne!(j["estimates"][0]["verdict"], "identifiable", "{j}");
     // Kv and Kvff: both recovered, nothing missing
     let summary = dir.path().join("kvff.json");

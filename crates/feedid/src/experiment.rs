@@ -306,7 +306,12 @@ pub fn summary_markdown(results: &[ExperimentResult], cfg: &PaperExperimentConfi
             Axis::Real(o) => format!(
                 "a real axis off the nominal simulation model (mass ×{}, stiffness ×{}, \
                  table damping ×{}, Kt and Ke ×{}, table friction ×{}, dead time {} samples)",
-                o.mass, o.stiffness, o.table_damping, o.motor_constant, o.table_friction, o.dead_time
+                o.mass,
+                o.stiffness,
+                o.table_damping,
+                o.motor_constant,
+                o.table_friction,
+                o.dead_time
             ),
         },
         if cfg.effects == RigEffects::default() {
@@ -407,7 +412,9 @@ fn paper_side_by_side(s: &mut String, results: &[ExperimentResult], cfg: &PaperE
              simulation model starts with an advantage no real axis gives it (`--axis real` \
              moves the rig off it)"
         }
-        Axis::Real(_) => "the measured axis is off the nominal model as a real axis is off its data sheet",
+        Axis::Real(_) => {
+            "the measured axis is off the nominal model as a real axis is off its data sheet"
+        }
     };
     let _ = writeln!(
         s,
@@ -476,10 +483,20 @@ mod tests {
         // the windowed identification does not use the nominal model
         assert!(off.qr.whole.rms.is_finite());
         // settled, the identified model beats the mismatched nominal model
-        assert!(off.qr.after.rms < off.simulation.after.rms, "{:?}", off.qr.after);
+        assert!(
+            off.qr.after.rms < off.simulation.after.rms,
+            "{:?}",
+            off.qr.after
+        );
         let md = summary_markdown(&[off], &real);
-        assert!(md.contains("a real axis off the nominal simulation model"), "{md}");
-        assert!(md.contains("| nominal simulation model | ≈ 80 µm |"), "{md}");
+        assert!(
+            md.contains("a real axis off the nominal simulation model"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| nominal simulation model | ≈ 80 µm |"),
+            "{md}"
+        );
         assert!(
             md.contains("holds here only for the settled part of the move"),
             "{md}"

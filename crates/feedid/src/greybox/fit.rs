@@ -711,8 +711,7 @@ pub fn fit_greybox_with_progress(
     } else {
         None
     };
-    let structured =
-        structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
+    let structured = structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
     // spread of the restarts in log-parameters, against the standard error
     let spread: Vec<Option<f64>> = (0..n)
         .map(|j| {

@@ -32,8 +32,6 @@ pub use fit::{
 };
 pub use identifiability::{Identifiability, IdentifiabilityThresholds, NullDirection, Verdict};
 pub use model::{linear_discrete, Dynamics, LoopModel, PhysicalModel};
+pub use names::{PhysicalParameter, FEED_FORWARD_START, LINEAR_PARAMETER_NAMES, PARAMETER_NAMES};
 pub use omitted::{MissingFeedForward, FEED_FORWARD_LIMIT};
-pub use names::{
-    PhysicalParameter, FEED_FORWARD_START, LINEAR_PARAMETER_NAMES, PARAMETER_NAMES,
-};
 pub use track::{track_greybox, track_greybox_with_progress, TrackConfig, TrackWindow};

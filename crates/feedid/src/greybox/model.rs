@@ -451,8 +451,14 @@ mod tests {
                 let d = max_abs_diff(&y, &rig.true_position);
                 assert!(d < 1e-9, "{kvff} {kaff} {sc}: {d}");
                 let di = max_abs_diff(&i, &rig.motor_current);
-                let scale = rig.motor_current.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-                assert!(di < 1e-6 * scale.max(1.0), "{kvff} {kaff} {sc}: current {di}");
+                let scale = rig
+                    .motor_current
+                    .iter()
+                    .fold(0.0_f64, |m, v| m.max(v.abs()));
+                assert!(
+                    di < 1e-6 * scale.max(1.0),
+                    "{kvff} {kaff} {sc}: current {di}"
+                );
             }
         }
     }
@@ -478,7 +484,10 @@ mod tests {
             let d = max_abs_diff(&y, &rig.true_position);
             assert!(d < 1e-9, "{kvff} {kaff}: {d}");
             let di = max_abs_diff(&i, &rig.motor_current);
-            let scale = rig.motor_current.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let scale = rig
+                .motor_current
+                .iter()
+                .fold(0.0_f64, |m, v| m.max(v.abs()));
             // the rig integrates the current's jumps with RK4: 5e-6 of the peak
             assert!(di < 1e-5 * scale, "{kvff} {kaff}: current {di} of {scale}");
         }
@@ -577,9 +586,11 @@ mod tests {
 
     #[test]
     fn discrete_order_is_seven_without_feed_forward_and_eight_with() {
-        for (kvff, kaff, order, feed_through) in
-            [(0.0, 0.0, 7, false), (0.9, 0.0, 8, true), (0.0, 0.5, 8, true)]
-        {
+        for (kvff, kaff, order, feed_through) in [
+            (0.0, 0.0, 7, false),
+            (0.9, 0.0, 8, true),
+            (0.0, 0.5, 8, true),
+        ] {
             let sys = linear_discrete(&ff(kvff, kaff), LoopModel::Sampled, 2e-4).unwrap();
             assert_eq!(sys.order(), order);
             assert_eq!(sys.d != 0.0, feed_through);

@@ -164,7 +164,10 @@ mod tests {
             let (kv, kvff) = (&fit.estimates[0], &fit.estimates[1]);
             assert_eq!(kvff.start, FEED_FORWARD_START);
             assert!((kv.value / 30.0 - 1.0).abs() < 0.05, "{scenario}: {fit:?}");
-            assert!((kvff.value / 0.97 - 1.0).abs() < 0.01, "{scenario}: {fit:?}");
+            assert!(
+                (kvff.value / 0.97 - 1.0).abs() < 0.01,
+                "{scenario}: {fit:?}"
+            );
             for e in &fit.estimates {
                 assert_eq!(e.verdict, Verdict::Identifiable, "{scenario}: {e:?}");
                 // the truth within 4 standard errors
@@ -184,8 +187,13 @@ mod tests {
         let (u, y) = record(ff_axis(), Scenario::Scurve, 0.4);
         let data = Measurements::new(&u, &y, 1.0 / RATE);
         let set = PhysicalParameter::parse_list("Kv").unwrap();
-        let fit = fit_greybox(&data, &RigParams::default(), &set, &GreyboxConfig::default())
-            .unwrap();
+        let fit = fit_greybox(
+            &data,
+            &RigParams::default(),
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap();
         // Kv runs far from 30 1/s to mimic the small following error
         assert!(fit.estimates[0].value > 300.0, "{fit:?}");
         assert_ne!(fit.estimates[0].verdict, Verdict::Identifiable);
@@ -208,9 +216,17 @@ mod tests {
         let (u, y) = record(truth, Scenario::Scurve, 0.4);
         let data = Measurements::new(&u, &y, 1.0 / RATE);
         let set = PhysicalParameter::parse_list("Kv").unwrap();
-        let fit = fit_greybox(&data, &RigParams::default(), &set, &GreyboxConfig::default())
-            .unwrap();
-        assert!((fit.estimates[0].value / 450.0 - 1.0).abs() < 0.01, "{fit:?}");
+        let fit = fit_greybox(
+            &data,
+            &RigParams::default(),
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap();
+        assert!(
+            (fit.estimates[0].value / 450.0 - 1.0).abs() < 0.01,
+            "{fit:?}"
+        );
         let m = fit.missing_feed_forward.unwrap();
         assert!(!m.likely && m.explained_share < 0.1, "{m:?}");
         assert!(!fit.warnings().join(" ").contains("feed-forward"));

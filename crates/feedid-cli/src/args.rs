@@ -171,16 +171,18 @@ pub struct MethodOptions {
     pub simplex_start: Option<String>,
     /// arx, rls, auto (its long-memory candidate): ARX orders `na,nb,nk`
     /// (poles, input terms, input delay in samples), or `auto` (chosen from
-    /// the recording by BIC; identify only) [default: 8,8,1].
+    /// the recording by BIC; identify only) [default: arx 3,3,0; rls 8,8,0;
+    /// auto 8,8,0].
     #[arg(long, value_name = "NA,NB,NK|auto")]
     pub order: Option<String>,
     /// rls: forgetting factor λ (memory ≈ 1/(1−λ) samples) [default: 0.999].
     #[arg(long, value_name = "LAMBDA")]
     pub lambda: Option<f64>,
-    /// auto: emit a prediction only when the chosen model's recent rms error
-    /// is within this tolerance [µm] [default: 5].
-    #[arg(long, value_name = "UM")]
-    pub tolerance: Option<f64>,
+    /// arx, auto (its windowed candidates): ridge of the least squares,
+    /// relative to the regressors' scale (arx: on the column-normalised
+    /// coefficients), ≥ 0, 0 = none [default: arx 1e-10; auto 1e-6].
+    #[arg(long, value_name = "R")]
+    pub ridge: Option<f64>,
 }
 
 /// Sliding-window options.
@@ -235,13 +237,16 @@ pub struct IdentifyArgs {
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
+    /// Probability of the prediction intervals (lower_m, upper_m) [%], in (0, 100).
+    #[arg(long, value_name = "P", default_value_t = 95.0)]
+    pub interval: f64,
     /// Rig parameters of the nominal simulation model (TOML); default: the built-in rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
     /// Use an unstable physical model anyway (its simulation diverges; refused by default).
     #[arg(long)]
     pub allow_unstable: bool,
-    /// Predictions CSV: time_s,command_m,measured_m,predicted_m,simulated_m.
+    /// Predictions CSV: time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m.
     #[arg(
         short,
         long,
@@ -337,6 +342,9 @@ pub struct StreamArgs {
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
+    /// Probability of the prediction intervals (lower_m, upper_m) [%], in (0, 100).
+    #[arg(long, value_name = "P", default_value_t = 95.0)]
+    pub interval: f64,
     /// How to read the lines (as a recording file; without a header and
     /// without column options: time, command, position are columns 1, 2, 3).
     #[command(flatten)]
@@ -523,6 +531,21 @@ pub struct CompensateArgs {
     /// Keep the model's DC gain instead of rescaling it to 1 (a position loop has 1).
     #[arg(long)]
     pub keep_dc_gain: bool,
+    /// The axis before the first desired sample: rest (at the first value) or moving (a segment cut from a longer program, at the first sample's velocity).
+    #[arg(long, default_value = "rest", value_name = "rest|moving")]
+    pub start: String,
+    /// Send the plain command when the model expects the rms error to fall less than this many times.
+    #[arg(long, default_value_t = 1.25, value_name = "X")]
+    pub min_benefit: f64,
+    /// Send the plain command when the model's free-run position fit is below this [%].
+    #[arg(long, default_value_t = 90.0, value_name = "PCT")]
+    pub min_fit: f64,
+    /// Always send the compensated command (no fall-back to the plain one).
+    #[arg(long)]
+    pub no_fallback: bool,
+    /// A recording of the axis (time_s,command_m,position_m; e.g. the identification run) on which the model's fits are measured for the fall-back [default: the model file's fit].
+    #[arg(long, value_name = "rec.csv", requires = "model")]
+    pub check: Option<PathBuf>,
     /// Use an unstable physical model anyway (its simulation diverges; refused by default).
     #[arg(long)]
     pub allow_unstable: bool,

@@ -297,6 +297,9 @@ pub struct ReproduceArgs {
     /// Methods compared with the paper's in report.html (comma-separated).
     #[arg(long, default_value = "arx,rls,oe,auto", value_name = "LIST")]
     pub compare: String,
+    /// Measured axis: nominal (the rig is the simulation model plus its effects) or real (off the nominal model: mass ×1.25, stiffness ×0.75, C2 ×1.5, Kt and Ke ×0.92, table friction ×1.6, 2 samples dead time).
+    #[arg(long, default_value = "nominal", value_name = "AXIS")]
+    pub axis: String,
 }
 
 /// `feedid order`.
@@ -436,7 +439,7 @@ pub struct GreyboxArgs {
     /// Starting (nominal) rig parameters; the others stay fixed at these values [default: the built-in rig].
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
-    /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc.
+    /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc.
     #[arg(long, value_name = "LIST")]
     pub estimate: String,
     /// Measured motor-current column/variable [A], used as a second output.

@@ -402,6 +402,46 @@ fn reproduce_writes_the_four_figures_and_the_summary() {
 }
 
 #[test]
+fn reproduce_on_a_real_axis_puts_the_papers_figures_beside_ours_with_a_verdict() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("real");
+    let o = feedid(&[
+        "reproduce",
+        "--axis",
+        "real",
+        "--compare",
+        "none",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(
+        md.contains("a real axis off the nominal simulation model"),
+        "{md}"
+    );
+    assert!(md.contains("## The paper's figures and ours"), "{md}");
+    assert!(
+        md.contains("| identified model (LSM, simplex) | ≈ 40 µm |"),
+        "{md}"
+    );
+    assert!(
+        md.contains("Verdict (the measured axis is off the nominal model"),
+        "{md}"
+    );
+    // the default axis says the simulation model starts with an advantage
+    let o = feedid(&[
+        "reproduce",
+        "--axis",
+        "ideal",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("ideal"), "{}", stderr(&o));
+}
+
+#[test]
 fn info_summarises_a_recording() {
     let o = feedid(&["info", data("comma_header.csv").to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));

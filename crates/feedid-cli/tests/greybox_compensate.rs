@@ -157,6 +157,72 @@ fn greybox_with_friction_and_current_recovers_the_rig_from_a_noisy_recording() {
 }
 
 #[test]
+fn greybox_estimates_feed_forward_and_says_when_it_is_missing() {
+    // a slow axis with full velocity feed-forward (Kv 30 1/s, kvff 1)
+    let dir = tempfile::tempdir().unwrap();
+    let rig = dir.path().join("ff.toml");
+    std::fs::write(&rig, "[control]\nkv = 30.0\nkvff = 1.0\n").unwrap();
+    let rec = simulate(
+        dir.path(),
+        "sc.csv",
+        &["--scenario", "scurve", "--linear", "--params", p(&rig)],
+    );
+    // Kv alone, from the built-in rig (no feed-forward): flagged, never identifiable
+    let summary = dir.path().join("kv.json");
+    let out = run_ok(&[
+        "greybox",
+        p(&rec),
+        "--estimate",
+        "Kv",
+        "--position-loop",
+        "continuous",
+        "--summary",
+        p(&summary),
+    ]);
+    let o = feedid(&[
+        "greybox",
+        p(&rec),
+        "--estimate",
+        "Kv",
+        "--position-loop",
+        "continuous",
+    ]);
+    let warnings = stderr(&o);
+    assert!(
+        warnings.contains("feed-forward may be missing")
+            && warnings.contains("--estimate Kv,Kvff,Kaff"),
+        "{out}{warnings}"
+    );
+    assert!(out.contains("feed-forward probably missing"), "{out}");
+    let j = json(&summary);
+    assert!(
+        j["missing_feed_forward"]["likely"].as_bool().unwrap(),
+        "{j}"
+    );
+    assert_ne!(j["estimates"][0]["verdict"], "identifiable", "{j}");
+    // Kv and Kvff: both recovered, nothing missing
+    let summary = dir.path().join("kvff.json");
+    run_ok(&[
+        "greybox",
+        p(&rec),
+        "--estimate",
+        "Kv,Kvff",
+        "--position-loop",
+        "continuous",
+        "--summary",
+        p(&summary),
+    ]);
+    let j = json(&summary);
+    let e = &j["estimates"];
+    let kv = e[0]["value"].as_f64().unwrap();
+    let kvff = e[1]["value"].as_f64().unwrap();
+    assert!((kv / 30.0 - 1.0).abs() < 1e-4, "{j}");
+    assert!((kvff - 1.0).abs() < 1e-5, "{j}");
+    assert_eq!(e[0]["verdict"], "identifiable", "{j}");
+    assert!(j.get("missing_feed_forward").is_none(), "{j}");
+}
+
+#[test]
 fn greybox_refuses_a_set_that_only_enters_as_a_combination() {
     let dir = tempfile::tempdir().unwrap();
     let rec = simulate(dir.path(), "prbs.csv", &["--scenario", "prbs", "--linear"]);

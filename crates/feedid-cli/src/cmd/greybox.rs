@@ -285,6 +285,18 @@ fn report(t: &mut String, fit: &GreyboxFit) {
             .collect();
         let _ = writeln!(t, "  residuals: {}", parts.join(", "));
     }
+    if let Some(f) = fit.missing_feed_forward {
+        let _ = writeln!(
+            t,
+            "  feed-forward test: Kvff, Kaff would explain {:.1} % of the position residual ({})",
+            100.0 * f.explained_share,
+            if f.likely {
+                "feed-forward probably missing"
+            } else {
+                "none missing"
+            }
+        );
+    }
     if fit.restarts > 0 {
         let _ = writeln!(
             t,

@@ -19,6 +19,7 @@ pub fn run(a: &ReproduceArgs) -> Result<()> {
         params: load_model_params(a.params.as_deref(), a.allow_unstable)?,
         seed: a.seed,
         solver: a.solver.parse()?,
+        axis: a.axis.parse()?,
         ..PaperExperimentConfig::default()
     };
     // three steps of about equal length: the two experiments, the report

@@ -283,20 +283,43 @@ pub fn closed_loop_state_space_with_stiffness(params: &RigParams, k: f64) -> Res
 
     if g.kvff != 0.0 || g.kaff != 0.0 {
         // g = b₀ + A·b₁ + A²·b₂ (module doc): b₁ = kvff·b_v, b₂ = c_a·b_i
-        let mut b1 = DVector::<f64>::zeros(7);
-        b1[ZV] = g.kvff;
-        b1[ZI] = g.kvff * kp;
-        b1[I] = g.kvff * kpi * kp / l;
-        let mut b2 = DVector::<f64>::zeros(7);
-        let ca = params.acceleration_feed_forward_gain();
-        b2[ZI] = ca;
-        b2[I] = ca * kpi / l;
+        let (bv, bi) = reference_inputs(params);
+        let b1 = bv * g.kvff;
+        let b2 = bi * params.acceleration_feed_forward_gain();
         let ab2 = &a * &b2;
         b += &a * (b1 + ab2);
     }
     let mut c = RowDVector::<f64>::zeros(7);
     c[XA] = 1.0;
     StateSpace::new(a, b, c, 0.0)
+}
+
+/// Input vectors of the velocity reference `v_c` \[m/s\] and of a current
+/// added to the current reference \[A\] in the physical state coordinates
+/// `[z_v, z_i, i, θ, ω, x_a, v_a]` of [`closed_loop_state_space`]:
+/// `b_v = [1, Kp, Kpi·Kp/L, 0, 0, 0, 0]`, `b_i = [0, 1, Kpi/L, 0, 0, 0, 0]`.
+/// With the position loop opened (`Kv = 0`, no feed-forward) the cascade is
+/// `ẋ = A₀·x + b_v·v_c + b_i·i_ff`; the feed-forward of the module doc is
+/// `b₁ = kvff·b_v`, `b₂ = c_a·b_i`.
+///
+/// ```
+/// use feedid::drive::{reference_inputs, RigParams};
+/// let p = RigParams::default();
+/// let (bv, bi) = reference_inputs(&p);
+/// assert_eq!(bv[1], p.control.kp);
+/// assert_eq!(bi[1], 1.0);
+/// ```
+pub fn reference_inputs(params: &RigParams) -> (DVector<f64>, DVector<f64>) {
+    let g = &params.control;
+    let l = params.motor.inductance;
+    let mut bv = DVector::<f64>::zeros(7);
+    bv[0] = 1.0;
+    bv[1] = g.kp;
+    bv[2] = g.kpi * g.kp / l;
+    let mut bi = DVector::<f64>::zeros(7);
+    bi[1] = 1.0;
+    bi[2] = g.kpi / l;
+    (bv, bi)
 }
 
 #[cfg(test)]

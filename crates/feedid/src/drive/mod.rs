@@ -11,7 +11,7 @@ mod summary;
 
 pub use closed_loop::{
     closed_loop_coefficients, closed_loop_coefficients_with_stiffness, closed_loop_state_space,
-    closed_loop_state_space_with_stiffness, ClosedLoopCoefficients, D1Variant,
+    closed_loop_state_space_with_stiffness, reference_inputs, ClosedLoopCoefficients, D1Variant,
 };
 pub use nominal::simulate_nominal;
 pub use params::{

@@ -154,6 +154,7 @@ pub fn fit_coefficients(
         residuals: RATIOS,
         residual_structure: Vec::new(),
         restarts: 0,
+        missing_feed_forward: None,
         params,
         effects,
     })

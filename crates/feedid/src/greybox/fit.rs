@@ -49,6 +49,7 @@ use super::identifiability::{
 };
 use super::model::{Dynamics, LoopModel, PhysicalModel};
 use super::names::PhysicalParameter;
+use super::omitted::{missing_feed_forward, MissingFeedForward};
 use super::whiteness::{residual_structure, ResidualStructure};
 use crate::drive::{RigEffects, RigParams};
 use crate::error::{Error, Result};
@@ -166,6 +167,11 @@ pub struct GreyboxFit {
     pub residual_structure: Vec<ResidualStructure>,
     /// Restarts made to test the estimates.
     pub restarts: usize,
+    /// What feed-forward would explain of the residual, tested when the
+    /// model has none and neither `Kvff` nor `Kaff` is estimated
+    /// ([`super::omitted`]; recordings only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub missing_feed_forward: Option<MissingFeedForward>,
     /// The full rig parameters with the estimates in place.
     #[serde(skip)]
     pub params: RigParams,
@@ -185,12 +191,27 @@ impl GreyboxFit {
     /// One warning line per parameter that is not well determined.
     pub fn warnings(&self) -> Vec<String> {
         let mut w: Vec<String> = Vec::new();
+        let ff = self.missing_feed_forward.filter(|f| f.likely);
         for s in self.residual_structure.iter().filter(|s| s.structured) {
             w.push(format!(
-                "the {} residual is not white: {:.0} % of its variance is predictable from its own past (lag-1 correlation {:.2}); the model leaves out part of the dynamics (friction? --friction), so the standard errors understate the error and the estimates may be biased: every estimate is unreliable",
+                "the {} residual is not white: {:.0} % of its variance is predictable from its own past (lag-1 correlation {:.2}); the model leaves out part of the dynamics ({}), so the standard errors understate the error and the estimates may be biased: every estimate is unreliable",
                 s.output,
                 100.0 * s.predictable_share,
-                s.lag1_correlation
+                s.lag1_correlation,
+                if ff.is_some() {
+                    "feed-forward, see below"
+                } else {
+                    "friction? --friction"
+                }
+            ));
+        }
+        if let Some(f) = ff {
+            let set: Vec<&str> = self.estimates.iter().map(|e| e.name).collect();
+            w.push(format!(
+                "feed-forward may be missing: velocity and acceleration feed-forward would explain {:.0} % of the position residual the estimated parameters leave (velocity feed-forward alone {:.0} %); the axis probably runs feed-forward, which the model lacks, so every estimate is unreliable: estimate it too (--estimate {},Kvff,Kaff) or give its gains ([control] kvff, kaff in --params)",
+                100.0 * f.explained_share,
+                100.0 * f.velocity_share,
+                set.join(",")
             ));
         }
         w.extend(
@@ -254,14 +275,17 @@ pub(crate) fn check_set(
             return Err(Error::InvalidChoice {
                 what: "parameter for the linear model (friction levels need the nonlinear model)",
                 value: p.name().to_string(),
-                expected: "Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K",
+                expected: super::names::LINEAR_PARAMETER_NAMES,
             });
         }
     }
     estimate
         .iter()
         .map(|p| {
-            let v = p.get(start, effects);
+            let v = match p.get(start, effects) {
+                v if v == 0.0 && p.is_feed_forward() => super::names::FEED_FORWARD_START,
+                v => v,
+            };
             if v.is_finite() && v > 0.0 {
                 Ok(v)
             } else {
@@ -668,7 +692,26 @@ pub fn fit_greybox_with_progress(
             structure.extend(residual_structure("current", &r[len..]));
         }
     }
-    let structured = structure.iter().any(|s| s.structured);
+    // feed-forward left out? (only asked when the model has none)
+    let no_feed_forward = start.control.kvff == 0.0
+        && start.control.kaff == 0.0
+        && !estimate.iter().any(|p| p.is_feed_forward());
+    let missing = if no_feed_forward && rms_y > EXACT_FIT * y_scale {
+        let position_jacobian: Vec<f64> = (0..n)
+            .flat_map(|j| jac[j * m..j * m + len].iter().copied())
+            .collect();
+        missing_feed_forward(
+            &prob.model,
+            data.command,
+            data.dt,
+            &r[..len],
+            &position_jacobian,
+            prob.weights.0,
+        )?
+    } else {
+        None
+    };
+    let structured = structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
     // spread of the restarts in log-parameters, against the standard error
     let spread: Vec<Option<f64>> = (0..n)
         .map(|j| {
@@ -721,6 +764,7 @@ pub fn fit_greybox_with_progress(
         residuals: m,
         residual_structure: structure,
         restarts: cfg.restarts,
+        missing_feed_forward: missing,
         params,
         effects,
     })

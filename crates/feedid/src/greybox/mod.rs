@@ -14,13 +14,14 @@
 //!   the move against the nut position.
 //!
 //! Parameter names are those a user types: [`PhysicalParameter`]
-//! (`Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc`).
+//! (`Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc`).
 
 mod coefficients;
 mod fit;
 pub mod identifiability;
 mod model;
 mod names;
+pub mod omitted;
 mod track;
 pub mod whiteness;
 
@@ -31,5 +32,6 @@ pub use fit::{
 };
 pub use identifiability::{Identifiability, IdentifiabilityThresholds, NullDirection, Verdict};
 pub use model::{linear_discrete, Dynamics, LoopModel, PhysicalModel};
-pub use names::{PhysicalParameter, PARAMETER_NAMES};
+pub use names::{PhysicalParameter, FEED_FORWARD_START, LINEAR_PARAMETER_NAMES, PARAMETER_NAMES};
+pub use omitted::{MissingFeedForward, FEED_FORWARD_LIMIT};
 pub use track::{track_greybox, track_greybox_with_progress, TrackConfig, TrackWindow};

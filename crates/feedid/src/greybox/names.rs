@@ -12,6 +12,11 @@
 //!   position — by the same factor;
 //! * `J` (total inertia): density, motor and bearing inertia scaled by `J/J₀`.
 //!
+//! `Kvff` and `Kaff` are the velocity and acceleration feed-forward gains
+//! (`control.kvff`, `control.kaff`, 0 … 2, 1 = full feed-forward). Estimated
+//! on a log scale like every parameter, they need a non-zero start: from a
+//! rig without feed-forward the fit starts at [`FEED_FORWARD_START`].
+//!
 //! `Fc` and `Tc` are the Coulomb levels of the table and motor friction of the
 //! virtual rig (breakaway level scaled with them); they only act in the
 //! nonlinear model.
@@ -41,6 +46,10 @@ pub enum PhysicalParameter {
     Kp,
     /// Velocity-loop reset rate Ki \[1/s\] (`control.ki`).
     Ki,
+    /// Velocity feed-forward gain kvff \[-\] (`control.kvff`; 1 = full).
+    Kvff,
+    /// Acceleration feed-forward gain kaff \[-\] (`control.kaff`; 1 = full).
+    Kaff,
     /// Current-loop proportional gain Kpi \[V/A\] (`control.kpi`).
     Kpi,
     /// Current-loop reset rate Kii \[1/s\] (`control.kii`).
@@ -70,14 +79,25 @@ pub enum PhysicalParameter {
 }
 
 /// The accepted names, comma separated (for error messages).
-pub const PARAMETER_NAMES: &str = "Kv, Kp, Ki, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc";
+pub const PARAMETER_NAMES: &str =
+    "Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc";
+
+/// The accepted names of the linear model (without the friction levels).
+pub const LINEAR_PARAMETER_NAMES: &str =
+    "Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K";
+
+/// Starting value of a feed-forward gain (`Kvff`, `Kaff`) whose value in the
+/// starting rig is 0 (a log-scale estimate cannot start at 0): 0.5.
+pub const FEED_FORWARD_START: f64 = 0.5;
 
 impl PhysicalParameter {
     /// Every parameter in documentation order.
-    pub const ALL: [PhysicalParameter; 16] = [
+    pub const ALL: [PhysicalParameter; 18] = [
         PhysicalParameter::Kv,
         PhysicalParameter::Kp,
         PhysicalParameter::Ki,
+        PhysicalParameter::Kvff,
+        PhysicalParameter::Kaff,
         PhysicalParameter::Kpi,
         PhysicalParameter::Kii,
         PhysicalParameter::Kt,
@@ -99,6 +119,8 @@ impl PhysicalParameter {
             PhysicalParameter::Kv => "Kv",
             PhysicalParameter::Kp => "Kp",
             PhysicalParameter::Ki => "Ki",
+            PhysicalParameter::Kvff => "Kvff",
+            PhysicalParameter::Kaff => "Kaff",
             PhysicalParameter::Kpi => "Kpi",
             PhysicalParameter::Kii => "Kii",
             PhysicalParameter::Kt => "Kt",
@@ -121,6 +143,7 @@ impl PhysicalParameter {
             PhysicalParameter::Kv | PhysicalParameter::Ki | PhysicalParameter::Kii => "1/s",
             PhysicalParameter::Kp => "A/(m/s)",
             PhysicalParameter::Kpi => "V/A",
+            PhysicalParameter::Kvff | PhysicalParameter::Kaff => "-",
             PhysicalParameter::Kt => "N·m/A",
             PhysicalParameter::Ke => "V·s/rad",
             PhysicalParameter::R => "Ω",
@@ -140,12 +163,20 @@ impl PhysicalParameter {
         matches!(self, PhysicalParameter::Fc | PhysicalParameter::Tc)
     }
 
+    /// True for the feed-forward gains, whose natural value 0 (no
+    /// feed-forward) cannot start a log-scale fit.
+    pub fn is_feed_forward(self) -> bool {
+        matches!(self, PhysicalParameter::Kvff | PhysicalParameter::Kaff)
+    }
+
     /// Current value in `params` / `effects` (SI).
     pub fn get(self, params: &RigParams, effects: &RigEffects) -> f64 {
         match self {
             PhysicalParameter::Kv => params.control.kv,
             PhysicalParameter::Kp => params.control.kp,
             PhysicalParameter::Ki => params.control.ki,
+            PhysicalParameter::Kvff => params.control.kvff,
+            PhysicalParameter::Kaff => params.control.kaff,
             PhysicalParameter::Kpi => params.control.kpi,
             PhysicalParameter::Kii => params.control.kii,
             PhysicalParameter::Kt => params.motor.kt,
@@ -176,6 +207,8 @@ impl PhysicalParameter {
             PhysicalParameter::Kv => params.control.kv = value,
             PhysicalParameter::Kp => params.control.kp = value,
             PhysicalParameter::Ki => params.control.ki = value,
+            PhysicalParameter::Kvff => params.control.kvff = value,
+            PhysicalParameter::Kaff => params.control.kaff = value,
             PhysicalParameter::Kpi => params.control.kpi = value,
             PhysicalParameter::Kii => params.control.kii = value,
             PhysicalParameter::Kt => params.motor.kt = value,
@@ -288,7 +321,11 @@ mod tests {
         for p in PhysicalParameter::ALL {
             let mut params = RigParams::default();
             let mut fx = RigEffects::default();
-            let v = 1.37 * p.get(&params, &fx);
+            let v = if p.is_feed_forward() {
+                0.73
+            } else {
+                1.37 * p.get(&params, &fx)
+            };
             p.set(&mut params, &mut fx, v);
             let back = p.get(&params, &fx);
             assert!((back / v - 1.0).abs() < 1e-14, "{p}: {back} vs {v}");

@@ -166,15 +166,26 @@ pub fn track_greybox_with_progress(
     // reference simulation state
     let mut ref_params = *start;
     let mut ref_effects = cfg.effects;
-    let mut x_ref = vec![0.0; 7];
-    let mut scratch7 = vec![0.0; 7];
+    // the start of the fit (a feed-forward gain of 0 starts at FEED_FORWARD_START)
+    apply(
+        estimate,
+        &base,
+        &vec![0.0; n],
+        &mut ref_params,
+        &mut ref_effects,
+    );
+    // 7 states, 8 with feed-forward (the same for every estimate: the
+    // feed-forward gains stay positive on their log scale)
+    let order = linear_discrete(&ref_params, cfg.position_loop, dt)?.order();
+    let mut x_ref = vec![0.0; order];
+    let mut scratch7 = vec![0.0; order];
     let mut ref_at = 0usize;
     let mut theta = vec![0.0; n];
     let mut rows = Vec::new();
     let mut lm = LevenbergMarquardt::new(w, n);
     let mut jac = vec![0.0; w * n];
     let mut r = vec![0.0; w];
-    let mut x = vec![0.0; 7];
+    let mut x = vec![0.0; order];
 
     let mut s = 0usize;
     let total = if len >= w {
@@ -205,11 +216,11 @@ pub fn track_greybox_with_progress(
                 return;
             };
             x.copy_from_slice(&x_start);
-            let mut sc = [0.0; 7];
+            let mut sc = [0.0; 8];
             let mut ok = true;
             for k in b..s + w {
                 if k >= s {
-                    out[k - s] = u0 + sys.output(&x, 0.0) - position[k];
+                    out[k - s] = u0 + sys.output(&x, command[k] - u0) - position[k];
                 }
                 if sys.advance(&mut x, command[k] - u0, &mut sc).is_err() {
                     ok = false;

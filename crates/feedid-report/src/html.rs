@@ -105,6 +105,9 @@ pub struct Section {
     pub blocks: Vec<Block>,
     /// Nested sections.
     pub subsections: Vec<Section>,
+    /// Shown folded (an HTML `<details>` element: the heading stays visible,
+    /// the content is one click away, no script); default false.
+    pub folded: bool,
 }
 
 impl Section {
@@ -115,7 +118,14 @@ impl Section {
             title: title.to_string(),
             blocks: Vec::new(),
             subsections: Vec::new(),
+            folded: false,
         }
+    }
+
+    /// The same section shown folded (see [`Section::folded`]).
+    pub fn fold(mut self) -> Self {
+        self.folded = true;
+        self
     }
 
     /// The same section with one more block.
@@ -177,6 +187,7 @@ figure svg { display: block; width: 100%; height: auto; max-width: 100%; border:
 figcaption { font-size: 13.5px; color: #333; margin-top: 6px; }
 figcaption b { color: var(--ink); }
 .grid { display: grid; grid-template-columns: 1fr 1fr; gap: 0 20px; }
+details > summary { cursor: pointer; color: var(--accent); margin: 0.5em 0; }
 table { border-collapse: collapse; margin: 8px 0 18px; font-size: 14px; font-variant-numeric: tabular-nums; break-inside: avoid; }
 caption { text-align: left; color: var(--muted); font-size: 13.5px; padding-bottom: 4px; }
 th, td { padding: 4px 10px; border-bottom: 1px solid var(--rule); }
@@ -309,6 +320,13 @@ fn toc_entry(h: &mut String, s: &Section, number: &dyn Fn(&str) -> usize) {
         escape_html(&s.id),
         escape_html(&s.title)
     );
+    if s.folded {
+        // folded: one line, the figures are one click away in the section
+        let mut figs = Vec::new();
+        s.figures(&mut figs);
+        let _ = writeln!(h, " (folded, {} figures)</li>", figs.len());
+        return;
+    }
     let mut own = Vec::new();
     for b in &s.blocks {
         match b {
@@ -356,6 +374,17 @@ fn write_section(h: &mut String, s: &Section, level: usize, number: &dyn Fn(&str
         escape_html(&s.id),
         escape_html(&s.title)
     );
+    if s.folded {
+        let mut figs = Vec::new();
+        s.figures(&mut figs);
+        let _ = writeln!(
+            h,
+            "<details><summary>{} — {} figure{}, click to show</summary>",
+            escape_html(&s.title),
+            figs.len(),
+            if figs.len() == 1 { "" } else { "s" }
+        );
+    }
     for b in &s.blocks {
         match b {
             Block::Paragraph(p) => {
@@ -414,6 +443,9 @@ fn write_section(h: &mut String, s: &Section, level: usize, number: &dyn Fn(&str
     }
     for sub in &s.subsections {
         write_section(h, sub, level + 1, number);
+    }
+    if s.folded {
+        h.push_str("</details>\n");
     }
     h.push_str("</section>\n");
 }

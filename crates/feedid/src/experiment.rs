@@ -404,6 +404,26 @@ fn paper_side_by_side(s: &mut String, results: &[ExperimentResult], cfg: &PaperE
         z = 1e3 * cfg.zoom,
         solver = cfg.solver.label()
     );
+    if let Some(v) = paper_verdict(results, cfg) {
+        let _ = writeln!(s, "{v}");
+    }
+}
+
+/// The plain verdict on the paper's question for the ramp: is the paper's
+/// identified model nearer the measurement than the nominal simulation
+/// model, over the whole move and once settled? `None` without a ramp or
+/// without predicted samples (no verdict over nothing).
+pub fn paper_verdict(results: &[ExperimentResult], cfg: &PaperExperimentConfig) -> Option<String> {
+    let ramp = results.iter().find(|r| r.name == "ramp")?;
+    let lsm = match cfg.solver {
+        Solver::Qr => &ramp.qr,
+        Solver::Simplex => &ramp.simplex,
+    };
+    let sim = &ramp.simulation;
+    if lsm.whole.samples == 0 || sim.whole.samples == 0 {
+        return None;
+    }
+    let um = |v: f64| format!("{:.1}", 1e6 * v);
     let whole = lsm.whole.rms < sim.whole.rms;
     let after = lsm.after.samples > 0 && lsm.after.rms < sim.after.rms;
     let axis = match cfg.axis {
@@ -416,8 +436,7 @@ fn paper_side_by_side(s: &mut String, results: &[ExperimentResult], cfg: &PaperE
             "the measured axis is off the nominal model as a real axis is off its data sheet"
         }
     };
-    let _ = writeln!(
-        s,
+    Some(format!(
         "Verdict ({axis}): over the whole ramp the paper's identified model is {} than \
          the simulation model ({} vs {} µm rms){}; once the motion has settled (after \
          {z:.0} ms) it is {} ({} vs {} µm rms). The paper's finding — the identified model \
@@ -439,7 +458,7 @@ fn paper_side_by_side(s: &mut String, results: &[ExperimentResult], cfg: &PaperE
             (false, false) => "does not hold here",
         },
         z = 1e3 * cfg.zoom
-    );
+    ))
 }
 
 #[cfg(test)]

@@ -285,14 +285,16 @@ impl RecordingAnalysis {
 
     /// The report's sections for this recording; element ids start with `prefix`.
     pub fn sections(&self, prefix: &str) -> Result<Vec<Section>> {
+        // the answer first (summary table and verdict), then the figures
+        // that show it; the diagnostics one click away
         Ok(vec![
+            self.summary_section(prefix),
             self.overview_section(prefix)?,
             self.response_section(prefix)?,
             self.error_section(prefix)?,
-            self.coefficient_section(prefix)?,
-            self.residual_section(prefix)?,
-            self.bode_section(prefix)?,
-            self.summary_section(prefix),
+            self.coefficient_section(prefix)?.fold(),
+            self.residual_section(prefix)?.fold(),
+            self.bode_section(prefix)?.fold(),
         ])
     }
 

@@ -201,6 +201,56 @@ impl RecordingAnalysis {
         Ok(sec)
     }
 
+    /// The answer in one paragraph: which method predicts best, its error
+    /// and coverage, the simulation model beside it, and what to look at.
+    /// "Best" is the lowest rms among the methods that predict at least
+    /// 95 % of the largest coverage any method reaches (an rms over fewer
+    /// samples is not comparable).
+    pub(super) fn verdict(&self) -> String {
+        let n = self.recording.len().max(1);
+        let cov =
+            |m: &super::MethodRun| m.identification.summary().samples_predicted as f64 / n as f64;
+        let max_cov = self.runs.iter().map(cov).fold(0.0f64, f64::max);
+        let best = self
+            .runs
+            .iter()
+            .filter(|m| cov(m) >= 0.95 * max_cov && max_cov > 0.0)
+            .filter_map(|m| {
+                let s = m.identification.summary();
+                s.rms_error_m.filter(|r| r.is_finite()).map(|r| (m, r, s))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        let sim = if self.simulation_stats.samples > 0 && self.simulation_stats.rms.is_finite() {
+            format!(
+                " The nominal simulation model is off by {:.3} µm rms over all {} samples.",
+                1e6 * self.simulation_stats.rms,
+                self.simulation_stats.samples
+            )
+        } else {
+            String::new()
+        };
+        match best {
+            Some((m, rms, s)) => format!(
+                "Answer: {} predicts best here, {} samples ({:.1} ms) ahead: rms {:.3} µm, max {:.3} µm \
+                 over {} of {} samples ({:.1} %).{sim} Look first at the prediction error per method \
+                 below; coefficients, residual correlations and frequency responses are folded \
+                 further down (one click).",
+                m.label,
+                s.horizon,
+                1e3 * s.horizon as f64 / s.rate_hz,
+                1e6 * rms,
+                1e6 * s.max_abs_error_m.unwrap_or(f64::NAN),
+                s.samples_predicted,
+                n,
+                100.0 * cov(m),
+            ),
+            None => format!(
+                "Answer: no method predicted any sample of this recording, so no prediction error \
+                 is reported.{sim}"
+            ),
+        }
+    }
+
     pub(super) fn summary_section(&self, p: &str) -> Section {
         let um = |v: f64| {
             if v.is_finite() {
@@ -273,8 +323,9 @@ impl RecordingAnalysis {
             ],
             rows,
         };
-        let mut sec =
-            Section::new(&format!("{p}-summary-sec"), "Summary").with(Block::Table(table));
+        let mut sec = Section::new(&format!("{p}-summary-sec"), "Summary")
+            .with(Block::Paragraph(self.verdict()))
+            .with(Block::Table(table));
         if !self.global.is_empty() {
             sec.blocks.push(Block::Table(Table {
                 id: format!("{p}-global"),

@@ -102,7 +102,7 @@ fn report_has_every_section_and_figure_and_no_external_reference() {
 fn summary_table_numbers_match_the_runs() {
     let a = RecordingAnalysis::run("r", ramp(), &opts()).unwrap();
     let sec = a.summary_section("x");
-    let Block::Table(t) = &sec.blocks[0] else {
+    let Block::Table(t) = &sec.blocks[1] else {
         panic!("table expected")
     };
     assert_eq!(t.rows.len(), 3);
@@ -134,4 +134,49 @@ fn phase_unwrapping_removes_jumps() {
     for (k, v) in p.iter().enumerate() {
         assert!((v + (0.2 * k as f64).to_degrees()).abs() < 1e-9, "{k}: {v}");
     }
+}
+
+#[test]
+fn report_opens_with_the_answer_and_folds_the_diagnostics() {
+    let a = RecordingAnalysis::run("ramp.csv", ramp(), &opts()).unwrap();
+    let secs = a.sections("rec").unwrap();
+    // the summary (answer) comes first, with the verdict before its table
+    assert_eq!(secs[0].id, "rec-summary-sec");
+    let Block::Paragraph(verdict) = &secs[0].blocks[0] else {
+        panic!(
+            "the summary opens with a paragraph: {:?}",
+            secs[0].blocks[0]
+        );
+    };
+    assert!(verdict.starts_with("Answer: "), "{verdict}");
+    // the best method named is the one with the lowest rms among those with
+    // (nearly) full coverage; its rms is the summary's
+    let n = a.recording.len() as f64;
+    let cov = |m: &MethodRun| m.identification.summary().samples_predicted as f64 / n;
+    let max_cov = a.runs.iter().map(cov).fold(0.0, f64::max);
+    let best = a
+        .runs
+        .iter()
+        .filter(|m| cov(m) >= 0.95 * max_cov)
+        .min_by(|x, y| {
+            let r = |m: &MethodRun| m.identification.summary().rms_error_m.unwrap();
+            r(x).total_cmp(&r(y))
+        })
+        .unwrap();
+    let rms = best.identification.summary().rms_error_m.unwrap();
+    assert!(
+        verdict.contains(&format!("{} predicts best", best.label))
+            && verdict.contains(&format!("rms {:.3} µm", 1e6 * rms)),
+        "{verdict}"
+    );
+    // the diagnostics are folded, the figures that answer are not
+    for s in &secs {
+        let diagnostic = s.id.contains("coef") || s.id.contains("resid") || s.id.contains("bode");
+        assert_eq!(s.folded, diagnostic, "{}", s.id);
+    }
+    let html = recording_report(&a).unwrap().to_html();
+    assert!(html.contains("<details><summary>"));
+    let answer = html.find("Answer: ").unwrap();
+    let first_figure = html.find("<figure").unwrap();
+    assert!(answer < first_figure);
 }

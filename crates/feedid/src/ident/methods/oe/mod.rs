@@ -4,5 +4,6 @@
 mod companion;
 mod estimator;
 mod srivc;
+mod window;
 
 pub use estimator::{fit_oe, OeConfig, OeEstimator, OeFit, OeJacobian};

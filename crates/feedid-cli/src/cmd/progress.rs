@@ -20,12 +20,58 @@ impl ProgressBar {
             };
         }
         let bar = indicatif::ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
-        if let Ok(style) = ProgressStyle::with_template(&format!(
-            "{label} [{{bar:40.cyan/blue}}] {{pos}}/{{len}} {unit}, {{elapsed}} (eta {{eta}})"
-        )) {
-            bar.set_style(style.progress_chars("=> "));
+        let this = Self { bar };
+        this.phase(label, unit);
+        this
+    }
+
+    /// A bar that never shows (e.g. for runs in parallel).
+    pub fn hidden() -> Self {
+        Self {
+            bar: indicatif::ProgressBar::hidden(),
         }
-        Self { bar }
+    }
+
+    /// Start a new phase `label` counting `unit`s from zero (`"bytes"`
+    /// shows sizes: `1.2 GiB/2.0 GiB`).
+    pub fn phase(&self, label: &str, unit: &str) {
+        if self.bar.is_hidden() {
+            return;
+        }
+        self.bar.disable_steady_tick();
+        self.bar.reset();
+        let counts = if unit == "bytes" {
+            "{bytes}/{total_bytes}".to_string()
+        } else {
+            format!("{{pos}}/{{len}} {unit}")
+        };
+        if let Ok(style) = ProgressStyle::with_template(&format!(
+            "{label} [{{bar:40.cyan/blue}}] {counts}, {{elapsed}} (eta {{eta}})"
+        )) {
+            self.bar.set_style(style.progress_chars("=> "));
+        }
+    }
+
+    /// Start a phase `label` whose length is not known: a spinner with the
+    /// elapsed time (and the bytes so far, see [`ProgressBar::set_bytes`]).
+    pub fn spin(&self, label: &str, bytes: bool) {
+        if self.bar.is_hidden() {
+            return;
+        }
+        self.bar.reset();
+        let counts = if bytes { " {bytes}," } else { "" };
+        if let Ok(style) =
+            ProgressStyle::with_template(&format!("{label} {{spinner}}{counts} {{elapsed}}"))
+        {
+            self.bar.set_style(style);
+        }
+        self.bar
+            .enable_steady_tick(std::time::Duration::from_millis(120));
+    }
+
+    /// The bytes written so far in a [`ProgressBar::spin`] phase.
+    pub fn set_bytes(&self, bytes: u64) {
+        self.bar.set_position(bytes);
     }
 
     /// Report `done` of `total` (the library's callback).

@@ -30,22 +30,37 @@ pub fn write_predictions_csv(
 ) -> std::io::Result<()> {
     writeln!(w, "time_s,command_m,measured_m,predicted_m,simulated_m")?;
     let at = |v: &[f64], k: usize| v.get(k).copied();
+    // one row formatted into a reused buffer, then written whole (no
+    // allocation per cell: 18 M rows for an hour at 5 kHz)
+    let mut row = String::with_capacity(128);
     for (k, t) in time.iter().enumerate() {
         let p = match has_prediction.get(k) {
             Some(true) => at(predicted, k),
             _ => None,
         };
-        writeln!(
-            w,
-            "{},{},{},{},{}",
-            cell(Some(*t)),
-            cell(at(command, k)),
-            cell(at(measured, k)),
-            cell(p),
-            cell(simulated.and_then(|s| at(s, k))),
-        )?;
+        row.clear();
+        push_cell(&mut row, Some(*t));
+        row.push(',');
+        push_cell(&mut row, at(command, k));
+        row.push(',');
+        push_cell(&mut row, at(measured, k));
+        row.push(',');
+        push_cell(&mut row, p);
+        row.push(',');
+        push_cell(&mut row, simulated.and_then(|s| at(s, k)));
+        row.push('\n');
+        w.write_all(row.as_bytes())?;
     }
     Ok(())
+}
+
+/// Append [`cell`]`(v)` to `out` without allocating.
+fn push_cell(out: &mut String, v: Option<f64>) {
+    use std::fmt::Write as _;
+    if let Some(x) = v.filter(|x| x.is_finite()) {
+        // writing to a String cannot fail
+        let _ = write!(out, "{x}");
+    }
 }
 
 /// One window's row of the coefficients table.
@@ -131,6 +146,31 @@ mod tests {
             String::from_utf8(out).unwrap(),
             "time_s,command_m,measured_m,predicted_m,simulated_m\n0,1,1,,1\n0.5,2,2,2.5,\n1,3,3,,3\n"
         );
+    }
+
+    #[test]
+    fn predictions_rows_are_the_cells_of_the_row_by_row_format() {
+        // the buffered writer gives exactly `cell` joined by commas
+        let vals = [0.1, -2.5e-7, 1e300, 3.0, f64::NAN, 1.0 / 3.0, -0.0, 5e-324];
+        let n = vals.len();
+        let rot = |s: usize| -> Vec<f64> { (0..n).map(|k| vals[(k + s) % n]).collect() };
+        let (t, u, y, p, sim) = (rot(0), rot(1), rot(2), rot(3), rot(4));
+        let has: Vec<bool> = (0..n).map(|k| k % 3 != 0).collect();
+        let mut out = Vec::new();
+        write_predictions_csv(&mut out, &t, &u, &y, &p, &has, Some(&sim)).unwrap();
+        let mut expect = String::from("time_s,command_m,measured_m,predicted_m,simulated_m\n");
+        for k in 0..n {
+            let pk = if has[k] { Some(p[k]) } else { None };
+            expect.push_str(&format!(
+                "{},{},{},{},{}\n",
+                cell(Some(t[k])),
+                cell(Some(u[k])),
+                cell(Some(y[k])),
+                cell(pk),
+                cell(Some(sim[k]))
+            ));
+        }
+        assert_eq!(String::from_utf8(out).unwrap(), expect);
     }
 
     #[test]

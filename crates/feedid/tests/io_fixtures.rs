@@ -386,7 +386,7 @@ fn emps_benchmark_reads_with_plausible_ranges() {
     assert!((r.rate_hz() - 1000.0).abs() < 0.05, "{}", r.rate_hz());
     assert!((r.duration() - 24.84).abs() < 1e-9);
     assert_eq!(r.extra().len(), 1); // vir
-    // the columnar read of `feedid identify`: the same signals, no `vir`
+                                    // the columnar read of `feedid identify`: the same signals, no `vir`
     let only = read_recording(
         &path,
         &ReadOptions {

@@ -172,7 +172,13 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
                         summary: Some(dir.join(format!("{stem}.summary.json"))),
                         model: None,
                     };
-                    identify_file(input, &a.recording, &pipeline, &paths, &ProgressBar::hidden())
+                    identify_file(
+                        input,
+                        &a.recording,
+                        &pipeline,
+                        &paths,
+                        &ProgressBar::hidden(),
+                    )
                 })
                 .collect();
             let mut failed = 0;

@@ -422,7 +422,8 @@ mod tests {
         let mut part = s.clone();
         (part.samples, part.global_model_samples) = (1000, Some(250));
         assert!(
-            part.to_string().contains("on the first 250 samples (25.0 %)"),
+            part.to_string()
+                .contains("on the first 250 samples (25.0 %)"),
             "{part}"
         );
     }

@@ -425,10 +425,7 @@ mod tests {
         let capped = fit_global_model(&long, &kind).unwrap();
         let head = fit_one(&long.head(GLOBAL_FIT_SAMPLES).unwrap(), &kind).unwrap();
         assert_eq!(capped, head);
-        assert_eq!(
-            capped.identified_by.unwrap().samples,
-            GLOBAL_FIT_SAMPLES
-        );
+        assert_eq!(capped.identified_by.unwrap().samples, GLOBAL_FIT_SAMPLES);
     }
 
     #[test]

@@ -9,19 +9,23 @@ use indicatif::{ProgressDrawTarget, ProgressStyle};
 /// A bar labelled `label`, counting `unit`s (hidden when standard error is not a terminal).
 pub struct ProgressBar {
     bar: indicatif::ProgressBar,
+    /// False when standard error is not a terminal.
+    shown: bool,
 }
 
 impl ProgressBar {
     /// A new bar, e.g. `ProgressBar::new("identify", "samples")`.
     pub fn new(label: &str, unit: &str) -> Self {
         if !std::io::stderr().is_terminal() {
-            return Self {
-                bar: indicatif::ProgressBar::hidden(),
-            };
+            return Self::hidden();
         }
-        let bar = indicatif::ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
-        let this = Self { bar };
+        // styled before it is drawn: no frame in the default style
+        let this = Self {
+            bar: indicatif::ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden()),
+            shown: true,
+        };
         this.phase(label, unit);
+        this.bar.set_draw_target(ProgressDrawTarget::stderr());
         this
     }
 
@@ -29,13 +33,14 @@ impl ProgressBar {
     pub fn hidden() -> Self {
         Self {
             bar: indicatif::ProgressBar::hidden(),
+            shown: false,
         }
     }
 
     /// Start a new phase `label` counting `unit`s from zero (`"bytes"`
     /// shows sizes: `1.2 GiB/2.0 GiB`).
     pub fn phase(&self, label: &str, unit: &str) {
-        if self.bar.is_hidden() {
+        if !self.shown {
             return;
         }
         self.bar.disable_steady_tick();
@@ -55,7 +60,7 @@ impl ProgressBar {
     /// Start a phase `label` whose length is not known: a spinner with the
     /// elapsed time (and the bytes so far, see [`ProgressBar::set_bytes`]).
     pub fn spin(&self, label: &str, bytes: bool) {
-        if self.bar.is_hidden() {
+        if !self.shown {
             return;
         }
         self.bar.reset();

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Side-by-side: the paper method as a user would write it in Python vs feedid.
 
-    python3 bench/compare_python.py [--scenarios ramp,step] [--simplex-windows 100]
+    python3 bench/compare_python.py [--scenarios ramp,step] [--simplex-windows 100] [--arx chirp]
 
 What it does, in one run (so the ratio holds on a noisy machine):
 
@@ -27,7 +27,15 @@ What it does, in one run (so the ratio holds on a noisy machine):
    for the predictions and timed from outside (process start and CSV I/O
    included: an upper bound).
 5. Checks the QR predictions agree within 1e-6 of the position range and
-   prints per-window times and ratios.
+   prints per-window times and ratios; feedid's simplex both from the
+   paper's zeros (default) and with `--simplex-start previous`.
+6. ARX 8,8,1 (issue 19), W = 200, H = 10, hop 10, on the chirp: a NumPy
+   refit per window (`numpy.linalg.lstsq` on [-y lags, u lags, 1], then
+   the 10-step prediction driven by the measured command) against
+   `feedid identify --method arx --window 200 --horizon 10` (its own ridge,
+   scaling, offset and checks, so the predictions are compared by their
+   rms error against the measured position over the same samples, not to
+   each other).
 
 Not part of CI. Exit code 1 if a QR comparison fails.
 """
@@ -177,6 +185,43 @@ def python_fmin(np, fmin, t, u, y, max_windows):
     return pred, elapsed, count
 
 
+ARX_NA, ARX_NB, ARX_NK, ARX_W = 8, 8, 1, 200
+
+
+def python_arx(np, u, y):
+    """ARX refit per window with numpy.linalg.lstsq; (predictions, seconds, windows)."""
+    na, nb, nk, w = ARX_NA, ARX_NB, ARX_NK, ARX_W
+    lag = max(na, nb + nk - 1)
+    n = len(y)
+    pred = np.full(n, np.nan)
+    count = 0
+    t0 = time.perf_counter()
+    s = lag
+    while s + w + H <= n:
+        e = s + w
+        k = np.arange(s, e)
+        cols = [-y[k - i] for i in range(1, na + 1)]
+        cols += [u[k - nk - j] for j in range(nb)]
+        cols.append(np.ones(w))
+        theta, *_ = np.linalg.lstsq(np.column_stack(cols), y[s:e], rcond=None)
+        a, b, c = theta[:na], theta[na:na + nb], theta[-1]
+        yy = list(y[e - na:e])  # the past outputs, the predictions appended
+        for j in range(H):
+            kk = e + j
+            v = c - sum(a[i] * yy[-1 - i] for i in range(na))
+            v += sum(b[i] * u[kk - nk - i] for i in range(nb))
+            yy.append(v)
+            pred[kk] = v
+        count += 1
+        s += H
+    return pred, time.perf_counter() - t0, count
+
+
+def rms_error(np, pred, y, mask):
+    d = pred[mask] - y[mask]
+    return float(np.sqrt(np.mean(d * d))) if d.size else float("nan")
+
+
 def read_predictions(np, path):
     """predicted_m per sample (NaN where empty) from feedid identify's predictions.csv."""
     with open(path) as f:
@@ -189,13 +234,28 @@ def read_predictions(np, path):
     return np.array(out)
 
 
-def feedid_predictions(np, feedid, rec, solver, workdir, n):
+def feedid_identify(np, feedid, rec, label, workdir, options):
+    """(predictions, µs per window) from `feedid identify REC OPTIONS`."""
+    pred_csv = workdir / f"pred_{rec.stem}_{label}.csv"
+    summary = workdir / f"summary_{rec.stem}_{label}.json"
+    r = subprocess.run([str(feedid), "identify", str(rec)] + options + ["-o", str(pred_csv), "--summary",
+                       str(summary)], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise SystemExit(f"feedid identify {' '.join(options)} failed: {r.stderr.strip()}")
+    with open(summary) as f:
+        us = float(json.load(f)["per_window_us"])
+    return read_predictions(np, pred_csv), us
+
+
+def feedid_predictions(np, feedid, rec, solver, workdir, n, start="zeros"):
     """(predictions, µs per window, how) from `feedid identify`, else from `feedid stream`."""
-    pred_csv = workdir / f"pred_{solver}.csv"
-    summary = workdir / f"summary_{solver}.json"
+    label = f"{solver}_{start}"
+    pred_csv = workdir / f"pred_{rec.stem}_{label}.csv"
+    summary = workdir / f"summary_{rec.stem}_{label}.json"
+    extra = ["--simplex-start", start] if solver == "simplex" else []
     r = subprocess.run([str(feedid), "identify", str(rec), "--method", "paper", "--solver", solver,
                         "--window", str(W), "--horizon", str(H), "-o", str(pred_csv),
-                        "--summary", str(summary)], capture_output=True, text=True)
+                        "--summary", str(summary)] + extra, capture_output=True, text=True)
     if r.returncode == 0 and pred_csv.exists() and summary.exists():
         with open(summary) as f:
             us = float(json.load(f)["per_window_us"])
@@ -232,6 +292,8 @@ def main():
     ap.add_argument("--scenarios", default="ramp,step")
     ap.add_argument("--simplex-windows", type=int, default=100,
                     help="moving windows timed with scipy's fmin (it is slow)")
+    ap.add_argument("--arx", default="chirp",
+                    help="recordings for the ARX comparison (scenarios; empty: none)")
     ap.add_argument("--feedid", help="feedid binary (default: cargo build --release)")
     ap.add_argument("--profile", default="release", help="cargo profile to build with")
     ap.add_argument("--keep", help="directory for recordings and outputs (default: temporary)")
@@ -254,10 +316,12 @@ def main():
         py_nm, py_nm_s, nwin_nm = python_fmin(np, fmin, t, u, y, args.simplex_windows)
         fq, fq_us, how_q = feedid_predictions(np, feedid, rec, "qr", workdir, n)
         fs, fs_us, how_s = feedid_predictions(np, feedid, rec, "simplex", workdir, n)
+        fp, fp_us, _ = feedid_predictions(np, feedid, rec, "simplex", workdir, n, "previous")
         err_qr, m_qr = compare(np, py_qr, fq, y)
         # the simplex subset: compare where Python's fmin predicted
         sub = ~np.isnan(py_nm)
         err_nm, _ = compare(np, np.where(sub, py_nm, np.nan), np.where(sub, fs, np.nan), y)
+        err_prev, _ = compare(np, np.where(sub, py_nm, np.nan), np.where(sub, fp, np.nan), y)
         ok &= err_qr <= 1e-6
         rows.append({
             "recording": f"{scenario} ({n} samples, {source})",
@@ -266,21 +330,55 @@ def main():
             "feedid_qr_us": fq_us,
             "py_fmin_us": 1e6 * py_nm_s / max(nwin_nm, 1),
             "feedid_simplex_us": fs_us,
+            "feedid_previous_us": fp_us,
+            "err_prev": err_prev,
             "err_qr": err_qr,
             "err_nm": err_nm,
             "how": how_q if how_q == how_s else f"{how_q}/{how_s}",
             "compared": m_qr,
         })
+    arx_rows = []
+    for scenario in [a for a in args.arx.split(",") if a]:
+        rec = workdir / f"{scenario}.csv"
+        source = make_recording(feedid, scenario, rec, args.profile)
+        t, u, y = read_recording(np, rec)
+        py, py_s, nwin = python_arx(np, u, y)
+        fa, fa_us = feedid_identify(np, feedid, rec, "arx", workdir,
+                                    ["--method", "arx", "--window", str(ARX_W), "--horizon", str(H)])
+        both = ~np.isnan(py) & ~np.isnan(fa)
+        arx_rows.append({
+            "recording": f"{scenario} ({len(t)} samples, {source})",
+            "windows": nwin,
+            "py_us": 1e6 * py_s / nwin,
+            "feedid_us": fa_us,
+            "rms_py": rms_error(np, py, y, both),
+            "rms_feedid": rms_error(np, fa, y, both),
+            "compared": int(both.sum()),
+        })
+    print()
+    print("Paper method, W = 20, H = hop = 10:")
     print()
     print("| recording | windows | NumPy lstsq µs/window | feedid QR µs/window | ratio "
-          "| SciPy fmin µs/window | feedid simplex µs/window | ratio | max QR diff / range "
-          "| max simplex diff / range |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "| SciPy fmin µs/window | feedid simplex µs/window | ratio | feedid simplex (previous) µs/window "
+          "| ratio | max QR diff / range | max simplex diff / range (zeros, previous) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r['recording']} | {r['windows']} | {r['py_lstsq_us']:.1f} | {r['feedid_qr_us']:.2f} "
               f"| {r['py_lstsq_us'] / r['feedid_qr_us']:.0f}× | {r['py_fmin_us']:.0f} "
               f"| {r['feedid_simplex_us']:.1f} | {r['py_fmin_us'] / r['feedid_simplex_us']:.0f}× "
-              f"| {r['err_qr']:.1e} | {r['err_nm']:.1e} |")
+              f"| {r['feedid_previous_us']:.1f} | {r['py_fmin_us'] / r['feedid_previous_us']:.0f}× "
+              f"| {r['err_qr']:.1e} | {r['err_nm']:.1e}, {r['err_prev']:.1e} |")
+    if arx_rows:
+        print()
+        print(f"ARX {ARX_NA},{ARX_NB},{ARX_NK}, W = {ARX_W}, H = hop = {H}:")
+        print()
+        print("| recording | windows | NumPy lstsq refit µs/window | feedid arx µs/window | ratio "
+              "| rms error NumPy [µm] | rms error feedid [µm] | samples compared |")
+        print("|---|---|---|---|---|---|---|---|")
+        for r in arx_rows:
+            print(f"| {r['recording']} | {r['windows']} | {r['py_us']:.1f} | {r['feedid_us']:.2f} "
+                  f"| {r['py_us'] / r['feedid_us']:.0f}× | {1e6 * r['rms_py']:.4f} "
+                  f"| {1e6 * r['rms_feedid']:.4f} | {r['compared']} |")
     print()
     print(f"feedid timing from: {rows[0]['how'] if rows else '-'}; "
           f"fmin timed on the first {args.simplex_windows} moving windows; outputs in {workdir}")

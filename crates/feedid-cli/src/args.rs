@@ -166,6 +166,9 @@ pub struct MethodOptions {
     /// paper: prediction, polynomial (fitted output continued) or tf (identified Tf on the next command) [default: polynomial].
     #[arg(long, value_name = "NAME")]
     pub prediction: Option<String>,
+    /// paper with --solver simplex: start of each window's simplex, zeros (every window on its own, the default) or previous (the previous window's fit: fewer iterations, about 2.5× faster) [default: zeros].
+    #[arg(long, value_name = "NAME")]
+    pub simplex_start: Option<String>,
     /// arx, rls, auto (its long-memory candidate): ARX orders `na,nb,nk`
     /// (poles, input terms, input delay in samples), or `auto` (chosen from
     /// the recording by BIC; identify only) [default: 8,8,1].

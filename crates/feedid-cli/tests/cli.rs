@@ -265,29 +265,51 @@ fn identify_simplex_agrees_with_qr_on_the_ramp() {
     let dir = tempfile::tempdir().unwrap();
     let input = simulated(dir.path(), "ramp");
     let mut preds = Vec::new();
-    for solver in ["qr", "simplex"] {
-        let out = dir.path().join(format!("{solver}.csv"));
-        let o = feedid(&[
-            "identify",
-            input.to_str().unwrap(),
-            "--method",
-            "paper",
-            "--solver",
-            solver,
-            "-o",
-            out.to_str().unwrap(),
-        ]);
+    for (name, extra) in [
+        ("qr", vec!["--solver", "qr"]),
+        ("simplex", vec!["--solver", "simplex"]),
+        (
+            "previous",
+            vec!["--solver", "simplex", "--simplex-start", "previous"],
+        ),
+    ] {
+        let out = dir.path().join(format!("{name}.csv"));
+        let mut args = vec!["identify", input.to_str().unwrap(), "--method", "paper"];
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = feedid(&args);
         assert!(o.status.success(), "{}", stderr(&o));
         let (h, rows) = read_csv(&out);
         preds.push(column(&h, &rows, "predicted_m"));
     }
-    let worst = preds[0]
-        .iter()
-        .zip(&preds[1])
-        .filter_map(|(a, b)| Some((a.as_ref()? - b.as_ref()?).abs()))
-        .fold(0.0, f64::max);
-    // same least-squares problems; the simplex stops within its tolerances
-    assert!(worst < 1e-6 * 0.03, "{worst}");
+    for other in &preds[1..] {
+        let worst = preds[0]
+            .iter()
+            .zip(other)
+            .filter_map(|(a, b)| Some((a.as_ref()? - b.as_ref()?).abs()))
+            .fold(0.0, f64::max);
+        // same least-squares problems; the simplex stops within its tolerances
+        assert!(worst < 1e-6 * 0.03, "{worst}");
+    }
+    // the simplex start needs the simplex
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--method",
+        "paper",
+        "--simplex-start",
+        "previous",
+    ]);
+    assert_fails(&o, "simplex");
+    let o = feedid(&[
+        "identify",
+        input.to_str().unwrap(),
+        "--method",
+        "arx",
+        "--simplex-start",
+        "previous",
+    ]);
+    assert_fails(&o, "--simplex-start");
 }
 
 #[test]

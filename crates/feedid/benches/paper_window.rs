@@ -1,10 +1,12 @@
 //! Benchmark: the paper method per window (fit + prediction of H = 10
 //! samples) at W = 20, QR and simplex, on windows of the virtual rig's ramp
-//! (every effect on) in motion. Targets: QR ≤ 2 µs, simplex ≤ 50 µs per window.
+//! (every effect on) in motion, consecutive windows (hop 10). Targets
+//! (issue 19): QR ≤ 1 µs, simplex ≤ 50 µs per window; the simplex from the
+//! paper's zeros (default) and from the previous window's coefficients.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use feedid::drive::{RigParams, VirtualRig};
-use feedid::ident::{Estimator, PaperConfig, Signals, Solver};
+use feedid::ident::{Estimator, PaperConfig, Signals, SimplexStart, Solver};
 use feedid::signal::Scenario;
 use feedid::Recording;
 
@@ -22,9 +24,14 @@ fn per_window(c: &mut Criterion) {
     let (w, h) = (20, 10);
     // windows in motion, 10 ms … 780 ms, hop 10
     let starts: Vec<usize> = (50..rec.len() - w - h).step_by(10).collect();
-    for solver in [Solver::Qr, Solver::Simplex] {
+    for (solver, start, name) in [
+        (Solver::Qr, SimplexStart::Zeros, "qr"),
+        (Solver::Simplex, SimplexStart::Zeros, "simplex"),
+        (Solver::Simplex, SimplexStart::Previous, "simplex_previous"),
+    ] {
         let mut m = PaperConfig {
             solver,
+            simplex_start: start,
             ..PaperConfig::default()
         }
         .build()
@@ -32,7 +39,7 @@ fn per_window(c: &mut Criterion) {
         let mut coef = [0.0; 11];
         let mut pred = [0.0; 10];
         let mut i = 0;
-        c.bench_function(&format!("paper_{}_per_window_w20", solver.label()), |b| {
+        c.bench_function(&format!("paper_{name}_per_window_w20"), |b| {
             b.iter(|| {
                 let s = starts[i % starts.len()];
                 i += 1;

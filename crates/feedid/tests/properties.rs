@@ -113,6 +113,7 @@ fn sliding_arx_regressions_found_by_the_property() {
         (409619, 1, 2, 0, 30, 1, 1e-8),
         (145067, 4, 1, 2, 35, 1, 1e-8),
         (101477, 4, 1, 2, 37, 5, 1e-8),
+        (288661, 4, 1, 2, 45, 4, 1e-8),
     ] {
         let r = sliding_vs_fresh(seed, ArxOrders::new(na, nb, nk), window, hop, ridge);
         assert!(r.is_ok(), "seed {seed}: {}", r.unwrap_err());

@@ -54,6 +54,13 @@ impl MethodOptions {
                 _ => missing.push("--prediction"),
             }
         }
+        if let Some(s) = &self.simplex_start {
+            let v = s.parse()?;
+            match method {
+                Method::Paper(c) => c.simplex_start = v,
+                _ => missing.push("--simplex-start"),
+            }
+        }
         match self.order_option()? {
             Some(OrderOption::Orders(o)) => match method.set_orders(o) {
                 Ok(()) => {}
@@ -132,6 +139,7 @@ impl MethodOptions {
 fn applies_to(flag: &str) -> &'static str {
     match flag {
         "--solver" | "--time-origin" | "--prediction" => "paper",
+        "--simplex-start" => "paper (with --solver simplex)",
         "--order" => "arx, rls, auto",
         "--lambda" => "rls",
         "--tolerance" => "auto",
@@ -161,6 +169,7 @@ mod tests {
             solver: None,
             time_origin: None,
             prediction: None,
+            simplex_start: None,
             order: None,
             lambda: None,
             tolerance: None,
@@ -195,6 +204,29 @@ mod tests {
         assert_eq!(ms.len(), 2);
         let e = o.methods(Some("arx,rls"), "").unwrap_err().to_string();
         assert!(e.contains("--solver") && e.contains("arx,rls"), "{e}");
+        // the simplex start: with the simplex only
+        let o = MethodOptions {
+            solver: Some("simplex".into()),
+            simplex_start: Some("previous".into()),
+            ..options()
+        };
+        let Method::Paper(c) = o.method("paper").unwrap() else {
+            unreachable!()
+        };
+        assert_eq!(c.simplex_start, feedid::ident::SimplexStart::Previous);
+        let o = MethodOptions {
+            simplex_start: Some("previous".into()),
+            ..options()
+        };
+        let e = format!("{:#}", o.method("paper").unwrap_err());
+        assert!(e.contains("simplex"), "{e}");
+        assert!(o.method("arx").is_err());
+        let o = MethodOptions {
+            solver: Some("simplex".into()),
+            simplex_start: Some("last".into()),
+            ..options()
+        };
+        assert!(o.method("paper").unwrap_err().to_string().contains("last"));
         // bad values are named
         let o = MethodOptions {
             order: Some("2,2".into()),

@@ -102,7 +102,12 @@ impl Method {
     /// (`"paper LSM, qr"`, `"ARX 8,8,1"`, `"RLS 8,8,1 λ=0.999"`, `"OE 3p/1z"`, `"auto"`).
     pub fn label(&self) -> String {
         match self {
-            Method::Paper(c) => format!("paper LSM, {}", c.solver.label()),
+            Method::Paper(c) => match (c.solver, c.simplex_start) {
+                (crate::ident::Solver::Simplex, crate::ident::SimplexStart::Previous) => {
+                    "paper LSM, simplex from the previous window".to_string()
+                }
+                _ => format!("paper LSM, {}", c.solver.label()),
+            },
             Method::Arx(c) => {
                 let o = c.orders;
                 format!("ARX {},{},{}", o.na, o.nb, o.nk)

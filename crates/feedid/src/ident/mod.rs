@@ -28,9 +28,9 @@ pub use method::{Method, METHOD_NAMES};
 pub use methods::{
     coefficients_from_polynomials, fit_arx, fit_oe, polynomials_from_coefficients, ArxConfig,
     ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, OeConfig,
-    OeEstimator, OeFit, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig,
-    RlsEstimator, SimplexSettings, Solver, TimeOrigin, AUTO_CANDIDATES, MAX_ARX_ORDER,
-    SHIFT_AMPLIFICATION_WARNING,
+    OeEstimator, OeFit, OeJacobian, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode,
+    RlsConfig, RlsEstimator, SimplexSettings, SimplexStart, Solver, TimeOrigin, AUTO_CANDIDATES,
+    MAX_ARX_ORDER, SHIFT_AMPLIFICATION_WARNING,
 };
 pub use model::{
     fit_global_model, GlobalModelKind, LinearModel, ModelFile, ModelProvenance, GLOBAL_FIT_SAMPLES,

@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::ident::engine::{run_with_progress, Progress};
 use crate::ident::{
     fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind, Method,
-    OrderSearch, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
+    OrderSearch, PredictionMode, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
 use crate::plausibility::check_recording;
@@ -228,8 +228,25 @@ impl<'a> Pipeline<'a> {
             }
         }
 
-        let mut estimator = method.build()?;
-        let sliding = run_with_progress(estimator.as_mut(), &signals, &config, self.progress)?;
+        let sliding = match &method {
+            // the paper's tf prediction may fall back per window: count it
+            Method::Paper(paper) if paper.prediction == PredictionMode::TransferFunction => {
+                let mut estimator = (*paper).build()?;
+                let sliding = run_with_progress(&mut estimator, &signals, &config, self.progress)?;
+                let fallbacks = estimator.tf_fallbacks();
+                if fallbacks > 0 {
+                    warnings.push(Warning::PaperTfFallback {
+                        fallbacks,
+                        windows: sliding.windows.len(),
+                    });
+                }
+                sliding
+            }
+            _ => {
+                let mut estimator = method.build()?;
+                run_with_progress(estimator.as_mut(), &signals, &config, self.progress)?
+            }
+        };
 
         let simulated = match &self.nominal {
             Some(p) => Some(
@@ -475,6 +492,88 @@ mod tests {
         );
         assert!(e.to_string().len() > "order selection: ".len() + 5, "{e}");
         assert!(!matches!(e.root(), Error::Stage { .. }));
+    }
+
+    #[test]
+    fn paper_tf_prediction_reports_the_windows_that_fell_back_to_the_polynomial() {
+        use crate::drive::{RigParams, VirtualRig};
+        use crate::ident::{Estimator, PaperConfig, PredictionMode};
+        let rate = 5000.0;
+        let command = Scenario::Ramp.command(rate, 0.3, 1).unwrap();
+        let out = VirtualRig::new(RigParams::default())
+            .with_seed(1)
+            .simulate(&command, rate)
+            .unwrap();
+        let rec = Recording::new(out.time, out.command, out.position).unwrap();
+        let paper = |prediction| {
+            Method::Paper(PaperConfig {
+                prediction,
+                ..PaperConfig::default()
+            })
+        };
+        let fallback_warnings = |run: &Identification| -> Vec<Warning> {
+            run.warnings
+                .iter()
+                .filter(|w| matches!(w, Warning::PaperTfFallback { .. }))
+                .cloned()
+                .collect()
+        };
+        let poly = Pipeline::new(paper(PredictionMode::Polynomial))
+            .run(&rec)
+            .unwrap();
+        assert!(fallback_warnings(&poly).is_empty());
+        let tf = Pipeline::new(paper(PredictionMode::TransferFunction))
+            .run(&rec)
+            .unwrap();
+        let warned = fallback_warnings(&tf);
+        // reference: the windows whose two predictions are identical, by an
+        // estimator of each mode fed the same windows
+        let cfg = tf.config;
+        let signals = rec.signals();
+        let mut a = PaperConfig::default().build().unwrap();
+        let mut b = PaperConfig {
+            prediction: PredictionMode::TransferFunction,
+            ..PaperConfig::default()
+        }
+        .build()
+        .unwrap();
+        let (mut coef, mut pa, mut pb) =
+            ([0.0; 11], vec![0.0; cfg.horizon], vec![0.0; cfg.horizon]);
+        let (mut windows, mut same, mut differ) = (0, 0, 0);
+        for (window, horizon) in cfg.windows(rec.len(), a.warm_up()) {
+            windows += 1;
+            a.fit(&signals, window.clone(), &mut coef).unwrap();
+            b.fit(&signals, window.clone(), &mut coef).unwrap();
+            a.predict(&signals, window.clone(), horizon.clone(), &mut pa)
+                .unwrap();
+            b.predict(&signals, window, horizon, &mut pb).unwrap();
+            let fell_back = b.diagnostics().is_some_and(|d| d.tf_fallback);
+            if fell_back {
+                assert_eq!(pa, pb);
+                same += 1;
+            } else if pa != pb {
+                differ += 1;
+            }
+        }
+        assert_eq!(b.tf_fallbacks(), same);
+        assert_eq!(tf.sliding.windows.len(), windows);
+        if same == 0 {
+            assert!(warned.is_empty(), "{warned:?}");
+        } else {
+            assert!(
+                matches!(
+                    warned.as_slice(),
+                    [Warning::PaperTfFallback { fallbacks, windows: w }] if *fallbacks == same && *w == windows
+                ),
+                "{warned:?} ({same} of {windows})"
+            );
+            assert!(warned[0]
+                .to_string()
+                .contains(&format!("{same} of {windows}")));
+        }
+        // the rig's ramp: the identified D(s) is almost never Hurwitz
+        assert!(same * 10 > windows * 9, "{same} of {windows}");
+        eprintln!("tf: {same} of {windows} windows fell back, {differ} predicted differently");
     }
 
     #[test]

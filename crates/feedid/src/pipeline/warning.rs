@@ -21,6 +21,18 @@ pub enum Warning {
         /// The largest growth factor of the change of basis over the windows.
         amplification: f64,
     },
+    /// Paper method with `--prediction tf`: in these windows the identified
+    /// `N(s)/D(s)` was unstable (or not realisable) and the prediction fell
+    /// back to the polynomial one (see
+    /// [`crate::ident::PaperMethod::tf_fallbacks`]). The identified `D(s)`
+    /// holds the command's Taylor coefficients, which rarely form a Hurwitz
+    /// polynomial, so on most recordings most windows fall back.
+    PaperTfFallback {
+        /// Windows whose transfer-function prediction fell back.
+        fallbacks: usize,
+        /// Windows predicted.
+        windows: usize,
+    },
 }
 
 impl fmt::Display for Warning {
@@ -33,6 +45,13 @@ impl fmt::Display for Warning {
                  lose about {:.0} of their 16 digits (amplification {g:.1e}); predictions are \
                  not affected (the time origin `window` keeps the coefficients accurate)",
                 g.log10().min(16.0)
+            ),
+            Warning::PaperTfFallback { fallbacks, windows } => write!(
+                f,
+                "paper method, prediction tf: the identified transfer function was unstable in \
+                 {fallbacks} of {windows} windows ({:.1} %), which were predicted by the \
+                 polynomial instead (as --prediction polynomial)",
+                100.0 * *fallbacks as f64 / (*windows).max(1) as f64
             ),
         }
     }

@@ -7,8 +7,11 @@
 //!     min_δ ‖J·δ + r‖² + μ‖D·δ‖²   ⇔   [J; √μ·D]·δ ≈ [−r; 0]
 //! ```
 //!
-//! by Householder QR of the augmented matrix ([`lstsq_in_place`], no normal
-//! equations), with Marquardt's diagonal scaling `D = diag(d_j)`,
+//! by Householder QR (no normal equations): the QR `J·D_s⁻¹·P = Q·R` of the
+//! Jacobian once per iteration ([`lstsq_in_place`]), then for every damping
+//! tried the small `2n×n` problem `[R; √μ·D·D_s⁻¹·P]·z ≈ [Qᵀ(−r); 0]` (the
+//! same step: `Q` is orthogonal on the first block; MINPACK's `lmpar`
+//! works on `R` the same way), with Marquardt's diagonal scaling `D = diag(d_j)`,
 //! `d_j = max(d_j, ‖J_j‖)` over the iterations (Moré 1978; a zero column
 //! gets `d_j = 1`). A step is accepted if it decreases `‖r‖`; the damping is
 //! updated from the gain ratio `ϱ = (‖r‖² − ‖r_new‖²)/(‖r‖² − ‖r + Jδ‖²)`
@@ -29,7 +32,8 @@
 //!
 //! The report gives the final residual norm; the workspace keeps the
 //! residuals and the Jacobian at the returned parameters
-//! ([`LevenbergMarquardt::jacobian`]) for standard errors.
+//! ([`LevenbergMarquardt::jacobian`]) for standard errors (unless
+//! [`LmConfig::final_jacobian`] is off).
 //!
 //! References: K. Levenberg (1944), D.W. Marquardt (1963); J.J. Moré, "The
 //! Levenberg–Marquardt algorithm: implementation and theory", LNM 630 (1978);
@@ -54,6 +58,12 @@ pub struct LmConfig {
     pub initial_damping: f64,
     /// Relative forward-difference step `√ε_fd`. Default `√ε ≈ 1.49e-8`.
     pub fd_step: f64,
+    /// Evaluate the Jacobian at the returned parameters when the last
+    /// accepted step moved them (for standard errors,
+    /// [`LevenbergMarquardt::jacobian`]); default true. `false` saves `n`
+    /// residual evaluations (forward differences) per run and leaves the
+    /// Jacobian of the last iteration in the workspace.
+    pub final_jacobian: bool,
 }
 
 impl Default for LmConfig {
@@ -65,6 +75,7 @@ impl Default for LmConfig {
             max_iterations: 200,
             initial_damping: 1e-3,
             fd_step: f64::EPSILON.sqrt(),
+            final_jacobian: true,
         }
     }
 }
@@ -92,12 +103,17 @@ pub struct LevenbergMarquardt {
     r_tmp: Vec<f64>,
     jac: Vec<f64>,
     jac_at_p: bool,
+    /// The QR of the Jacobian (`m×n`) and `Qᵀ(−r)` (`m`).
+    jqr: Vec<f64>,
+    jrhs: Vec<f64>,
+    /// The damped `2n×n` problem of a step and its right-hand side.
     aug: Vec<f64>,
     rhs: Vec<f64>,
     delta: Vec<f64>,
     p_new: Vec<f64>,
     diag: Vec<f64>,
     qr: QrWorkspace,
+    qr_small: QrWorkspace,
 }
 
 impl LevenbergMarquardt {
@@ -111,12 +127,15 @@ impl LevenbergMarquardt {
             r_tmp: vec![0.0; m],
             jac: vec![0.0; m * n],
             jac_at_p: false,
-            aug: vec![0.0; (m + n) * n],
-            rhs: vec![0.0; m + n],
+            jqr: vec![0.0; m * n],
+            jrhs: vec![0.0; m],
+            aug: vec![0.0; 2 * n * n],
+            rhs: vec![0.0; 2 * n],
             delta: vec![0.0; n],
             p_new: vec![0.0; n],
             diag: vec![0.0; n],
             qr: QrWorkspace::new(n),
+            qr_small: QrWorkspace::new(n),
         }
     }
 
@@ -289,40 +308,66 @@ impl LevenbergMarquardt {
             if gmax <= config.gtol {
                 break Termination::Converged;
             }
+            // QR of J once: J·D_s⁻¹·P = Q·R, c = Qᵀ(−r); ‖J·δ + r‖² = ‖R·z − c₁‖² + ‖c₂‖²
+            self.jqr.copy_from_slice(&self.jac);
+            for (c, r) in self.jrhs.iter_mut().zip(&self.r) {
+                *c = -r;
+            }
+            lstsq_in_place(
+                m,
+                n,
+                &mut self.jqr,
+                &mut self.jrhs,
+                &mut self.delta,
+                &mut self.qr,
+                &LstsqOptions::default(),
+            )?;
+            let kmax = m.min(n);
+            let rest2: f64 = self.jrhs[kmax..].iter().map(|v| v * v).sum();
             // inner loop: find an acceptable step
             loop {
-                let rows = m + n;
+                // [R; √μ·D·D_s⁻¹·P] z ≈ [c₁; 0], δ = D_s⁻¹·P·z
+                let rows = 2 * n;
+                let perm = self.qr.permutation(n);
+                let scale = self.qr.scales(n);
+                self.aug.fill(0.0);
                 for j in 0..n {
                     let col = &mut self.aug[j * rows..(j + 1) * rows];
-                    col[..m].copy_from_slice(&self.jac[j * m..(j + 1) * m]);
-                    for v in col[m..].iter_mut() {
-                        *v = 0.0;
-                    }
-                    col[m + j] = mu.sqrt() * self.diag[j];
+                    // the upper triangle of R (kmax ≥ 1 rows)
+                    let top = (j + 1).min(kmax);
+                    col[..top].copy_from_slice(&self.jqr[j * m..j * m + top]);
+                    let pj = perm[j];
+                    col[n + j] = mu.sqrt() * self.diag[pj] / scale[pj];
                 }
-                for i in 0..m {
-                    self.rhs[i] = -self.r[i];
-                }
-                for v in self.rhs[m..].iter_mut() {
-                    *v = 0.0;
-                }
+                self.rhs.fill(0.0);
+                self.rhs[..kmax].copy_from_slice(&self.jrhs[..kmax]);
+                let mut z = [0.0f64; 64];
+                let z = if n <= z.len() {
+                    &mut z[..n]
+                } else {
+                    &mut self.p_new[..n]
+                };
                 lstsq_in_place(
                     rows,
                     n,
                     &mut self.aug,
                     &mut self.rhs,
-                    &mut self.delta,
-                    &mut self.qr,
+                    z,
+                    &mut self.qr_small,
                     &LstsqOptions::default(),
                 )?;
                 // predicted ‖r + Jδ‖²
-                let mut pred_cost = 0.0;
-                for i in 0..m {
-                    let mut v = self.r[i];
-                    for j in 0..n {
-                        v += self.jac[i + j * m] * self.delta[j];
+                let mut pred_cost = rest2;
+                for i in 0..kmax {
+                    let mut v = -self.jrhs[i];
+                    for (j, zj) in z.iter().enumerate().skip(i) {
+                        v += self.jqr[i + j * m] * zj;
                     }
                     pred_cost += v * v;
+                }
+                for k in 0..n {
+                    let pj = perm[k];
+                    self.delta[pj] = z[k] / scale[pj];
                 }
                 let dx_norm = self
                     .delta
@@ -378,7 +423,7 @@ impl LevenbergMarquardt {
                 }
             }
         };
-        if !self.jac_at_p {
+        if !self.jac_at_p && config.final_jacobian {
             // refresh the Jacobian at the returned parameters
             match jacobian.as_mut() {
                 Some(jf) => jf(p, &mut self.jac),

@@ -344,9 +344,13 @@ impl NelderMead {
                         }
                         self.fvals[i] = eval(&self.simplex[i * n..(i + 1) * n], &mut evaluations);
                     }
+                    self.sort();
+                    continue;
                 }
             }
-            self.sort();
+            // only the worst vertex changed: move it to its place (what the
+            // full insertion sort would do, in O(n))
+            self.insert_last();
         };
         let ib = self.order[0];
         x.copy_from_slice(&self.simplex[ib * n..(ib + 1) * n]);
@@ -380,6 +384,17 @@ impl NelderMead {
             }
         }
         true
+    }
+
+    /// Re-sort after only the vertex `order[n]` changed (stable: the same
+    /// order as [`Self::sort`]).
+    fn insert_last(&mut self) {
+        let mut k = self.n;
+        let v = self.fvals[self.order[k]];
+        while k > 0 && v < self.fvals[self.order[k - 1]] {
+            self.order.swap(k, k - 1);
+            k -= 1;
+        }
     }
 
     /// Stable insertion sort of the vertex indices by objective value.

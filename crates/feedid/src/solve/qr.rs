@@ -97,6 +97,8 @@ pub struct QrWorkspace {
     /// Squared partial column norms (current estimate, last exact value).
     vn1: Vec<f64>,
     vn2: Vec<f64>,
+    /// Run the AVX2 build of the solver.
+    avx: bool,
 }
 
 impl QrWorkspace {
@@ -111,12 +113,25 @@ impl QrWorkspace {
             small_rhs: vec![0.0; 2 * n],
             vn1: vec![0.0; n],
             vn2: vec![0.0; n],
+            avx: crate::solve::rows::avx2(),
         }
     }
 
     /// Largest number of unknowns this workspace supports.
     pub fn capacity(&self) -> usize {
         self.n_max
+    }
+
+    /// Column permutation of the last [`lstsq_in_place`] with `n` unknowns
+    /// (column `k` of its `R` is column `perm[k]` of `A`).
+    pub(crate) fn permutation(&self, n: usize) -> &[usize] {
+        &self.perm[..n]
+    }
+
+    /// Column scales `d_j` of the last [`lstsq_in_place`] with `n` unknowns
+    /// (`R` is the factor of `A·diag(1/d_j)`, permuted).
+    pub(crate) fn scales(&self, n: usize) -> &[f64] {
+        &self.scale[..n]
     }
 }
 
@@ -145,6 +160,42 @@ impl QrWorkspace {
 /// assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 2.0).abs() < 1e-14);
 /// ```
 pub fn lstsq_in_place(
+    m: usize,
+    n: usize,
+    a: &mut [f64],
+    b: &mut [f64],
+    x: &mut [f64],
+    ws: &mut QrWorkspace,
+    options: &LstsqOptions,
+) -> Result<LstsqInfo> {
+    #[cfg(target_arch = "x86_64")]
+    if ws.avx {
+        // SAFETY: `avx` is set only when the CPU reports AVX2 (workspace construction).
+        return unsafe { lstsq_avx2(m, n, a, b, x, ws, options) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = ws.avx;
+    lstsq_impl(m, n, a, b, x, ws, options)
+}
+
+/// [`lstsq_impl`] compiled for AVX2 (4-wide vectors; the same operations in
+/// the same order, no FMA contraction: bit-identical results).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lstsq_avx2(
+    m: usize,
+    n: usize,
+    a: &mut [f64],
+    b: &mut [f64],
+    x: &mut [f64],
+    ws: &mut QrWorkspace,
+    options: &LstsqOptions,
+) -> Result<LstsqInfo> {
+    lstsq_impl(m, n, a, b, x, ws, options)
+}
+
+#[inline(always)]
+fn lstsq_impl(
     m: usize,
     n: usize,
     a: &mut [f64],
@@ -189,14 +240,24 @@ pub fn lstsq_in_place(
         Some(t) => t,
         None => m.max(n) as f64 * f64::EPSILON,
     };
-    if let Some((i, &v)) = a.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+    if !all_finite(a) {
+        let (i, &v) = a
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite())
+            .unwrap_or((0, &f64::NAN));
         return Err(Error::NonFinite {
             channel: "least-squares matrix".to_string(),
             index: i,
             value: v,
         });
     }
-    if let Some((i, &v)) = b.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+    if !all_finite(b) {
+        let (i, &v) = b
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite())
+            .unwrap_or((0, &f64::NAN));
         return Err(Error::NonFinite {
             channel: "least-squares right-hand side".to_string(),
             index: i,
@@ -463,13 +524,184 @@ fn householder_solve(
     Ok(())
 }
 
+/// [`lstsq_in_place`] without ridge for a small problem of fixed size
+/// `M×N` (`M ≥ N`) on stack arrays: the same algorithm — unit-norm
+/// columns, Householder QR with column pivoting (norms downdated, recomputed
+/// after cancellation), numerical rank against `tol·|R₀₀|` (`None`:
+/// `max(M, N)·ε`), condition estimate `|R₀₀|/|R_{N−1,N−1}|`, the basic
+/// solution, the residual `‖A·x − b‖` — without the size checks and the
+/// workspace (a few hundred instructions for 8×3 instead of thousands).
+/// The same operations in the same order: bit-identical results.
+///
+/// `a` holds the `N` columns. Errors as [`lstsq_in_place`]: non-finite
+/// input, rank 0, an overflowing solution.
+#[allow(clippy::needless_range_loop)] // index loops mirror lstsq_in_place
+pub(crate) fn lstsq_fixed<const M: usize, const N: usize>(
+    a: &[[f64; M]; N],
+    b: &[f64; M],
+    tol: Option<f64>,
+) -> Result<([f64; N], LstsqInfo)> {
+    if let Some(v) = a.iter().flatten().chain(b).find(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            channel: "least-squares problem".to_string(),
+            index: 0,
+            value: *v,
+        });
+    }
+    let tol = tol.unwrap_or(M.max(N) as f64 * f64::EPSILON);
+    let mut a = *a;
+    let mut b = *b;
+    let mut scale = [1.0; N];
+    let mut perm = [0usize; N];
+    let mut vn1 = [0.0; N];
+    let mut vn2 = [0.0; N];
+    for j in 0..N {
+        let d = norm2(&a[j]);
+        let d = if d > 0.0 && d.is_finite() { d } else { 1.0 };
+        let inv = 1.0 / d;
+        a[j].iter_mut().for_each(|v| *v *= inv);
+        scale[j] = d;
+        perm[j] = j;
+        vn1[j] = sum_sq(&a[j]);
+        vn2[j] = vn1[j];
+    }
+    let tol3z = f64::EPSILON.sqrt();
+    for k in 0..N.min(M) {
+        let mut best = k;
+        let mut best_norm = -1.0;
+        for (j, &nj) in vn1.iter().enumerate().skip(k) {
+            if nj > best_norm {
+                best_norm = nj;
+                best = j;
+            }
+        }
+        if best != k {
+            a.swap(k, best);
+            perm.swap(k, best);
+            vn1.swap(k, best);
+            vn2.swap(k, best);
+        }
+        let alpha_norm = norm2(&a[k][k..]);
+        if alpha_norm == 0.0 {
+            continue;
+        }
+        let x0 = a[k][k];
+        let alpha = if x0 >= 0.0 { -alpha_norm } else { alpha_norm };
+        a[k][k] = x0 - alpha;
+        let vtv = a[k][k..].iter().map(|t| t * t).sum::<f64>();
+        if vtv > 0.0 {
+            let beta = 2.0 / vtv;
+            let (head, tail) = a.split_at_mut(k + 1);
+            let v = &head[k][k..];
+            for col in tail.iter_mut() {
+                let c = &mut col[k..];
+                let s = beta * dot(v, c);
+                c.iter_mut().zip(v).for_each(|(ci, vi)| *ci -= s * vi);
+            }
+            let c = &mut b[k..];
+            let s = beta * dot(v, c);
+            c.iter_mut().zip(v).for_each(|(ci, vi)| *ci -= s * vi);
+        }
+        a[k][k] = alpha;
+        a[k][k + 1..].iter_mut().for_each(|v| *v = 0.0);
+        for j in (k + 1)..N {
+            let r = a[j][k];
+            let rest = vn1[j] - r * r;
+            if rest <= tol3z * vn2[j] {
+                vn1[j] = sum_sq(&a[j][k + 1..]);
+                vn2[j] = vn1[j];
+            } else {
+                vn1[j] = rest;
+            }
+        }
+    }
+    let kmax = M.min(N);
+    let r00 = a[0][0].abs();
+    let mut rank = 0;
+    for k in 0..kmax {
+        if a[k][k].abs() > tol * r00 && r00 > 0.0 {
+            rank += 1;
+        } else {
+            break;
+        }
+    }
+    let cond_estimate = if M < N {
+        f64::INFINITY
+    } else {
+        let rlast = a[N - 1][N - 1].abs();
+        if rlast > 0.0 {
+            r00 / rlast
+        } else {
+            f64::INFINITY
+        }
+    };
+    if rank == 0 {
+        return Err(Error::Singular {
+            context: "least squares (matrix of rank 0)",
+        });
+    }
+    let mut z = [0.0; N];
+    for k in (0..rank).rev() {
+        let mut s = b[k];
+        for j in (k + 1)..rank {
+            s -= a[j][k] * z[j];
+        }
+        z[k] = s / a[k][k];
+    }
+    let mut res2 = 0.0;
+    for i in 0..kmax {
+        let mut s = -b[i];
+        for j in i..N {
+            s += a[j][i] * z[j];
+        }
+        res2 += s * s;
+    }
+    for bi in b.iter().skip(kmax) {
+        res2 += bi * bi;
+    }
+    let mut x = [0.0; N];
+    for k in 0..N {
+        let j = perm[k];
+        x[j] = z[k] / scale[j];
+    }
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Singular {
+            context: "least squares (solution overflowed)",
+        });
+    }
+    Ok((
+        x,
+        LstsqInfo {
+            rank,
+            cond_estimate,
+            residual_norm: res2.sqrt(),
+        },
+    ))
+}
+
 /// Columns `k < j` of a column-major `m`-row matrix, `k` shared and `j` mutable.
 fn split_cols(a: &mut [f64], m: usize, k: usize, j: usize) -> (&[f64], &mut [f64]) {
     let (left, right) = a.split_at_mut(j * m);
     (&left[k * m..(k + 1) * m], &mut right[..m])
 }
 
+/// Whether every element is finite: four partial sums of `v·0` (NaN exactly
+/// when some `v` is NaN or infinite), vectorisable.
+#[inline(always)]
+fn all_finite(v: &[f64]) -> bool {
+    let mut acc = [0.0f64; 4];
+    let chunks = v.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().map(|x| x * 0.0).sum();
+    for c in chunks {
+        for (a, x) in acc.iter_mut().zip(c) {
+            *a += x * 0.0;
+        }
+    }
+    (acc[0] + acc[1] + acc[2] + acc[3] + rest) == 0.0
+}
+
 /// Dot product with four partial sums (independent dependency chains).
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
@@ -490,12 +722,14 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Sum of squares (no protection against over/underflow).
+#[inline(always)]
 fn sum_sq(v: &[f64]) -> f64 {
     dot(v, v)
 }
 
 /// 2-norm without overflow/underflow for extreme magnitudes (one pass when
 /// the sum of squares is safely representable).
+#[inline(always)]
 fn norm2(v: &[f64]) -> f64 {
     let s = sum_sq(v);
     if s.is_finite() && s >= 1e-200 {
@@ -533,6 +767,48 @@ mod tests {
         let a = DMatrix::from_fn(m, n, |_, _| rng.random_range(-1.0..1.0));
         let b = DVector::from_fn(m, |_, _| rng.random_range(-1.0..1.0));
         (a, b)
+    }
+
+    #[test]
+    fn avx2_build_gives_the_portable_results_bit_for_bit() {
+        // the kernels are chosen at run time: both builds must agree exactly
+        // (on a CPU without AVX2 both are the portable one)
+        let mut fast = QrWorkspace::new(24);
+        let mut slow = crate::solve::rows::portable(|| QrWorkspace::new(24));
+        assert!(!slow.avx);
+        #[cfg(target_arch = "x86_64")]
+        assert_eq!(fast.avx, std::arch::is_x86_feature_detected!("avx2"));
+        let mut rng = ChaCha8Rng::seed_from_u64(41);
+        for case in 0..300 {
+            let n = rng.random_range(1..=24);
+            let m = n + rng.random_range(0..60);
+            let (a, b) = random_problem(&mut rng, m, n);
+            let mut a: Vec<f64> = a.as_slice().to_vec();
+            if n > 2 && case % 3 == 0 {
+                // a nearly dependent column and decades of scale
+                for i in 0..m {
+                    a[i + 2 * m] = a[i + m] + 1e-9 * a[i + 2 * m];
+                    a[i] *= 1e6;
+                }
+            }
+            let options = LstsqOptions {
+                ridge: [0.0, 1e-8, 1e-2][case % 3],
+                rank_tolerance: [None, Some(1e-6)][case % 2],
+            };
+            let run = |ws: &mut QrWorkspace| {
+                let (mut a, mut b, mut x) = (a.clone(), b.as_slice().to_vec(), vec![0.0; n]);
+                let info = lstsq_in_place(m, n, &mut a, &mut b, &mut x, ws, &options)
+                    .map(|i| format!("{i:?}"));
+                let bits = |v: &[f64]| v.iter().map(|e| e.to_bits()).collect::<Vec<_>>();
+                (
+                    info.map_err(|e| e.to_string()),
+                    bits(&x),
+                    bits(&a),
+                    bits(&b),
+                )
+            };
+            assert_eq!(run(&mut fast), run(&mut slow), "case {case} (m {m}, n {n})");
+        }
     }
 
     fn svd_solve(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
@@ -751,5 +1027,44 @@ mod tests {
             lstsq_in_place(2, 2, &mut a, &mut b, &mut x, &mut ws, &neg),
             Err(Error::InvalidParameter { .. })
         ));
+    }
+
+    #[test]
+    fn fixed_size_solver_matches_lstsq_in_place() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(31);
+        let mut ws = QrWorkspace::new(3);
+        for case in 0..500 {
+            let mut a = [[0.0; 8]; 3];
+            for col in a.iter_mut() {
+                for v in col.iter_mut() {
+                    *v = rng.random_range(-1.0..1.0);
+                }
+            }
+            // dependent or badly scaled columns now and then
+            match case % 5 {
+                1 => a[2] = a[0].map(|v| 2.0 * v),
+                2 => a[1] = a[1].map(|v| 1e-9 * v),
+                3 => a[2] = [0.0; 8],
+                _ => {}
+            }
+            let b: [f64; 8] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+            let mut flat: Vec<f64> = a.iter().flatten().copied().collect();
+            let mut bb = b.to_vec();
+            let mut want = [0.0; 3];
+            let opts = LstsqOptions::default();
+            let r = lstsq_in_place(8, 3, &mut flat, &mut bb, &mut want, &mut ws, &opts);
+            let got = lstsq_fixed::<8, 3>(&a, &b, None);
+            match (r, got) {
+                (Ok(ri), Ok((x, gi))) => {
+                    assert_eq!(ri.rank, gi.rank, "case {case}");
+                    // the same operations in the same order: the same numbers
+                    assert_eq!(ri, gi, "case {case}");
+                    assert_eq!(x, want, "case {case}");
+                }
+                (Err(_), Err(_)) => {}
+                (r, g) => panic!("case {case}: {r:?} vs {g:?}"),
+            }
+        }
     }
 }

@@ -12,10 +12,11 @@ mod rls;
 pub(crate) use arx::fit_arx_rows;
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit};
 pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
-pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit};
+pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit, OeJacobian};
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
-    PaperMethod, PredictionMode, SimplexSettings, Solver, TimeOrigin, SHIFT_AMPLIFICATION_WARNING,
+    PaperMethod, PredictionMode, SimplexSettings, SimplexStart, Solver, TimeOrigin,
+    SHIFT_AMPLIFICATION_WARNING,
 };
 pub(crate) use regressor::regressor;
 pub use regressor::{ArxOrders, MAX_ARX_ORDER};

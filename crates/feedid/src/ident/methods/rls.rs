@@ -228,10 +228,7 @@ impl RlsEstimator {
             start: None,
             updates: 0,
             max_trace: config.max_trace.unwrap_or(n as f64 * config.p0),
-            #[cfg(target_arch = "x86_64")]
-            avx: std::arch::is_x86_feature_detected!("avx2"),
-            #[cfg(not(target_arch = "x86_64"))]
-            avx: false,
+            avx: crate::solve::rows::avx2(),
         };
         s.reset();
         s
@@ -315,7 +312,10 @@ impl RlsEstimator {
             add_sized(self.n, p, psi, theta, g, target, lambda, max)
         };
         #[cfg(not(target_arch = "x86_64"))]
-        let r = add_sized(self.n, p, psi, theta, g, target, lambda, max);
+        let r = {
+            let _ = self.avx;
+            add_sized(self.n, p, psi, theta, g, target, lambda, max)
+        };
         match r {
             Ok(e) => e,
             Err(e) => {
@@ -815,6 +815,36 @@ mod tests {
         b.reset();
         b.fit(&s, 8..600, &mut cb).unwrap();
         assert_eq!(ca, cb);
+    }
+
+    #[test]
+    fn avx2_update_gives_the_portable_estimates_bit_for_bit() {
+        // the update's kernel is chosen at run time: both give exactly the
+        // same estimates (on a CPU without AVX2 both are the portable one)
+        let (t, u, y) = data(4, 1500, 1e-6);
+        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
+        for cfg in [
+            RlsConfig::default(),
+            RlsConfig {
+                orders: ArxOrders::new(2, 2, 1),
+                window: Some(120),
+                ..RlsConfig::default()
+            },
+        ] {
+            let run = || {
+                let mut rls = cfg.build().unwrap();
+                assert_eq!(rls.avx, crate::solve::rows::avx2());
+                let mut coef = vec![0.0; cfg.orders.n_params()];
+                let mut bits = Vec::new();
+                for end in (200..=1500).step_by(10) {
+                    rls.fit(&s, end - 100..end, &mut coef).unwrap();
+                    bits.extend(coef.iter().map(|v| v.to_bits()));
+                }
+                bits
+            };
+            let fast = run();
+            assert_eq!(fast, crate::solve::rows::portable(run));
+        }
     }
 
     #[test]

@@ -35,10 +35,12 @@ pub struct ArxConfig {
     /// windows predict well on the rig. Without ridge, a numerically rank
     /// deficient regression always counts as not informative.
     pub max_condition: f64,
-    /// Recompute the sliding factor from scratch after this many windows; default 64.
+    /// At most this many windows between two factorisations from scratch;
+    /// default 64. (The sliding update rebuilds every `⌈W/hop⌉` windows
+    /// anyway and has no drift to bound; 1 refactors every window.)
     pub refactor_every: usize,
     /// Use the exact sliding update when windows overlap (default true);
-    /// `false` refits every window from scratch (same result, slower).
+    /// `false` factors every window from scratch (same result to rounding, slower).
     pub sliding: bool,
     /// Estimate an offset `c` as well, `A·ỹ = B·ũ + c` (coefficient name `"c"`);
     /// default false (a position servo has unit DC gain and needs none). Use

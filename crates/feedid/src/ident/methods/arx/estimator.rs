@@ -19,7 +19,10 @@ use super::factor::SlidingFactor;
 use crate::error::{Error, Result};
 use crate::ident::methods::regressor::{dc_gain, poles_inside, predict_horizon, MAX_ARX_ORDER};
 use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
-use crate::solve::{lstsq_in_place, LstsqOptions, QrWorkspace, Termination};
+use crate::solve::{
+    hessenberg_condition, lstsq_hessenberg_view, lstsq_in_place, HessenbergWorkspace, LstsqOptions,
+    QrWorkspace, Termination,
+};
 
 /// Diagnostics of the last ARX window.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -28,7 +31,10 @@ pub struct ArxDiagnostics {
     pub accepted: bool,
     /// Why the model was not accepted (`""` when accepted).
     pub reason: &'static str,
-    /// Condition estimate of the column-scaled regression.
+    /// Condition estimate of the column-scaled regression: `max|T_kk|/min|T_kk|`
+    /// of its triangular factor (with the default ridge and no
+    /// [`ArxConfig::max_condition`] the factor is not pivoted, so this is a
+    /// rougher lower bound than the pivoted one used otherwise).
     pub condition: f64,
     /// Standard deviation of the command over the rows \[m\].
     pub excitation: f64,
@@ -44,6 +50,10 @@ pub struct ArxEstimator {
     config: ArxConfig,
     factor: SlidingFactor,
     ws: QrWorkspace,
+    hess: HessenbergWorkspace,
+    /// Scratch: squared column norms of the factor, the ridge per unknown.
+    colnorm2: Vec<f64>,
+    lambda: Vec<f64>,
     small_a: Vec<f64>,
     small_b: Vec<f64>,
     z: Vec<f64>,
@@ -52,6 +62,10 @@ pub struct ArxEstimator {
     scratch: Vec<f64>,
     past: Vec<f64>,
     diagnostics: Option<ArxDiagnostics>,
+    /// Samples (absolute) checked finite while the factor stayed valid.
+    checked: Range<usize>,
+    /// The last window was solved without a condition estimate; the factor still holds it.
+    condition_pending: bool,
 }
 
 impl ArxEstimator {
@@ -60,8 +74,11 @@ impl ArxEstimator {
         let p = n + 2;
         Self {
             config,
-            factor: SlidingFactor::new(n),
+            factor: SlidingFactor::new(&config.orders),
             ws: QrWorkspace::new(n + 1),
+            hess: HessenbergWorkspace::new(n + 1),
+            colnorm2: vec![0.0; p.div_ceil(4) * 4],
+            lambda: vec![0.0; n + 1],
             small_a: vec![0.0; p * (n + 1)],
             small_b: vec![0.0; p],
             z: vec![0.0; n + 1],
@@ -70,7 +87,15 @@ impl ArxEstimator {
             scratch: vec![0.0; config.orders.na + 1],
             past: Vec::new(),
             diagnostics: None,
+            checked: 0..0,
+            condition_pending: false,
         }
+    }
+
+    /// Whether the window's problem is solved from the regularised factor by
+    /// [`lstsq_hessenberg`] (a ridge and no condition limit: the defaults).
+    fn hessenberg(config: &ArxConfig) -> bool {
+        config.ridge > 0.0 && config.max_condition == f64::INFINITY
     }
 
     /// The configuration.
@@ -95,11 +120,26 @@ impl ArxEstimator {
     }
 
     /// Diagnostics of the last window.
-    pub fn diagnostics(&self) -> Option<&ArxDiagnostics> {
-        self.diagnostics.as_ref()
+    ///
+    /// With the default settings the window's condition estimate is not
+    /// needed by the fit; it is computed here, from the window's factor, on
+    /// request (`O(n²)`, allocates).
+    pub fn diagnostics(&self) -> Option<ArxDiagnostics> {
+        let mut d = self.diagnostics?;
+        if self.condition_pending {
+            let n = self.config.orders.n_params();
+            let nr = n + usize::from(self.config.offset);
+            let mut h = vec![0.0; (n + 1) * nr];
+            let mut colnorm = vec![1.0; nr];
+            hessenberg_rows(&self.factor, n, self.config.offset, &mut h, &mut colnorm);
+            d.condition = hessenberg_condition(n + 1, nr, &h, &mut HessenbergWorkspace::new(nr))
+                .unwrap_or(f64::INFINITY);
+        }
+        Some(d)
     }
 
-    /// Bring the factor to `rows`; returns whether the sliding update was used.
+    /// Bring the factor to `rows` in the frame `reference`; returns whether
+    /// the two stacks were used (false: factored from scratch).
     fn update_factor(
         &mut self,
         y: &[f64],
@@ -109,29 +149,146 @@ impl ArxEstimator {
         reference: f64,
     ) -> bool {
         let orders = self.config.orders;
-        let f = &mut self.factor;
-        let old = f.rows.clone();
-        let can_slide = self.config.sliding
-            && f.valid
-            && rows.start > old.start
-            && rows.start < old.end
-            && rows.end - rows.start == old.end - old.start
-            && f.age + 1 < self.config.refactor_every;
-        if can_slide && f.slide(&orders, y, u, base, rows.clone()) {
-            // frame check: the shift to the reference must not exceed the data
-            // (every digit it cancels is lost in the coefficients)
-            let n = f.p - 2;
-            let d = (reference - f.r0).abs() * (rows.len() as f64).sqrt();
-            let out_norm = (0..f.p)
-                .map(|i| (f.rs(i, n + 1) - (reference - f.r0) * f.rs(i, 0)).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            if d <= 1.0 * out_norm {
-                return true;
+        self.factor.update(
+            &orders,
+            y,
+            u,
+            base,
+            rows,
+            reference,
+            self.config.sliding,
+            self.config.refactor_every,
+        )
+    }
+
+    /// Solve the window's ridge problem from the factor (frame = the
+    /// reference): `z[..=n]` the coefficients `[θ, c]` (unscaled); returns
+    /// the condition estimate (`NaN` where it is left to
+    /// [`ArxEstimator::diagnostics`]), the numerical rank and the residual
+    /// norm.
+    ///
+    /// With a ridge and no condition limit the factor's columns already form
+    /// an upper-Hessenberg matrix ([`lstsq_hessenberg`], `n³/3 + O(n²)`);
+    /// otherwise the pivoted Householder QR of the same small matrix reveals
+    /// the rank and estimates the condition ([`lstsq_in_place`]).
+    fn solve_window(&mut self) -> Result<(f64, usize, f64)> {
+        let n = self.config.orders.n_params();
+        let offset = self.config.offset;
+        let nr = n + usize::from(offset);
+        let p = self.factor.p;
+        if Self::hessenberg(&self.config) {
+            // Rows 0 ..= n of R from column `first` on are [H | b] for the
+            // unknowns β_j = S_j·θ_j/S_t (S the column scales, S_t the
+            // target's): upper Hessenberg without the offset (row 0 is
+            // dense), triangular with it. The window's ridge ρ·d_j²·θ_j² is
+            // ρ·c_j²·β_j² with c_j the norm of R's column j.
+            let f = &self.factor;
+            let first = usize::from(!offset);
+            let t = n + 1;
+            let c2 = &mut self.colnorm2[..f.ps];
+            f.column_norms2(c2);
+            for (l, &c) in self.lambda[..nr].iter_mut().zip(&c2[first..]) {
+                *l = self.config.ridge * c;
+            }
+            let info = lstsq_hessenberg_view(
+                n + 1,
+                nr,
+                &f.r,
+                f.ps,
+                first,
+                &self.lambda[..nr],
+                &mut self.z[..nr],
+                &mut self.hess,
+            )?;
+            // θ_j = β_j·S_t/S_j, in estimator order (offset last)
+            let z = &mut self.z;
+            let scale = &f.scale;
+            if offset {
+                let c = z[0] * scale[t] / scale[0];
+                for j in 0..n {
+                    z[j] = z[j + 1] * scale[t] / scale[j + 1];
+                }
+                z[n] = c;
+            } else {
+                for j in 0..n {
+                    z[j] *= scale[t] / scale[j + 1];
+                }
+                z[n] = 0.0;
+            }
+            let last = f.at(t, t);
+            let residual = (info.residual_norm.powi(2) + last * last).sqrt() * scale[t];
+            return Ok((f64::NAN, nr, residual));
+        }
+        let f = &self.factor;
+        // regressor columns 0..n (ψ), n (ones, with an offset), then the target
+        for j in 0..=n {
+            for i in 0..p {
+                let v = f.rs(i, j + 1);
+                if j < n {
+                    self.small_a[i + j * p] = v;
+                } else {
+                    self.small_b[i] = v;
+                }
             }
         }
-        f.refactor(&orders, y, u, base, rows, reference);
-        false
+        if offset {
+            for i in 0..p {
+                self.small_a[i + n * p] = f.rs(i, 0);
+            }
+        }
+        let mut colscale = [1.0f64; 2 * MAX_ARX_ORDER + 1];
+        for j in 0..nr {
+            let col = &mut self.small_a[j * p..(j + 1) * p];
+            let nrm = col.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if nrm > 0.0 {
+                colscale[j] = nrm;
+                for v in col.iter_mut() {
+                    *v /= nrm;
+                }
+            }
+        }
+        let opts = LstsqOptions {
+            ridge: self.config.ridge,
+            rank_tolerance: None,
+        };
+        let info = lstsq_in_place(
+            p,
+            nr,
+            &mut self.small_a[..p * nr],
+            &mut self.small_b,
+            &mut self.z[..nr],
+            &mut self.ws,
+            &opts,
+        )?;
+        for j in 0..nr {
+            self.z[j] /= colscale[j];
+        }
+        if !offset {
+            self.z[n] = 0.0;
+        }
+        Ok((info.cond_estimate, info.rank, info.residual_norm))
+    }
+}
+
+/// The window's regression from the factor `f` as an upper-Hessenberg
+/// matrix for [`lstsq_hessenberg`]: unknowns `[ones (offset only), ψ_1 …
+/// ψ_n]` in the coordinates `z_j = c_j·S_j·θ_j/S_t` (`c_j` the norm of the
+/// factor's column, `S` the column scales, `S_t` the target's), rows
+/// `0 ..= n` of `R` with each column scaled to unit norm, into `h`
+/// (row-major `(n+1) × nr`), the `c_j` into `colnorm`.
+fn hessenberg_rows(f: &SlidingFactor, n: usize, offset: bool, h: &mut [f64], colnorm: &mut [f64]) {
+    let nr = n + usize::from(offset);
+    let first = usize::from(!offset);
+    let m = n + 1;
+    let h = &mut h[..m * nr];
+    for (jj, col) in (first..=n).enumerate() {
+        let ss: f64 = (0..=col).map(|i| f.at(i, col).powi(2)).sum();
+        let nrm = ss.sqrt();
+        let inv = if nrm > 0.0 { 1.0 / nrm } else { 1.0 };
+        colnorm[jj] = if nrm > 0.0 { nrm } else { 1.0 };
+        for i in 0..m {
+            h[i * nr + jj] = if i <= col { f.at(i, col) * inv } else { 0.0 };
+        }
     }
 }
 
@@ -153,10 +310,11 @@ impl Estimator for ArxEstimator {
     }
 
     fn reset(&mut self) {
-        self.factor.valid = false;
-        self.factor.rows = 0..0;
+        self.factor.invalidate();
         self.has_model = false;
         self.diagnostics = None;
+        self.checked = 0..0;
+        self.condition_pending = false;
     }
 
     fn fit(
@@ -176,32 +334,36 @@ impl Estimator for ArxEstimator {
                 actual: 0,
             });
         }
-        // slices indexed by (absolute index − base); the base reaches back to
-        // the oldest row still in the sliding factor (to remove it)
-        let mut base = window.start - lag;
-        if self.factor.valid {
-            let old = self.factor.rows.start;
-            if old < window.start && old >= signals.offset() + lag {
-                base = base.min(old - lag);
-            } else if old < window.start {
-                self.factor.valid = false;
-            }
-        }
+        // slices indexed by (absolute index − base)
+        let base = window.start - lag;
         let w = signals.window(base..window.end, 0, "ARX window (past samples + window)")?;
         let (y, u) = (w.position, w.command);
-        if let Some(i) = y.iter().chain(u).position(|v| !v.is_finite()) {
-            let ch = if i < y.len() { "position" } else { "command" };
-            return Err(Error::NonFinite {
-                channel: ch.to_string(),
-                index: base + i % y.len(),
-                value: f64::NAN,
-            });
+        // samples checked for an earlier window of the same factor are not checked again
+        let known = self.factor.valid && self.checked.start <= base;
+        let from = if known {
+            self.checked.end.clamp(base, window.end)
+        } else {
+            base
+        };
+        for (ch, v) in [("position", y), ("command", u)] {
+            if let Some(i) = v[from - base..].iter().position(|v| !v.is_finite()) {
+                self.factor.invalidate();
+                return Err(Error::NonFinite {
+                    channel: ch.to_string(),
+                    index: from + i,
+                    value: f64::NAN,
+                });
+            }
         }
+        self.checked = if known {
+            self.checked.start..self.checked.end.max(window.end)
+        } else {
+            base..window.end
+        };
         let reference = y[window.end - 1 - base];
         let slid = self.update_factor(y, u, base, window.clone(), reference);
 
         let f = &self.factor;
-        let p = f.p;
         let m = window.len() as f64;
         let excitation = f.centred_norm(1 + orders.na) / m.sqrt();
         let mut diag = ArxDiagnostics {
@@ -213,71 +375,26 @@ impl Estimator for ArxEstimator {
             slid,
         };
 
-        // small problem R·S·M: columns ψ_j − (r − r0)·w_j·1, target likewise
-        let d = reference - f.r0;
         let mut residual_rms = 0.0;
         let mut reason = "";
+        self.condition_pending = false;
         if !(excitation >= self.config.min_excitation) || excitation == 0.0 {
             reason = "standstill (command not exciting)";
         } else {
-            // regressor columns 0..n (ψ), n (ones, with an offset), then the target
             let nr = n + usize::from(self.config.offset);
-            for j in 0..=n {
-                let w = if j < orders.na { -1.0 } else { 1.0 };
-                for i in 0..p {
-                    let v = f.rs(i, j + 1) - d * w * f.rs(i, 0);
-                    if j < n {
-                        self.small_a[i + j * p] = v;
-                    } else {
-                        self.small_b[i] = v;
-                    }
-                }
-            }
-            if self.config.offset {
-                for i in 0..p {
-                    self.small_a[i + n * p] = f.rs(i, 0);
-                }
-            }
-            let mut colscale = [1.0f64; 2 * MAX_ARX_ORDER + 1];
-            for j in 0..nr {
-                let col = &mut self.small_a[j * p..(j + 1) * p];
-                let nrm = col.iter().map(|v| v * v).sum::<f64>().sqrt();
-                if nrm > 0.0 {
-                    colscale[j] = nrm;
-                    for v in col.iter_mut() {
-                        *v /= nrm;
-                    }
-                }
-            }
-            let opts = LstsqOptions {
-                ridge: self.config.ridge,
-                rank_tolerance: None,
-            };
-            match lstsq_in_place(
-                p,
-                nr,
-                &mut self.small_a[..p * nr],
-                &mut self.small_b,
-                &mut self.z[..nr],
-                &mut self.ws,
-                &opts,
-            ) {
+            match self.solve_window() {
                 Err(_) => reason = "rank deficient",
-                Ok(info) => {
-                    diag.condition = info.cond_estimate;
-                    residual_rms = info.residual_norm / m.sqrt();
-                    for j in 0..nr {
-                        self.z[j] /= colscale[j];
-                    }
-                    if !self.config.offset {
-                        self.z[n] = 0.0;
-                    }
+                Ok((condition, rank, residual_norm)) => {
+                    diag.condition = condition;
+                    self.condition_pending = condition.is_nan();
+                    residual_rms = residual_norm / m.sqrt();
                     let th = &self.z[..=n];
                     let g = dc_gain(&orders, th);
                     diag.dc_gain = g;
                     let (lo, hi) = self.config.dc_gain_bounds;
-                    let deficient = (self.config.ridge == 0.0 && info.rank < nr)
-                        || !(info.cond_estimate <= self.config.max_condition);
+                    let deficient = (self.config.ridge == 0.0 && rank < nr)
+                        || (self.config.max_condition < f64::INFINITY
+                            && !(condition <= self.config.max_condition));
                     if deficient {
                         reason = "rank deficient";
                     } else if !th.iter().all(|v| v.is_finite()) {

@@ -41,7 +41,10 @@
 //! Reference: C.F. Van Loan, "Computing integrals involving the matrix
 //! exponential", IEEE TAC 23 (1978); N.J. Higham, *Functions of Matrices*, §10.3.
 
-use nalgebra::{Complex, DMatrix};
+// Index loops mirror the matrix formulas.
+#![allow(clippy::needless_range_loop)]
+
+use nalgebra::Complex;
 
 use crate::error::{Error, Result};
 use crate::lti::{poly_from_roots, poly_roots};
@@ -54,18 +57,21 @@ const TAYLOR_DEGREE: usize = 16;
 
 /// Exact discretisation of `1/A(σ)` in companion form, reusable for any
 /// coefficients of the same order (allocation-free after construction).
+/// Plain column-major arrays: the matrices are at most 14×14, and the
+/// stepping loop runs for every sample of every window.
 #[derive(Debug, Clone)]
 pub(crate) struct Companion {
     n: usize,
-    /// A_d (n×n, column-major).
-    ad: DMatrix<f64>,
+    /// A_d (n×n, column-major: `ad[i + j·n]`).
+    ad: Vec<f64>,
     /// Γ₀ (ZOH input vector).
     g0: Vec<f64>,
     /// Γ₁ (FOH increment vector).
     g1: Vec<f64>,
-    m: DMatrix<f64>,
-    e: DMatrix<f64>,
-    t: DMatrix<f64>,
+    /// `(n+2)×(n+2)` column-major scratch of the exponential.
+    m: Vec<f64>,
+    e: Vec<f64>,
+    t: Vec<f64>,
     scratch: Vec<f64>,
 }
 
@@ -75,12 +81,12 @@ impl Companion {
         let k = n + 2;
         Self {
             n,
-            ad: DMatrix::zeros(n, n),
+            ad: vec![0.0; n * n],
             g0: vec![0.0; n],
             g1: vec![0.0; n],
-            m: DMatrix::zeros(k, k),
-            e: DMatrix::zeros(k, k),
-            t: DMatrix::zeros(k, k),
+            m: vec![0.0; k * k],
+            e: vec![0.0; k * k],
+            t: vec![0.0; k * k],
             scratch: vec![0.0; n],
         }
     }
@@ -101,19 +107,21 @@ impl Companion {
             });
         }
         let k = n + 2;
-        self.m.fill(0.0);
+        let m = &mut self.m;
+        m.fill(0.0);
         for i in 0..n.saturating_sub(1) {
-            self.m[(i, i + 1)] = h;
+            m[i + (i + 1) * k] = h;
         }
         for i in 0..n {
             // α_i multiplies x_i; alpha_desc[0] = α_{n−1}
-            self.m[(n - 1, i)] = -alpha_desc[n - 1 - i] * h;
+            m[(n - 1) + i * k] = -alpha_desc[n - 1 - i] * h;
         }
-        self.m[(n - 1, n)] = h;
-        self.m[(n, n + 1)] = h;
+        m[(n - 1) + n * k] = h;
+        m[n + (n + 1) * k] = h;
         // scaling: ‖M/2ˢ‖₁ ≤ 1/2
-        let norm = (0..k)
-            .map(|j| self.m.column(j).iter().map(|v| v.abs()).sum::<f64>())
+        let norm = m
+            .chunks_exact(k)
+            .map(|col| col.iter().map(|v| v.abs()).sum::<f64>())
             .fold(0.0f64, f64::max);
         let mut s = 0u32;
         if norm > 0.5 {
@@ -125,31 +133,31 @@ impl Companion {
             });
         }
         let scale = 0.5f64.powi(s as i32);
-        self.m *= scale;
+        m.iter_mut().for_each(|v| *v *= scale);
         // Horner: E = I + X/K·(I + X/(K−1)·(…))
         self.e.fill(0.0);
         for i in 0..k {
-            self.e[(i, i)] = 1.0;
+            self.e[i + i * k] = 1.0;
         }
         for d in (1..=TAYLOR_DEGREE).rev() {
-            self.t.gemm(1.0 / d as f64, &self.m, &self.e, 0.0);
+            companion_product(n, 1.0 / d as f64, &self.m, &self.e, &mut self.t);
             for i in 0..k {
-                self.t[(i, i)] += 1.0;
+                self.t[i + i * k] += 1.0;
             }
             std::mem::swap(&mut self.t, &mut self.e);
         }
         for _ in 0..s {
-            self.t.gemm(1.0, &self.e, &self.e, 0.0);
+            gemm(k, 1.0, &self.e, &self.e, &mut self.t);
             std::mem::swap(&mut self.t, &mut self.e);
         }
         for j in 0..n {
             for i in 0..n {
-                self.ad[(i, j)] = self.e[(i, j)];
+                self.ad[i + j * n] = self.e[i + j * k];
             }
         }
         for i in 0..n {
-            self.g0[i] = self.e[(i, n)];
-            self.g1[i] = self.e[(i, n + 1)] / h;
+            self.g0[i] = self.e[i + n * k];
+            self.g1[i] = self.e[i + (n + 1) * k] / h;
         }
         if self
             .ad
@@ -165,11 +173,6 @@ impl Companion {
         Ok(())
     }
 
-    /// A_d of the last discretisation.
-    pub(crate) fn ad(&self) -> &DMatrix<f64> {
-        &self.ad
-    }
-
     /// One zero-order-hold step `x ← A_d·x + Γ₀·v`.
     pub(crate) fn step_zoh(&mut self, x: &mut [f64], v: f64) {
         self.step(x, v, 0.0);
@@ -180,20 +183,311 @@ impl Companion {
         self.step(x, v, v_next - v);
     }
 
+    #[inline]
     fn step(&mut self, x: &mut [f64], v: f64, dv: f64) {
         let n = self.n;
         let s = &mut self.scratch[..n];
         for ((si, g0), g1) in s.iter_mut().zip(&self.g0).zip(&self.g1) {
             *si = g0 * v + g1 * dv;
         }
-        for (j, &xj) in x.iter().enumerate().take(n) {
+        for (col, &xj) in self.ad.chunks_exact(n).zip(x.iter()) {
             if xj != 0.0 {
-                for (si, aij) in s.iter_mut().zip(self.ad.column(j).iter()) {
+                for (si, aij) in s.iter_mut().zip(col) {
                     *si += aij * xj;
                 }
             }
         }
         x[..n].copy_from_slice(s);
+    }
+}
+
+/// The window quantities of the output-error fit from the last
+/// discretisation: the forced response from the zero state `forced[k]`, the
+/// observability rows `obs[k + j·w] = (C·A_dᵏ)_j` (`C` from `beta_desc`) and
+/// `rhs = y − forced`. The order is a constant for `n ≤ 8` (the state lives
+/// in registers); the same operations in the same order as stepping with
+/// [`Companion::step_zoh`] and [`output`].
+pub(crate) fn window_responses(
+    comp: &Companion,
+    beta_desc: &[f64],
+    u: &[f64],
+    y: &[f64],
+    forced: &mut [f64],
+    obs: &mut [f64],
+    rhs: &mut [f64],
+) {
+    macro_rules! fixed {
+        ($($n:literal),*) => {
+            match comp.n {
+                $($n => responses::<$n>(&comp.ad, &comp.g0, beta_desc, u, y, forced, obs, rhs),)*
+                _ => responses_dyn(comp, beta_desc, u, y, forced, obs, rhs),
+            }
+        };
+    }
+    fixed!(1, 2, 3, 4, 5, 6, 7, 8);
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn responses<const N: usize>(
+    ad: &[f64],
+    g0: &[f64],
+    beta_desc: &[f64],
+    u: &[f64],
+    y: &[f64],
+    forced: &mut [f64],
+    obs: &mut [f64],
+    rhs: &mut [f64],
+) {
+    let w = u.len();
+    let mut a = [[0.0; N]; N]; // a[j] = column j of A_d
+    for (j, col) in a.iter_mut().enumerate() {
+        col.copy_from_slice(&ad[j * N..(j + 1) * N]);
+    }
+    let mut g = [0.0; N];
+    g.copy_from_slice(&g0[..N]);
+    let mb = beta_desc.len();
+    // The forced response from the zero state and the observability rows
+    // o_0 = C (c_i = β_i), o_{k+1} = o_k·A_d, in one loop: two independent
+    // recursions whose latencies overlap.
+    let mut x = [0.0; N];
+    let mut row = [0.0; N];
+    for (i, b) in beta_desc.iter().enumerate() {
+        row[mb - 1 - i] = *b;
+    }
+    for k in 0..w {
+        let uk = u[k];
+        let mut f = 0.0;
+        for (kk, b) in beta_desc.iter().enumerate() {
+            f += b * x[mb - 1 - kk];
+        }
+        forced[k] = f;
+        rhs[k] = y[k] - f;
+        let mut s = [0.0; N];
+        for i in 0..N {
+            s[i] = g[i] * uk + 0.0;
+        }
+        // (A_d is finite: the terms of zero states add exact zeros, as the
+        // skipped ones of `step`)
+        for j in 0..N {
+            for i in 0..N {
+                s[i] += a[j][i] * x[j];
+            }
+        }
+        x = s;
+        let mut next = [0.0; N];
+        for j in 0..N {
+            obs[k + j * w] = row[j];
+            let mut v = 0.0;
+            for i in 0..N {
+                v += row[i] * a[j][i];
+            }
+            next[j] = v;
+        }
+        row = next;
+    }
+}
+
+/// The output `ŷ_k = C·x_k` of the last discretisation over `u` from the
+/// state `x0` (`beta_desc` as in [`output`]), with the states `x_k` into
+/// `states` (`states[k + j·w]`, state `j`) if given. Fixed order up to 8.
+pub(crate) fn simulate_from(
+    comp: &Companion,
+    beta_desc: &[f64],
+    x0: &[f64],
+    u: &[f64],
+    out: &mut [f64],
+    states: Option<&mut [f64]>,
+) {
+    macro_rules! fixed {
+        ($($n:literal),*) => {
+            match comp.n {
+                $($n => simulate::<$n>(comp, beta_desc, x0, u, out, states),)*
+                _ => simulate::<0>(comp, beta_desc, x0, u, out, states),
+            }
+        };
+    }
+    fixed!(1, 2, 3, 4, 5, 6, 7, 8);
+}
+
+#[inline(always)]
+fn simulate<const N: usize>(
+    comp: &Companion,
+    beta_desc: &[f64],
+    x0: &[f64],
+    u: &[f64],
+    out: &mut [f64],
+    states: Option<&mut [f64]>,
+) {
+    if N == 0 {
+        return simulate_dyn(comp, beta_desc, x0, u, out, states);
+    }
+    let w = u.len();
+    let mb = beta_desc.len();
+    let mut a = [[0.0; N]; N]; // a[j] = column j of A_d
+    for (j, col) in a.iter_mut().enumerate() {
+        col.copy_from_slice(&comp.ad[j * N..(j + 1) * N]);
+    }
+    let mut g = [0.0; N];
+    g.copy_from_slice(&comp.g0[..N]);
+    let mut c = [0.0; N]; // the output row: c[mb−1−kk] = β_desc[kk]
+    for (kk, b) in beta_desc.iter().enumerate() {
+        c[mb - 1 - kk] = *b;
+    }
+    let mut x = [0.0; N];
+    x.copy_from_slice(&x0[..N]);
+    let (u, out) = (&u[..w], &mut out[..w]);
+    if let Some(st) = states {
+        let st = &mut st[..w * N];
+        for k in 0..w {
+            out[k] = (0..N).map(|j| c[j] * x[j]).sum();
+            for j in 0..N {
+                st[k + j * w] = x[j];
+            }
+            x = step_fixed(&a, &g, &x, u[k]);
+        }
+    } else {
+        for k in 0..w {
+            out[k] = (0..N).map(|j| c[j] * x[j]).sum();
+            x = step_fixed(&a, &g, &x, u[k]);
+        }
+    }
+}
+
+/// `A_d·x + Γ₀·v` for a fixed order.
+#[inline(always)]
+fn step_fixed<const N: usize>(a: &[[f64; N]; N], g: &[f64; N], x: &[f64; N], v: f64) -> [f64; N] {
+    let mut s = [0.0; N];
+    for i in 0..N {
+        s[i] = g[i] * v;
+    }
+    for j in 0..N {
+        for i in 0..N {
+            s[i] += a[j][i] * x[j];
+        }
+    }
+    s
+}
+
+/// [`simulate`] for any order.
+fn simulate_dyn(
+    comp: &Companion,
+    beta_desc: &[f64],
+    x0: &[f64],
+    u: &[f64],
+    out: &mut [f64],
+    mut states: Option<&mut [f64]>,
+) {
+    let n = comp.n;
+    let w = u.len();
+    let mb = beta_desc.len();
+    let mut x = [0.0; MAX_ORDER];
+    let mut s = [0.0; MAX_ORDER];
+    x[..n].copy_from_slice(&x0[..n]);
+    for k in 0..w {
+        let mut f = 0.0;
+        for (kk, b) in beta_desc.iter().enumerate() {
+            f += b * x[mb - 1 - kk];
+        }
+        out[k] = f;
+        if let Some(st) = states.as_deref_mut() {
+            for j in 0..n {
+                st[k + j * w] = x[j];
+            }
+        }
+        for i in 0..n {
+            s[i] = comp.g0[i] * u[k];
+        }
+        for j in 0..n {
+            for i in 0..n {
+                s[i] += comp.ad[i + j * n] * x[j];
+            }
+        }
+        x[..n].copy_from_slice(&s[..n]);
+    }
+}
+
+/// [`responses`] for any order.
+fn responses_dyn(
+    comp: &Companion,
+    beta_desc: &[f64],
+    u: &[f64],
+    y: &[f64],
+    forced: &mut [f64],
+    obs: &mut [f64],
+    rhs: &mut [f64],
+) {
+    let n = comp.n;
+    let w = u.len();
+    let mut x = [0.0; MAX_ORDER];
+    let mut s = [0.0; MAX_ORDER];
+    for k in 0..w {
+        forced[k] = output(beta_desc, &x[..n]);
+        rhs[k] = y[k] - forced[k];
+        for i in 0..n {
+            s[i] = comp.g0[i] * u[k] + comp.g1[i] * 0.0;
+        }
+        for j in 0..n {
+            if x[j] != 0.0 {
+                for i in 0..n {
+                    s[i] += comp.ad[i + j * n] * x[j];
+                }
+            }
+        }
+        x[..n].copy_from_slice(&s[..n]);
+    }
+    let mb = beta_desc.len();
+    let mut row = [0.0; MAX_ORDER];
+    let mut next = [0.0; MAX_ORDER];
+    for (i, b) in beta_desc.iter().enumerate() {
+        row[mb - 1 - i] = *b;
+    }
+    for k in 0..w {
+        for j in 0..n {
+            obs[k + j * w] = row[j];
+        }
+        for j in 0..n {
+            next[j] = (0..n).map(|i| row[i] * comp.ad[i + j * n]).sum();
+        }
+        row[..n].copy_from_slice(&next[..n]);
+    }
+}
+
+/// `c = α·m·e` for the scaled Van Loan matrix `m` of [`Companion::discretize`]
+/// (`k = n + 2`, column-major): only its superdiagonal and row `n − 1`
+/// are non-zero, so row `i` of the product is `m[i][i+1]·e[i+1]` (`i ≠ n−1`)
+/// or `Σ_{j ≤ n} m[n−1][j]·e[j]`, `O(k·n)` instead of `O(k³)`.
+fn companion_product(n: usize, alpha: f64, m: &[f64], e: &[f64], c: &mut [f64]) {
+    let k = n + 2;
+    // the superdiagonal entries are all the scaled step; row n−1 is dense up to column n
+    let row: [f64; MAX_ORDER + 1] =
+        std::array::from_fn(|l| if l <= n { m[(n - 1) + l * k] } else { 0.0 });
+    for (cj, ej) in c.chunks_exact_mut(k).zip(e.chunks_exact(k)) {
+        for i in 0..n - 1 {
+            cj[i] = m[i + (i + 1) * k] * (alpha * ej[i + 1]);
+        }
+        let mut s = 0.0;
+        for (r, &elj) in row[..=n].iter().zip(ej) {
+            s += r * (alpha * elj);
+        }
+        cj[n - 1] = s;
+        cj[n] = m[n + (n + 1) * k] * (alpha * ej[n + 1]);
+        cj[n + 1] = 0.0;
+    }
+}
+
+/// `c = α·a·b` for column-major `k×k` matrices.
+fn gemm(k: usize, alpha: f64, a: &[f64], b: &[f64], c: &mut [f64]) {
+    for (cj, bj) in c.chunks_exact_mut(k).zip(b.chunks_exact(k)) {
+        cj.fill(0.0);
+        for (al, &blj) in a.chunks_exact(k).zip(bj) {
+            if blj != 0.0 {
+                let f = alpha * blj;
+                for (ci, &ail) in cj.iter_mut().zip(al) {
+                    *ci += ail * f;
+                }
+            }
+        }
     }
 }
 

@@ -5,4 +5,4 @@ mod companion;
 mod estimator;
 mod srivc;
 
-pub use estimator::{fit_oe, OeConfig, OeEstimator, OeFit};
+pub use estimator::{fit_oe, OeConfig, OeEstimator, OeFit, OeJacobian};

@@ -31,17 +31,20 @@ pub(super) fn affine_to_monomial(m: &[f64], c: f64, h: f64, out: &mut [f64]) {
     for v in out.iter_mut() {
         *v = 0.0;
     }
+    // multiplications by 1/h and c/h instead of two divisions per term
+    let (ih, ch) = (1.0 / h, c / h);
     for j in (0..n).rev() {
         // out ← out·(τ/h − c/h) + m_j
         for i in (0..n).rev() {
             let lower = if i > 0 { out[i - 1] } else { 0.0 };
-            out[i] = lower / h - out[i] * c / h;
+            out[i] = lower * ih - out[i] * ch;
         }
         out[0] += m[j];
     }
 }
 
 /// Scale `v` to unit 2-norm and return the norm (1 for a zero vector, which is kept).
+#[cfg(test)]
 pub(super) fn normalise(v: &mut [f64]) -> f64 {
     let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     if n > 0.0 && n.is_finite() {

@@ -27,6 +27,22 @@ pub enum TimeOrigin {
     Window,
 }
 
+/// Where the simplex starts in each window ([`Solver::Simplex`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SimplexStart {
+    /// Zero coefficients, start steps `step_rel·‖b‖` (default; every window
+    /// independent of the others, as the paper's description reads).
+    #[default]
+    Zeros,
+    /// The previous window's fitted polynomials, projected on this window's
+    /// basis (zero after a rest window or [`Estimator::reset`](crate::ident::Estimator::reset)), with start
+    /// steps `step_rel` times the distance of that start from the best
+    /// polynomial of degree 7 (at least `100·xtol_data·‖b‖`). Fewer
+    /// iterations; results then depend on the previous window (the same in
+    /// batch and streaming use, which visit the same windows in order).
+    Previous,
+}
+
 /// How the next samples are predicted from a window's fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PredictionMode {
@@ -53,6 +69,31 @@ impl TimeOrigin {
         match self {
             TimeOrigin::Motion => "motion",
             TimeOrigin::Window => "window",
+        }
+    }
+}
+
+impl SimplexStart {
+    /// Lowercase name as used on the command line.
+    pub fn label(self) -> &'static str {
+        match self {
+            SimplexStart::Zeros => "zeros",
+            SimplexStart::Previous => "previous",
+        }
+    }
+}
+
+impl FromStr for SimplexStart {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "zeros" | "zero" => Ok(SimplexStart::Zeros),
+            "previous" => Ok(SimplexStart::Previous),
+            _ => Err(Error::InvalidChoice {
+                what: "simplex start",
+                value: s.to_string(),
+                expected: "zeros, previous",
+            }),
         }
     }
 }
@@ -165,6 +206,9 @@ pub struct PaperConfig {
     pub prediction: PredictionMode,
     /// Simplex settings (used with [`Solver::Simplex`]).
     pub simplex: SimplexSettings,
+    /// Start of the simplex in each window (used with [`Solver::Simplex`]).
+    /// Default [`SimplexStart::Zeros`].
+    pub simplex_start: SimplexStart,
 }
 
 /// Growth factor `(1 + |τ_c|/h)⁷` of the change of basis to monomial
@@ -237,8 +281,16 @@ impl PaperConfig {
     }
 
     /// Check the simplex settings (finite non-negative tolerances, positive
-    /// start step, iteration and evaluation caps of at least 1).
+    /// start step, iteration and evaluation caps of at least 1; a simplex
+    /// start other than zeros only with the simplex solver).
     pub fn validate(&self) -> Result<()> {
+        if self.simplex_start != SimplexStart::Zeros && self.solver != Solver::Simplex {
+            return Err(Error::NotApplicable {
+                setting: "simplex start",
+                method: "paper (qr solver)",
+                applies_to: "paper with the simplex solver",
+            });
+        }
         let s = &self.simplex;
         for (name, v) in [
             ("simplex.xtol_data", s.xtol_data),

@@ -4,14 +4,17 @@
 
 use std::ops::Range;
 
-use super::basis::{affine_to_monomial, legendre_monomials, normalise, LEGENDRE_A, LEGENDRE_B};
-use super::config::{shift_amplification, PaperConfig, PredictionMode, Solver, TimeOrigin};
+use super::basis::{affine_to_monomial, legendre_monomials};
+use super::config::{
+    shift_amplification, PaperConfig, PredictionMode, SimplexStart, Solver, TimeOrigin,
+};
 use super::polynomials::{coefficients_from_polynomials, NAMES, NC, NP, NQ};
-use super::simplex::simplex_fit;
+use super::projection::{LegendreTables, Projection};
+use super::simplex::{simplex_fit, Reduced};
 use crate::error::{Error, Result};
 use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
 use crate::lti::TransferFunction;
-use crate::solve::{lstsq_in_place, LstsqInfo, LstsqOptions, NelderMead, QrWorkspace, Termination};
+use crate::solve::{lstsq_fixed, LstsqInfo, NelderMead, QrWorkspace, Termination};
 
 /// Per-window diagnostics of the last fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,13 +64,14 @@ pub struct PaperMethod {
     pub(super) config: PaperConfig,
     /// Held position of the last window if it was a rest window.
     pub(super) rest_hold: Option<f64>,
-    pub(super) legendre: [[f64; NQ]; NQ],
+    pub(super) tables: LegendreTables,
     pub(super) cap: usize,
+    /// The window's `τ`, then its grid `s`.
     pub(super) tau: Vec<f64>,
     pub(super) data: Vec<f64>,
-    pub(super) design_out: Vec<f64>,
-    pub(super) design_in: Vec<f64>,
     pub(super) work: Vec<f64>,
+    /// The window basis's QR, reused while the grid repeats.
+    pub(super) projection: Projection,
     pub(super) rhs: Vec<f64>,
     pub(super) resid: Vec<f64>,
     pub(super) qr: QrWorkspace,
@@ -87,13 +91,12 @@ impl PaperMethod {
         Self {
             config,
             rest_hold: None,
-            legendre: legendre_monomials(),
+            tables: LegendreTables::new(legendre_monomials()),
             cap: 0,
             tau: Vec::new(),
             data: Vec::new(),
-            design_out: Vec::new(),
-            design_in: Vec::new(),
             work: Vec::new(),
+            projection: Projection::new(),
             rhs: Vec::new(),
             resid: Vec::new(),
             qr: QrWorkspace::new(NQ),
@@ -155,9 +158,7 @@ impl PaperMethod {
         if w > self.cap {
             self.tau.resize(w, 0.0);
             self.data.resize(w, 0.0);
-            self.design_out.resize(NP * w, 0.0);
-            self.design_in.resize(NQ * w, 0.0);
-            self.work.resize(NQ * w, 0.0);
+            self.work.resize(w, 0.0);
             self.rhs.resize(w, 0.0);
             self.resid.resize(w, 0.0);
             self.cap = w;
@@ -308,106 +309,135 @@ impl Estimator for PaperMethod {
             });
         }
 
-        // --- bases (column-major), columns normalised to unit norm
-        let mut norm_out = [0.0; NP];
-        let mut norm_in = [0.0; NQ];
-        {
-            let g_out = &mut self.design_out[..NP * w];
-            let g_in = &mut self.design_in[..NQ * w];
-            // multiplications by reciprocals: no division in the per-sample loop
-            let (inv_half, inv_t) = (1.0 / half, 1.0 / t_scale);
-            for i in 0..w {
-                let s = (tau[i] - centre) * inv_half;
-                let wt = (tau[i] * inv_t).powi(5);
-                // Legendre recurrence L_{k+1} = ((2k+1) s L_k − k L_{k−1})/(k+1)
-                let mut lm1 = 1.0;
-                let mut l = s;
-                g_in[i] = 1.0;
-                g_in[i + w] = s;
-                for k in 1..NQ - 1 {
-                    let next = LEGENDRE_A[k] * s * l - LEGENDRE_B[k] * lm1;
-                    lm1 = l;
-                    l = next;
-                    g_in[i + (k + 1) * w] = l;
-                }
-                for k in 0..NP {
-                    g_out[i + k * w] = wt * g_in[i + k * w];
-                }
-            }
-            for (k, nk) in norm_out.iter_mut().enumerate() {
-                let col = &mut g_out[k * w..(k + 1) * w];
-                *nk = normalise(col);
-            }
-            for (k, nk) in norm_in.iter_mut().enumerate() {
-                let col = &mut g_in[k * w..(k + 1) * w];
-                *nk = normalise(col);
-            }
+        // --- the grid s_i; the cached projection if the grid repeats
+        let inv_half = 1.0 / half;
+        for v in tau.iter_mut() {
+            *v = (*v - centre) * inv_half;
         }
+        let tol = (8.0 * (time[0].abs() + time[w - 1].abs() + origin.abs()) * inv_half + 64.0)
+            * f64::EPSILON;
+        if !self.projection.matches(&self.tau[..w], tol) {
+            self.projection.build(&self.tau[..w], &mut self.qr)?;
+        }
+        let proj = &self.projection;
 
-        // --- solve both problems in the normalised basis
+        // --- data projected on the 8 Legendre polynomials of the window
+        for (r, p) in self.rhs[..w].iter_mut().zip(pos) {
+            *r = p - y_ref;
+        }
+        for (r, c) in self.data[..w].iter_mut().zip(cmd) {
+            *r = c - u_ref;
+        }
+        let (mut cy, mut cu) = ([0.0; NQ], [0.0; NQ]);
+        let (rest_y, rest_u) = proj.project2(&self.rhs[..w], &self.data[..w], &mut cy, &mut cu);
+        // the output basis (τ/T)⁵·L_k(s) in the projected coordinates, unit-norm columns
+        let mut m_out = [0.0; NQ * NP];
+        let mut norm_out = [0.0; NP];
+        proj.output_matrix(
+            &self.tables,
+            centre / t_scale,
+            half / t_scale,
+            &mut m_out,
+            &mut norm_out,
+        );
+        for (k, nk) in norm_out.iter_mut().enumerate() {
+            if !(*nk > 0.0 && nk.is_finite()) {
+                *nk = 1.0;
+            }
+            m_out[k * NQ..(k + 1) * NQ]
+                .iter_mut()
+                .for_each(|v| *v /= *nk);
+        }
+        // rank tolerance of the direct W×3 fit
+        let rank_tol = Some(w as f64 * f64::EPSILON);
+
+        // --- solve both problems (coordinates of the unit-norm bases)
         let mut z_out = [0.0; NP];
         let mut z_in = [0.0; NQ];
         let (out_sse, in_sse, iterations, termination, out_info, in_info);
         match self.config.solver {
             Solver::Qr => {
-                let opts = LstsqOptions::default();
-                self.work[..NP * w].copy_from_slice(&self.design_out[..NP * w]);
-                for (r, p) in self.rhs[..w].iter_mut().zip(pos) {
-                    *r = p - y_ref;
+                let (z, io) = lstsq_fixed::<NQ, NP>(&columns(&m_out), &cy, rank_tol)?;
+                z_out = z;
+                let mut a = [0.0; NQ];
+                proj.input_coefficients(&cu, &mut a);
+                for k in 0..NQ {
+                    z_in[k] = a[k] * proj.vnorm[k];
                 }
-                let io = lstsq_in_place(
-                    w,
-                    NP,
-                    &mut self.work[..NP * w],
-                    &mut self.rhs[..w],
-                    &mut z_out,
-                    &mut self.qr,
-                    &opts,
-                )?;
-                self.work[..NQ * w].copy_from_slice(&self.design_in[..NQ * w]);
-                for (r, c) in self.rhs[..w].iter_mut().zip(cmd) {
-                    *r = c - u_ref;
-                }
-                let ii = lstsq_in_place(
-                    w,
-                    NQ,
-                    &mut self.work[..NQ * w],
-                    &mut self.rhs[..w],
-                    &mut z_in,
-                    &mut self.qr,
-                    &opts,
-                )?;
-                out_sse = io.residual_norm * io.residual_norm;
-                in_sse = ii.residual_norm * ii.residual_norm;
+                out_sse = io.residual_norm * io.residual_norm + rest_y * rest_y;
+                in_sse = rest_u * rest_u;
                 iterations = 0;
                 termination = Termination::Exact;
-                out_info = Some(io);
-                in_info = Some(ii);
+                out_info = Some(LstsqInfo {
+                    residual_norm: out_sse.sqrt(),
+                    ..io
+                });
+                in_info = Some(proj.input_info(rest_u));
             }
             Solver::Simplex => {
                 let settings = self.config.simplex;
+                let mut m_in = [0.0; NQ * NQ];
+                proj.input_matrix(&mut m_in);
+                // the start: zeros, or the previous window's polynomials on this window
+                let start = match (self.config.simplex_start, self.last.as_ref()) {
+                    (SimplexStart::Previous, Some(prev)) => {
+                        let prev = *prev;
+                        for ((v, &t), r) in self.resid[..w]
+                            .iter_mut()
+                            .zip(time)
+                            .zip(self.work.iter_mut())
+                        {
+                            *v = prev.y_ref + Self::eval_output(&prev, t) - y_ref;
+                            *r = prev.u_ref + Self::eval_input(&prev, t) - u_ref;
+                        }
+                        let (mut py, mut pu) = ([0.0; NQ], [0.0; NQ]);
+                        proj.project2(&self.resid[..w], &self.work[..w], &mut py, &mut pu);
+                        z_out = lstsq_fixed::<NQ, NP>(&columns(&m_out), &py, rank_tol)
+                            .map_or([0.0; NP], |(z, _)| z);
+                        let mut a = [0.0; NQ];
+                        proj.input_coefficients(&pu, &mut a);
+                        for k in 0..NQ {
+                            z_in[k] = a[k] * proj.vnorm[k];
+                        }
+                        let finite = z_out.iter().chain(&z_in).all(|v| v.is_finite());
+                        if !finite {
+                            z_out = [0.0; NP];
+                            z_in = [0.0; NQ];
+                        }
+                        finite
+                    }
+                    _ => false,
+                };
+                let ynorm = (self.rhs[..w].iter().map(|v| v * v).sum::<f64>()).sqrt();
+                let unorm = (self.data[..w].iter().map(|v| v * v).sum::<f64>()).sqrt();
                 let mut steps = [0.0; NQ];
-                for (r, p) in self.data[..w].iter_mut().zip(pos) {
-                    *r = p - y_ref;
-                }
                 let (fo, it_o, term_o) = simplex_fit(
                     &mut self.nm_out,
-                    &self.design_out[..NP * w],
-                    &self.data[..w],
-                    &mut self.resid[..w],
+                    &Reduced {
+                        m: &m_out,
+                        c: &cy,
+                        rest2: rest_y * rest_y,
+                        bnorm: ynorm,
+                        rows: w,
+                        triangular: false,
+                    },
                     &mut z_out,
+                    start,
                     &settings,
                     &mut steps[..NP],
                 )?;
-                for (r, c) in self.data[..w].iter_mut().zip(cmd) {
-                    *r = c - u_ref;
-                }
                 let (fi, it_i, term_i) = simplex_fit(
                     &mut self.nm_in,
-                    &self.design_in[..NQ * w],
-                    &self.data[..w],
-                    &mut self.resid[..w],
+                    &Reduced {
+                        m: &m_in,
+                        c: &cu,
+                        rest2: rest_u * rest_u,
+                        bnorm: unorm,
+                        rows: w,
+                        triangular: true,
+                    },
                     &mut z_in,
+                    start,
                     &settings,
                     &mut steps,
                 )?;
@@ -425,6 +455,7 @@ impl Estimator for PaperMethod {
                 in_info = None;
             }
         }
+        let norm_in = proj.vnorm;
 
         // --- back to the unnormalised Legendre basis, then to monomials in τ
         let mut a_out = [0.0; NP];
@@ -436,7 +467,7 @@ impl Estimator for PaperMethod {
             a_in[k] = z_in[k] / norm_in[k];
         }
         let mut ms = [0.0; NQ];
-        for (ak, lk) in a_out.iter().zip(&self.legendre) {
+        for (ak, lk) in a_out.iter().zip(&self.tables.table) {
             for (mj, lkj) in ms.iter_mut().zip(lk).take(NP) {
                 *mj += ak * lkj;
             }
@@ -446,7 +477,7 @@ impl Estimator for PaperMethod {
         let t5 = t_scale.powi(5);
         let p = [r[0] / t5, r[1] / t5, r[2] / t5];
         let mut ms = [0.0; NQ];
-        for (ak, lk) in a_in.iter().zip(&self.legendre) {
+        for (ak, lk) in a_in.iter().zip(&self.tables.table) {
             for (mj, lkj) in ms.iter_mut().zip(lk) {
                 *mj += ak * lkj;
             }
@@ -559,6 +590,15 @@ impl Estimator for PaperMethod {
         }
         Ok(PredictStatus::Predicted)
     }
+}
+
+/// The 8×3 column-major output matrix as three columns.
+fn columns(m: &[f64; NQ * NP]) -> [[f64; NQ]; NP] {
+    let mut c = [[0.0; NQ]; NP];
+    for (k, col) in c.iter_mut().enumerate() {
+        col.copy_from_slice(&m[k * NQ..(k + 1) * NQ]);
+    }
+    c
 }
 
 /// Response of the identified `N(s)/D(s)` (coefficients `[N2, N1, N0, D7 … D0]`)

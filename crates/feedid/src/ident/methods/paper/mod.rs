@@ -43,24 +43,40 @@
 //! [`PredictionMode::Polynomial`] are evaluated in the fitted basis and stay
 //! accurate regardless.
 //!
+//! **One projection per sample grid.** The basis `L_0(s) … L_7(s)` depends
+//! only on the window's grid `s_i`, which a uniformly sampled recording
+//! repeats in every window, with either time origin; its thin QR
+//! `V = Q·R` is computed once and reused while the grid repeats (to the
+//! rounding of `s_i` itself), and a window costs the projections `Qᵀb`
+//! (`8·W` multiply-adds each). The output basis is an exact polynomial
+//! transform `V·C` of the local one (`C` from `(τ_c/T + (h/T)·s)⁵·L_k(s)`),
+//! so the output fit is an 8×3 problem. Jittered grids rebuild the QR per
+//! window. See `projection.rs`.
+//!
 //! **Solvers** ([`Solver`]): `Qr` is the exact linear least-squares solution
-//! (Householder QR, [`crate::solve::lstsq_in_place`]); `Simplex` is the
-//! paper's Nelder–Mead minimisation of the same sums of squares, evaluated
-//! directly from the residuals on the scaled basis: once for the 3 output
-//! coefficients and once for the 8 input coefficients. The paper is silent on
-//! the start and the tolerances; here every window starts from **zero
-//! coefficients** (each window is then independent of the previous ones, so
-//! results do not depend on the hop, on the order of processing or on
-//! batch vs streaming use) with start steps `step_rel·‖b‖` and tolerances
-//! relative to the window's data norm `‖b‖` (see [`SimplexSettings`]). With
+//! (Householder QR with column pivoting, [`crate::solve::lstsq_in_place`]'s
+//! algorithm, on the projected problems); `Simplex` is the
+//! paper's Nelder–Mead minimisation of the same sums of squares, evaluated in
+//! the projected form `‖M·z − Qᵀb‖² + ‖b⊥‖²` (the same function, `8·n`
+//! instead of `W·n` multiply-adds): once for the 3 output coefficients and
+//! once for the 8 input coefficients. The paper is silent on the start and
+//! the tolerances; by default ([`SimplexStart::Zeros`]) every window starts
+//! from **zero coefficients** (each window is then independent of the
+//! previous ones, so results do not depend on the hop, on the order of
+//! processing or on batch vs streaming use) with start steps `step_rel·‖b‖`;
+//! [`SimplexStart::Previous`] starts from the previous window's polynomials
+//! projected on this window's basis, with start steps scaled to that start's
+//! distance from the best degree-7 polynomial (about 2.5× fewer iterations).
+//! Tolerances are relative to the window's data norm `‖b‖` (see
+//! [`SimplexSettings`]). With
 //! the defaults the simplex resolves exactly representable data to
 //! `‖G·Δz‖ ≈ 1e-13·‖b‖` and otherwise to the rounding level of the sum of
 //! squares, so that simplex and QR coefficients agree to 1e-6 relative where
 //! the change of basis is benign, and predictions agree to 1e-6 of the data
 //! scale everywhere. This costs about 150 iterations for the 3-parameter
-//! output fit and 600–1000 for the 8-parameter input fit per window (one or
-//! two objective evaluations of `W·n` multiply-adds each): the simplex is two
-//! orders of magnitude slower than QR, which is the default.
+//! output fit and 600–1000 for the 8-parameter input fit per window from
+//! zeros: the simplex is two orders of magnitude slower than QR, which is
+//! the default.
 //!
 //! **Prediction** ([`PredictionMode`]): `Polynomial` (default) continues the
 //! fitted output polynomial over the horizon — the response of the identified
@@ -101,12 +117,14 @@ mod basis;
 mod config;
 mod estimator;
 mod polynomials;
+mod projection;
 mod simplex;
 #[cfg(test)]
 mod tests;
 
 pub use config::{
-    PaperConfig, PredictionMode, SimplexSettings, Solver, TimeOrigin, SHIFT_AMPLIFICATION_WARNING,
+    PaperConfig, PredictionMode, SimplexSettings, SimplexStart, Solver, TimeOrigin,
+    SHIFT_AMPLIFICATION_WARNING,
 };
 pub use estimator::{PaperDiagnostics, PaperMethod};
 pub use polynomials::{coefficients_from_polynomials, polynomials_from_coefficients};

@@ -537,12 +537,12 @@ fn buffers_are_not_regrown_for_windows_of_the_same_size() {
     let s = d.signals(0.0);
     let mut m = method(Solver::Simplex, TimeOrigin::Motion);
     fit(&mut m, &s, 0..W);
-    let ptrs = (m.tau.as_ptr(), m.design_in.as_ptr(), m.work.as_ptr(), m.cap);
+    let ptrs = (m.tau.as_ptr(), m.data.as_ptr(), m.work.as_ptr(), m.cap);
     for start in (10..80).step_by(10) {
         fit(&mut m, &s, start..start + W);
         assert_eq!(
             ptrs,
-            (m.tau.as_ptr(), m.design_in.as_ptr(), m.work.as_ptr(), m.cap)
+            (m.tau.as_ptr(), m.data.as_ptr(), m.work.as_ptr(), m.cap)
         );
     }
     // a longer window grows once
@@ -887,4 +887,250 @@ fn transfer_function_mode_runs_in_the_engine_without_nan() {
         .iter()
         .zip(&r.has_prediction)
         .all(|(p, h)| !h || p.is_finite()));
+}
+
+/// The direct fit of one window as the method computed it before the
+/// cached projection (the test oracle): bases on the window's own grid,
+/// unit-norm columns, pivoted Householder QR of the `W×3` and `W×8`
+/// problems. Returns the prediction of the horizon `[e, e+h)` (motion or
+/// window origin, polynomial mode) and the output residual rms.
+fn direct_fit(
+    origin: TimeOrigin,
+    s: &Signals<'_>,
+    window: Range<usize>,
+    h: usize,
+) -> Option<(Vec<f64>, f64)> {
+    use crate::solve::{lstsq_in_place, LstsqOptions, QrWorkspace};
+    let w = window.len();
+    let all = s.all();
+    let time = &all.time[window.clone()];
+    let pos = &all.position[window.clone()];
+    let (o, y_ref) = match origin {
+        TimeOrigin::Motion => {
+            let ms = s.motion_start();
+            if time[w - 1] <= ms {
+                return None;
+            }
+            let y_ref = all
+                .time
+                .iter()
+                .rposition(|&t| t <= ms)
+                .map_or(0.0, |k| all.position[k]);
+            (ms, y_ref)
+        }
+        TimeOrigin::Window => (time[0], 0.0),
+    };
+    let tau: Vec<f64> = time.iter().map(|t| t - o).collect();
+    let (t_first, t_last) = (tau[0], tau[w - 1]);
+    let centre = 0.5 * (t_first + t_last);
+    let half = 0.5 * (t_last - t_first);
+    let t_scale = tau.iter().fold(0.0f64, |a, t| a.max(t.abs()));
+    let mut g = vec![0.0; NP * w];
+    for i in 0..w {
+        let sv = (tau[i] - centre) / half;
+        let wt = (tau[i] / t_scale).powi(5);
+        let (mut lm1, mut l) = (1.0, sv);
+        let mut leg = [0.0; NQ];
+        leg[0] = 1.0;
+        leg[1] = sv;
+        for k in 1..NQ - 1 {
+            let next = LEGENDRE_A[k] * sv * l - LEGENDRE_B[k] * lm1;
+            lm1 = l;
+            l = next;
+            leg[k + 1] = l;
+        }
+        for k in 0..NP {
+            g[i + k * w] = wt * leg[k];
+        }
+    }
+    let mut norms = [0.0; NP];
+    for k in 0..NP {
+        norms[k] = normalise(&mut g[k * w..(k + 1) * w]);
+    }
+    let mut b: Vec<f64> = pos.iter().map(|p| p - y_ref).collect();
+    let mut z = [0.0; NP];
+    let info = lstsq_in_place(
+        w,
+        NP,
+        &mut g,
+        &mut b,
+        &mut z,
+        &mut QrWorkspace::new(NQ),
+        &LstsqOptions::default(),
+    )
+    .ok()?;
+    let times = &all.time[window.end..window.end + h];
+    let pred = times
+        .iter()
+        .map(|&t| {
+            let tau = t - o;
+            let sv = (tau - centre) / half;
+            let l2 = 1.5 * sv * sv - 0.5;
+            y_ref
+                + (tau / t_scale).powi(5)
+                    * (z[0] / norms[0] + z[1] / norms[1] * sv + z[2] / norms[2] * l2)
+        })
+        .collect();
+    Some((pred, info.residual_norm / (w as f64).sqrt()))
+}
+
+/// A named recording: (name, time, command, position, motion start).
+type Named = (&'static str, Vec<f64>, Vec<f64>, Vec<f64>, f64);
+
+/// The rig's ramp and step (every effect on, seed 3) at 5 kHz, and a
+/// seeded random smooth motion far from the motion start.
+fn oracle_recordings() -> Vec<Named> {
+    use crate::drive::{RigParams, VirtualRig};
+    use crate::signal::Scenario;
+    use rand::{Rng, SeedableRng};
+    let mut out = vec![];
+    for (name, scenario, seconds) in [("ramp", Scenario::Ramp, 0.8), ("step", Scenario::Step, 0.1)]
+    {
+        let command = scenario.command(5000.0, seconds, 3).unwrap();
+        let r = VirtualRig::new(RigParams::default())
+            .with_seed(3)
+            .simulate(&command, 5000.0)
+            .unwrap();
+        let ms = crate::Recording::new(r.time.clone(), r.command.clone(), r.position.clone())
+            .unwrap()
+            .motion_start_time();
+        out.push((name, r.time, r.command, r.position, ms));
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let n = 3000;
+    let (mut y, mut v) = (0.1, 0.0);
+    let mut t = vec![0.0; n];
+    let mut u = vec![0.0; n];
+    let mut p = vec![0.0; n];
+    for k in 0..n {
+        t[k] = 7.0 + k as f64 * DT; // far from the motion start at 0
+        v = 0.99 * v + 1e-3 * rng.random_range(-1.0..1.0);
+        y += v * DT;
+        u[k] = y + 1e-4 * v;
+        p[k] = y + 1e-8 * rng.random_range(-1.0..1.0);
+    }
+    out.push(("random", t, u, p, 0.0));
+    out
+}
+
+#[test]
+fn cached_projection_predicts_like_the_direct_fit_on_rig_and_random_data() {
+    for (name, t, u, y, ms) in oracle_recordings() {
+        let s = Signals::new(&t, &u, &y, DT, ms);
+        let range = y.iter().fold(f64::NEG_INFINITY, |a, &v| a.max(v))
+            - y.iter().fold(f64::INFINITY, |a, &v| a.min(v));
+        for origin in [TimeOrigin::Motion, TimeOrigin::Window] {
+            let mut m = method(Solver::Qr, origin);
+            let (mut worst, mut worst_rms, mut compared) = (0.0f64, 0.0f64, 0);
+            let mut pred = [0.0; H];
+            for start in (0..t.len() - W - H).step_by(H) {
+                let win = start..start + W;
+                let (_, f) = fit(&mut m, &s, win.clone());
+                m.predict(&s, win.clone(), win.end..win.end + H, &mut pred)
+                    .unwrap();
+                let Some((want, rms)) = direct_fit(origin, &s, win, H) else {
+                    continue;
+                };
+                // relative to the signal range, or to the prediction where the
+                // model runs away from the data (the window origin cannot
+                // represent positions that do not start at 0 in the window:
+                // it extrapolates the random motion to metres)
+                for (a, b) in pred.iter().zip(&want) {
+                    worst = worst.max((a - b).abs() / range.max(b.abs()));
+                }
+                worst_rms = worst_rms.max((f.residual_rms - rms).abs() / range);
+                compared += 1;
+            }
+            assert!(compared > 5, "{name} {origin:?}: {compared}");
+            assert!(
+                worst < 1e-9 && worst_rms < 1e-9,
+                "{name} {origin:?}: predictions {worst:e}, residual rms {worst_rms:e} of the range"
+            );
+            // a uniform grid is projected once per window length
+            assert!(
+                m.projection.builds <= 2,
+                "{name}: {} builds",
+                m.projection.builds
+            );
+        }
+    }
+}
+
+#[test]
+fn jittered_time_grids_rebuild_the_projection_and_still_match_the_direct_fit() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+    let n = 400;
+    let t: Vec<f64> = (0..n)
+        .map(|k| k as f64 * DT + 0.05 * DT * rng.random_range(-1.0..1.0))
+        .collect();
+    let y: Vec<f64> = t
+        .iter()
+        .map(|&t| 1e-3 * (30.0 * t).sin() + 1e-3 * t)
+        .collect();
+    let u: Vec<f64> = t.iter().map(|&t| 1e-3 * (30.0 * t).sin()).collect();
+    let s = Signals::new(&t, &u, &y, DT, 0.0);
+    let mut m = method(Solver::Qr, TimeOrigin::Window);
+    let mut pred = [0.0; H];
+    let mut windows = 0;
+    for start in (0..n - W - H).step_by(H) {
+        let win = start..start + W;
+        fit(&mut m, &s, win.clone());
+        m.predict(&s, win.clone(), win.end..win.end + H, &mut pred)
+            .unwrap();
+        let (want, _) = direct_fit(TimeOrigin::Window, &s, win, H).unwrap();
+        for (a, b) in pred.iter().zip(&want) {
+            assert!((a - b).abs() < 1e-12, "window {start}: {a} vs {b}");
+        }
+        windows += 1;
+    }
+    assert_eq!(m.projection.builds, windows);
+}
+
+#[test]
+fn simplex_from_the_previous_window_agrees_with_qr_in_fewer_iterations() {
+    for (name, t, u, y, ms) in oracle_recordings() {
+        let s = Signals::new(&t, &u, &y, DT, ms);
+        let mut qr = method(Solver::Qr, TimeOrigin::Motion);
+        let mut zeros = method(Solver::Simplex, TimeOrigin::Motion);
+        let mut prev = PaperConfig {
+            solver: Solver::Simplex,
+            simplex_start: SimplexStart::Previous,
+            ..PaperConfig::default()
+        }
+        .build()
+        .unwrap();
+        let (mut it_zeros, mut it_prev, mut compared) = (0, 0, 0);
+        let (mut pq, mut pz, mut pp) = ([0.0; H], [0.0; H], [0.0; H]);
+        let last = (t.len() - W - H).min(1200);
+        for start in (0..last).step_by(H) {
+            let win = start..start + W;
+            let hor = win.end..win.end + H;
+            fit(&mut qr, &s, win.clone());
+            let (_, fz) = fit(&mut zeros, &s, win.clone());
+            let (_, fp) = fit(&mut prev, &s, win.clone());
+            qr.predict(&s, win.clone(), hor.clone(), &mut pq).unwrap();
+            zeros
+                .predict(&s, win.clone(), hor.clone(), &mut pz)
+                .unwrap();
+            prev.predict(&s, win.clone(), hor, &mut pp).unwrap();
+            if fz.iterations == 0 {
+                continue; // rest window
+            }
+            assert_eq!(fp.status, FitStatus::Identified(Termination::Converged));
+            let scale = y[win].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for ((a, b), c) in pq.iter().zip(&pz).zip(&pp) {
+                assert!((a - b).abs() < 1e-6 * scale, "{name} {start}: {a} vs {b}");
+                assert!((a - c).abs() < 1e-6 * scale, "{name} {start}: {a} vs {c}");
+            }
+            it_zeros += fz.iterations;
+            it_prev += fp.iterations;
+            compared += 1;
+        }
+        assert!(compared > 5, "{name}");
+        assert!(
+            it_prev < it_zeros,
+            "{name}: {it_prev} iterations from the previous window, {it_zeros} from zeros"
+        );
+    }
 }

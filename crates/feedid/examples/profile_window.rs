@@ -1,0 +1,76 @@
+//! A fixed workload for instruction-count profiles of the per-window
+//! paths (callgrind counts instructions and is repeatable on a shared,
+//! noisy machine, unlike wall time):
+//!
+//! ```text
+//! cargo build --profile bench -p feedid --example profile_window
+//! valgrind --tool=callgrind --callgrind-out-file=cg.out \
+//!     target/release/examples/profile_window arx 3
+//! callgrind_annotate cg.out | head -40
+//! ```
+//!
+//! Arguments: a method name (`arx`, `oe`, `rls`, `auto`, `paper` (QR,
+//! motion origin: the defaults), `paper-window` (window origin),
+//! `paper-simplex`, `paper-simplex-previous`) and a repetition count. The workload is the
+//! benches' (`benches/methods.rs`, `benches/paper_window.rs`): the virtual
+//! rig's chirp (1 s at 5 kHz, seed 1) through the sliding engine with the
+//! method's default window, H = 10, hop 10; the paper variants on the ramp
+//! (0.8 s) with W = 20. Prints the windows and the mean wall time per
+//! window (indicative only).
+
+use feedid::drive::{RigParams, VirtualRig};
+use feedid::ident::engine::run;
+use feedid::ident::{EngineConfig, Method, PaperConfig, SimplexStart, Solver, TimeOrigin};
+use feedid::signal::Scenario;
+use feedid::Recording;
+
+fn recording(scenario: Scenario, seconds: f64) -> feedid::Result<Recording> {
+    let rate = 5000.0;
+    let command = scenario.command(rate, seconds, 1)?;
+    let out = VirtualRig::new(RigParams::default())
+        .with_seed(1)
+        .simulate(&command, rate)?;
+    Recording::new(out.time, out.command, out.position)
+}
+
+fn main() -> feedid::Result<()> {
+    let args: Vec<String> = std::env::args().collect();
+    let name = args.get(1).map_or("arx", String::as_str);
+    let reps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
+    let (spec, rec) = if let Some(rest) = name.strip_prefix("paper") {
+        let mut cfg = PaperConfig::default();
+        if rest.contains("simplex") {
+            cfg.solver = Solver::Simplex;
+        }
+        if rest.contains("previous") {
+            cfg.simplex_start = SimplexStart::Previous;
+        }
+        if rest.contains("window") {
+            cfg.time_origin = TimeOrigin::Window;
+        }
+        (Method::Paper(cfg), recording(Scenario::Ramp, 0.8)?)
+    } else {
+        (name.parse::<Method>()?, recording(Scenario::Chirp, 1.0)?)
+    };
+    let signals = rec.signals();
+    let cfg = EngineConfig {
+        window: spec.default_window(),
+        ..EngineConfig::default()
+    };
+    let mut est = spec.build()?;
+    let mut total = 0.0;
+    let mut windows = 0;
+    let mut rms = 0.0;
+    for _ in 0..reps {
+        let r = run(est.as_mut(), &signals, &cfg)?;
+        total += r.elapsed.as_secs_f64();
+        windows += r.windows.len();
+        rms = r.stats.rms;
+    }
+    println!(
+        "{name}: {windows} windows, {:.2} µs/window, rms {:.3} µm",
+        1e6 * total / windows.max(1) as f64,
+        rms * 1e6
+    );
+    Ok(())
+}

@@ -160,7 +160,7 @@ pub struct MethodOptions {
     /// paper: solver, qr (exact least squares) or simplex (Nelder–Mead, as in the paper) [default: qr].
     #[arg(long, value_name = "NAME")]
     pub solver: Option<String>,
-    /// paper: time origin, motion (start of motion) or window (each window's first sample) [default: motion].
+    /// paper: time origin, motion (start of motion) or window (each window's first sample; accurate coefficients, but it cannot predict a moving axis) [default: motion].
     #[arg(long, value_name = "NAME")]
     pub time_origin: Option<String>,
     /// paper: prediction, polynomial (fitted output continued) or tf (identified Tf on the next command) [default: polynomial].

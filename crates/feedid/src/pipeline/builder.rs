@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::ident::engine::{run_with_progress, Progress};
 use crate::ident::{
     fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind, Method,
-    OrderSearch, PredictionMode, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
+    OrderSearch, PredictionMode, TimeOrigin, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
 use crate::plausibility::check_recording;
@@ -225,6 +225,9 @@ impl<'a> Pipeline<'a> {
             let g = paper.worst_shift_amplification(&signals, &config);
             if g > SHIFT_AMPLIFICATION_WARNING {
                 warnings.push(Warning::PaperCoefficientAccuracy { amplification: g });
+            }
+            if paper.time_origin == TimeOrigin::Window {
+                warnings.push(Warning::PaperWindowOrigin);
             }
         }
 
@@ -591,5 +594,31 @@ mod tests {
         assert!(run.warnings[0].to_string().contains("lose about"));
         let run = Pipeline::new("arx".parse().unwrap()).run(&rec).unwrap();
         assert!(run.warnings.is_empty());
+    }
+
+    #[test]
+    fn paper_window_time_origin_warns_that_it_cannot_predict_a_moving_axis() {
+        // a ramp away from 0: the window-local output model starts at rest at 0
+        let n = 400;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 2e-4).collect();
+        let u: Vec<f64> = t.iter().map(|&t| 0.01 + 0.05 * t).collect();
+        let rec = Recording::new(t, u.clone(), u).unwrap();
+        let mut method: Method = "paper".parse().unwrap();
+        if let Method::Paper(c) = &mut method {
+            c.time_origin = TimeOrigin::Window;
+        }
+        let run = Pipeline::new(method).run(&rec).unwrap();
+        assert!(
+            run.warnings
+                .iter()
+                .any(|w| matches!(w, Warning::PaperWindowOrigin)),
+            "{:?}",
+            run.warnings
+        );
+        let run = Pipeline::new("paper".parse().unwrap()).run(&rec).unwrap();
+        assert!(!run
+            .warnings
+            .iter()
+            .any(|w| matches!(w, Warning::PaperWindowOrigin)));
     }
 }

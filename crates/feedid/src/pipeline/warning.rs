@@ -21,6 +21,13 @@ pub enum Warning {
         /// The largest growth factor of the change of basis over the windows.
         amplification: f64,
     },
+    /// Paper method with the window time origin: the output model
+    /// `P5·τ⁵ + P6·τ⁶ + P7·τ⁷` is zero with its first four derivatives at each
+    /// window's first sample, so it cannot represent an axis that is away from
+    /// zero or moving there; the coefficients are accurate, the predictions are
+    /// not (design notes §2: window-local time is an option for studying the
+    /// coefficients).
+    PaperWindowOrigin,
     /// Paper method with `--prediction tf`: in these windows the identified
     /// `N(s)/D(s)` was unstable (or not realisable) and the prediction fell
     /// back to the polynomial one (see
@@ -43,8 +50,16 @@ impl fmt::Display for Warning {
                 f,
                 "paper method: windows lie far from the time origin; the coefficients N, D \
                  lose about {:.0} of their 16 digits (amplification {g:.1e}); predictions are \
-                 not affected (the time origin `window` keeps the coefficients accurate)",
+                 not affected (the time origin `window` keeps the coefficients accurate but \
+                 cannot predict a moving axis)",
                 g.log10().min(16.0)
+            ),
+            Warning::PaperWindowOrigin => write!(
+                f,
+                "paper method, time origin window: the output model P5·τ⁵ + P6·τ⁶ + P7·τ⁷ \
+                 starts at zero position and velocity in every window, so it cannot represent \
+                 an axis away from 0 or moving at a window's start; its predictions are far off \
+                 there (use --time-origin window to study the coefficients, motion to predict)"
             ),
             Warning::PaperTfFallback { fallbacks, windows } => write!(
                 f,

@@ -171,16 +171,18 @@ pub struct MethodOptions {
     pub simplex_start: Option<String>,
     /// arx, rls, auto (its long-memory candidate): ARX orders `na,nb,nk`
     /// (poles, input terms, input delay in samples), or `auto` (chosen from
-    /// the recording by BIC; identify only) [default: 8,8,1].
+    /// the recording by BIC; identify only) [default: arx 3,3,0; rls 8,8,0;
+    /// auto 8,8,0].
     #[arg(long, value_name = "NA,NB,NK|auto")]
     pub order: Option<String>,
     /// rls: forgetting factor λ (memory ≈ 1/(1−λ) samples) [default: 0.999].
     #[arg(long, value_name = "LAMBDA")]
     pub lambda: Option<f64>,
-    /// auto: emit a prediction only when the chosen model's recent rms error
-    /// is within this tolerance [µm] [default: 5].
-    #[arg(long, value_name = "UM")]
-    pub tolerance: Option<f64>,
+    /// arx, auto (its windowed candidates): ridge of the least squares,
+    /// relative to the regressors' scale (arx: on the column-normalised
+    /// coefficients), ≥ 0, 0 = none [default: arx 1e-10; auto 1e-6].
+    #[arg(long, value_name = "R")]
+    pub ridge: Option<f64>,
 }
 
 /// Sliding-window options.
@@ -235,13 +237,16 @@ pub struct IdentifyArgs {
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
+    /// Probability of the prediction intervals (lower_m, upper_m) [%], in (0, 100).
+    #[arg(long, value_name = "P", default_value_t = 95.0)]
+    pub interval: f64,
     /// Rig parameters of the nominal simulation model (TOML); default: the built-in rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
     /// Use an unstable physical model anyway (its simulation diverges; refused by default).
     #[arg(long)]
     pub allow_unstable: bool,
-    /// Predictions CSV: time_s,command_m,measured_m,predicted_m,simulated_m.
+    /// Predictions CSV: time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m.
     #[arg(
         short,
         long,
@@ -334,6 +339,9 @@ pub struct StreamArgs {
     /// Windows.
     #[command(flatten)]
     pub windows: WindowArgs,
+    /// Probability of the prediction intervals (lower_m, upper_m) [%], in (0, 100).
+    #[arg(long, value_name = "P", default_value_t = 95.0)]
+    pub interval: f64,
     /// How to read the lines (as a recording file; without a header and
     /// without column options: time, command, position are columns 1, 2, 3).
     #[command(flatten)]

@@ -49,7 +49,7 @@ fn report_writes_one_self_contained_page_with_every_figure() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
     assert!(
-        text.contains("paper LSM, qr (W=20)") && text.contains("ARX 8,8,1 (W=200)"),
+        text.contains("paper LSM, qr (W=20)") && text.contains("ARX 3,3,0 (W=100)"),
         "{text}"
     );
     assert!(text.contains("simulation model (nominal)"), "{text}");
@@ -67,7 +67,6 @@ fn report_writes_one_self_contained_page_with_every_figure() {
         "coef-paper1",
         "coef-paper1-2",
         "coef-arx2",
-        "coef-arx2-2",
         "ree-paper1",
         "rue-paper1",
         "ree-arx2",

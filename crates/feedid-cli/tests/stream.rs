@@ -99,16 +99,23 @@ fn stream(args: &[&str], input: &str) -> (String, String) {
     )
 }
 
-/// Parse `time_s,predicted_m` rows.
+/// Parse `time_s,predicted_m,lower_m,upper_m` rows (time and prediction;
+/// the prediction lies inside its interval).
 fn rows(stdout: &str) -> Vec<(f64, f64)> {
     let mut lines = stdout.lines();
-    assert_eq!(lines.next(), Some("time_s,predicted_m"));
-    lines
-        .map(|l| {
-            let (t, y) = l.split_once(',').unwrap();
-            (t.parse().unwrap(), y.parse().unwrap())
-        })
-        .collect()
+    assert_eq!(lines.next(), Some(HEADER_OUT));
+    lines.map(parse_row).collect()
+}
+
+/// The header of the predictions a stream writes.
+const HEADER_OUT: &str = "time_s,predicted_m,lower_m,upper_m";
+
+/// Time and prediction of one output row, its interval checked around it.
+fn parse_row(l: &str) -> (f64, f64) {
+    let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
+    assert_eq!(v.len(), 4, "{l}");
+    assert!(v[2] <= v[1] && v[1] <= v[3], "{l}");
+    (v[0], v[1])
 }
 
 /// What the library's streamer writes for `lines` (`t,u,y` text), with the
@@ -183,10 +190,7 @@ fn interleaved(args: &[&str], lines: &[String], due: &[usize]) -> (Vec<(usize, f
             }
         }
     });
-    let parse = |l: &str| -> (f64, f64) {
-        let (t, y) = l.split_once(',').unwrap();
-        (t.parse().unwrap(), y.parse().unwrap())
-    };
+    let parse = parse_row;
     let wait = Duration::from_secs(60);
     let mut out = Vec::new();
     stdin.write_all(format!("{HEADER}\n").as_bytes()).unwrap();
@@ -197,7 +201,7 @@ fn interleaved(args: &[&str], lines: &[String], due: &[usize]) -> (Vec<(usize, f
             let h = rx
                 .recv_timeout(wait)
                 .expect("the header after the first sample");
-            assert_eq!(h, "time_s,predicted_m");
+            assert_eq!(h, HEADER_OUT);
         }
         for r in 0..due[i] {
             let row = rx.recv_timeout(wait).unwrap_or_else(|_| {
@@ -625,7 +629,7 @@ fn no_usable_line_and_an_unwritable_output_exit_2_and_a_closed_reader_exits_0() 
     // too few samples for a window: exit 0, no rms over nothing
     let rec = rig_recording(Scenario::Ramp, 0.004);
     let (out, err) = stream(&[], &csv(&rec, true));
-    assert_eq!(out, "time_s,predicted_m\n");
+    assert_eq!(out, format!("{HEADER_OUT}\n"));
     assert!(
         err.contains("scored: no sample") && !err.contains("rms"),
         "{err}"

@@ -106,7 +106,7 @@ impl Pipe {
             completed = true;
             if p.is_ok() {
                 self.rows
-                    .write(p.time, p.position)
+                    .write(p.time, p.position, p.lower, p.upper)
                     .unwrap_or_else(|e| panic!("{e}"));
             }
         }

@@ -37,7 +37,7 @@ fn row(name: &str, s: &Signals<'_>) -> feedid::Result<String> {
 }
 
 fn main() -> feedid::Result<()> {
-    println!("| recording | paper (W 20) | arx (W 200) | rls (W 100) | oe (W 200) | auto (W 50) |");
+    println!("| recording | paper (W 20) | arx (W 100) | rls (W 100) | oe (W 200) | auto (W 50) |");
     println!("|---|---|---|---|---|---|");
     for scenario in Scenario::ALL {
         let rate = 5000.0;

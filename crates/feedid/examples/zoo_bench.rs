@@ -7,7 +7,7 @@
 //! cargo run --release -p feedid --example zoo_bench -- --members small --csv zoo.csv
 //! ```
 //!
-//! `--members` takes all (default), regular, gapped, small, a range `A..B` /
+//! `--members` takes all (default), regular, even, odd, gapped, small, a range `A..B` /
 //! `A..=B` or a list `1,5,9`; `--csv FILE` writes one row per member and
 //! method. The summary is printed as a Markdown table.
 //!
@@ -25,15 +25,18 @@
 //! of every score, since no method can predict a wild sample):
 //!
 //! * `rms`, `max` over the samples a method predicts; `coverage` = share of
-//!   the recording's samples it predicts;
+//!   the samples after the method's first window (its first horizon's
+//!   start) that it predicts (the CSV has the share of all samples too);
 //! * `ratio` = rms of the method / rms of the best fixed method (paper, arx,
 //!   rls, oe with defaults), each pair compared on the samples both predict:
 //!   `max over fixed f of rms_m(S_m ∩ S_f) / rms_f(S_m ∩ S_f)` (at least 50
 //!   shared samples, else the pair is skipped); 1 for the best fixed method;
 //! * `loses` = the method's rms exceeds a baseline's on the samples both
 //!   predict, for some baseline (a baseline against the other two);
-//! * interval coverage: the share of measured samples inside the method's
-//!   95 % prediction interval — `n/a` until a method outputs intervals.
+//! * interval coverage: the share of the scored predicted samples whose
+//!   measured position lies inside the method's 95 % prediction interval
+//!   (the library's default [`feedid::ident::GuardConfig`]); `n/a` for the
+//!   baselines.
 //!
 //! Members with dropped rows are refused by the reader (as by
 //! `feedid identify`): they are listed as `refused` and left out of the summary.
@@ -69,11 +72,16 @@ struct Predictions {
     has: Vec<bool>,
     /// Lower and upper 95 % interval bounds, when the method gives them.
     interval: Option<(Vec<f64>, Vec<f64>)>,
+    /// First sample the method can predict (the end of its first window).
+    first: usize,
     /// Wall time \[s\].
     seconds: f64,
     /// Why the method gave nothing, if it failed.
     error: Option<String>,
 }
+
+/// Predictions, their flags, the interval bounds and the first predicted sample.
+type RunOutput = (Vec<f64>, Vec<bool>, (Vec<f64>, Vec<f64>), usize);
 
 /// Every use of the identification API: the five library methods with their
 /// defaults (window per method, H = 10, hop = H), as `feedid identify` runs
@@ -85,7 +93,7 @@ fn run_library_methods(rec: &Recording) -> Vec<Predictions> {
         .iter()
         .map(|&name| {
             let t = Instant::now();
-            let run = || -> feedid::Result<(Vec<f64>, Vec<bool>)> {
+            let run = || -> feedid::Result<RunOutput> {
                 let spec: Method = name.parse()?;
                 let mut est = spec.build()?;
                 let cfg = EngineConfig {
@@ -95,14 +103,16 @@ fn run_library_methods(rec: &Recording) -> Vec<Predictions> {
                     warm_up: 0,
                 };
                 let r = engine::run(&mut est, &signals, &cfg)?;
-                Ok((r.predicted, r.has_prediction))
+                let first = r.windows.first().map_or(n, |w| w.horizon.start);
+                Ok((r.predicted, r.has_prediction, (r.lower, r.upper), first))
             };
             match run() {
-                Ok((value, has)) => Predictions {
+                Ok((value, has, interval, first)) => Predictions {
                     name,
                     value,
                     has,
-                    interval: None,
+                    interval: Some(interval),
+                    first,
                     seconds: t.elapsed().as_secs_f64(),
                     error: None,
                 },
@@ -111,6 +121,7 @@ fn run_library_methods(rec: &Recording) -> Vec<Predictions> {
                     value: vec![0.0; n],
                     has: vec![false; n],
                     interval: None,
+                    first: n,
                     seconds: t.elapsed().as_secs_f64(),
                     error: Some(e.to_string()),
                 },
@@ -126,6 +137,7 @@ fn baseline_command(u: &[f64]) -> Predictions {
         value: u.to_vec(),
         has: vec![true; u.len()],
         interval: None,
+        first: 0,
         seconds: 0.0,
         error: None,
     }
@@ -149,6 +161,7 @@ fn baseline_hold(y: &[f64]) -> Predictions {
         value,
         has,
         interval: None,
+        first: H,
         seconds: 0.0,
         error: None,
     }
@@ -200,6 +213,7 @@ fn baseline_arx220(u: &[f64], y: &[f64]) -> Predictions {
         value,
         has,
         interval: None,
+        first: W + 2,
         seconds: t.elapsed().as_secs_f64(),
         error: None,
     }
@@ -240,6 +254,8 @@ struct Row {
     rms: Option<f64>,
     max: Option<f64>,
     coverage: f64,
+    /// Share of the samples after the method's first window that it predicts \[%\].
+    coverage_after: f64,
     ratio: Option<f64>,
     beaten_by: Option<&'static str>,
     baseline_ratio: Option<f64>,
@@ -262,6 +278,7 @@ fn score(m: &ZooMember) -> Vec<Row> {
         rms: None,
         max: None,
         coverage: 0.0,
+        coverage_after: 0.0,
         ratio: None,
         beaten_by: None,
         baseline_ratio: None,
@@ -333,6 +350,9 @@ fn score(m: &ZooMember) -> Vec<Row> {
                 rms: own.map(|o| o.0),
                 max: own.map(|o| o.1),
                 coverage: 100.0 * predicted as f64 / n as f64,
+                coverage_after: 100.0
+                    * p.has[p.first.min(n)..].iter().filter(|&&h| h).count() as f64
+                    / (n - p.first.min(n)).max(1) as f64,
                 ratio,
                 beaten_by: worst.filter(|w| w.1 > 1.0).map(|w| w.0),
                 baseline_ratio: worst.map(|w| w.1),
@@ -367,11 +387,16 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
 
 fn parse_members(s: &str, zoo: &Zoo) -> Result<Vec<usize>, String> {
     let n = zoo.len();
-    let bad =
-        || format!("invalid --members `{s}` (all, regular, gapped, small, A..B, A..=B, 1,5,9)");
+    let bad = || {
+        format!(
+            "invalid --members `{s}` (all, regular, even, odd, gapped, small, A..B, A..=B, 1,5,9)"
+        )
+    };
     let v: Vec<usize> = match s {
         "all" => (0..n).collect(),
         "regular" => zoo.regular().collect(),
+        "even" => zoo.regular().filter(|i| i % 2 == 0).collect(),
+        "odd" => zoo.regular().filter(|i| i % 2 == 1).collect(),
         "gapped" => zoo.gapped().collect(),
         "small" => zoo.small().collect(),
         _ if s.contains("..") => {
@@ -418,13 +443,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     if let Some(path) = &csv {
         let mut text = String::from(
-            "member,method,plant,command,samples,predicted,coverage_percent,rms_m,max_m,\
-             ratio_to_best_fixed,beaten_by_baseline,worst_baseline_ratio,interval_coverage_percent,\
+            "member,method,plant,command,samples,predicted,coverage_percent,\
+             coverage_after_first_window_percent,rms_m,max_m,ratio_to_best_fixed,beaten_by_baseline,worst_baseline_ratio,interval_coverage_percent,\
              seconds,note,label\n",
         );
         for r in &rows {
             text += &format!(
-                "{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{:.6},\"{}\",\"{}\"\n",
+                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{:.6},\"{}\",\"{}\"\n",
                 r.member,
                 r.method,
                 r.plant,
@@ -432,6 +457,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.samples,
                 r.predicted,
                 r.coverage,
+                r.coverage_after,
                 r.rms.map_or(String::new(), |v| v.to_string()),
                 r.max.map_or(String::new(), |v| v.to_string()),
                 r.ratio.map_or(String::new(), |v| v.to_string()),
@@ -467,13 +493,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         wall,
         rayon::current_num_threads()
     );
-    println!("| method | compared | median rms / best fixed | 90th pct rms / best fixed | loses to a baseline | coverage min / median [%] | median own rms [µm] | failed | 95 % interval coverage |");
+    println!("| method | compared | median rms / best fixed | 90th pct rms / best fixed | loses to a baseline | coverage after the first window, min / median [%] | median own rms [µm] | failed | 95 % interval coverage |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for method in LIBRARY.iter().chain(&BASELINES) {
         let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == *method).collect();
         let ratios: Vec<f64> = mine.iter().filter_map(|r| r.ratio).collect();
         let losses = mine.iter().filter(|r| r.beaten_by.is_some()).count();
-        let cov: Vec<f64> = mine.iter().map(|r| r.coverage).collect();
+        let cov: Vec<f64> = mine.iter().map(|r| r.coverage_after).collect();
         let rms: Vec<f64> = mine.iter().filter_map(|r| r.rms).map(|v| v * 1e6).collect();
         let failed = mine.iter().filter(|r| !r.note.is_empty()).count();
         let intervals: Vec<f64> = mine.iter().filter_map(|r| r.interval_coverage).collect();
@@ -546,7 +572,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          with defaults), each pair on the samples both predict; loses: its rms exceeds a baseline's \
          (command, hold, arx220) on the samples both predict (a recording it does not predict is \
          not a loss: see coverage); own rms: over the method's own predicted samples. Glitch rows \
-         are not scored. Interval coverage: n/a until a method outputs prediction intervals."
+         are not scored. Coverage: share of the samples after the method's first window that it \
+         predicts. Interval coverage: share of the scored predicted samples inside the method's 95 % \
+         prediction interval (median over the recordings)."
     );
     Ok(())
 }
@@ -594,6 +622,7 @@ mod tests {
             value: vec![1.0; 200],
             has: (0..200).map(|k| k < 150).collect(),
             interval: None,
+            first: 0,
             seconds: 0.0,
             error: None,
         };
@@ -602,6 +631,7 @@ mod tests {
             value: (0..200).map(|k| if k < 100 { 5.0 } else { 2.0 }).collect(),
             has: (0..200).map(|k| k >= 100).collect(),
             interval: None,
+            first: 100,
             seconds: 0.0,
             error: None,
         };

@@ -153,7 +153,7 @@ fn low_layers_import_nothing_from_higher_ones() {
 #[test]
 fn rls_and_oe_use_the_shared_regressor_not_arx_internals() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/ident/methods");
-    for f in ["rls.rs", "oe", "auto.rs"] {
+    for f in ["rls.rs", "oe", "auto"] {
         for file in sources(&src.join(f)) {
             let code = code(&file);
             assert!(

@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use feedid::ident::{GlobalModelKind, OrderSearch, SlidingResult};
-use feedid::io::{write_coefficients_csv, write_predictions_csv, CoefficientRow};
+use feedid::io::{
+    write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
+};
 use feedid::pipeline::Pipeline;
 use rayon::prelude::*;
 
@@ -79,11 +81,19 @@ struct OutputPaths {
 /// Identify, write the outputs, print a short summary (one file, or a batch with --out-dir).
 pub fn run(a: &IdentifyArgs) -> Result<()> {
     let method = a.options.method(&a.method)?;
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // rejects NaN
+    if !(a.interval > 0.0 && a.interval < 100.0) {
+        bail!(
+            "invalid --interval {}: the probability of the prediction intervals must be in (0, 100) % (e.g. 95)",
+            a.interval
+        );
+    }
     let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let mut pipeline = Pipeline::new(method)
         .window_or_default(a.windows.window)
         .horizon(a.windows.horizon)
         .hop(a.windows.hop)
+        .interval(a.interval / 100.0)
         .nominal(params);
     if a.options.order_option()? == Some(OrderOption::Select) {
         pipeline = pipeline.select_orders(OrderSearch::default());
@@ -258,8 +268,12 @@ fn identify_file(
             rec.time(),
             rec.command(),
             rec.position(),
-            &s.predicted,
-            &s.has_prediction,
+            PredictionColumns {
+                predicted: &s.predicted,
+                lower: &s.lower,
+                upper: &s.upper,
+                has_prediction: &s.has_prediction,
+            },
             run.simulated.as_deref(),
         )
     })?;

@@ -80,10 +80,11 @@ impl MethodOptions {
                 _ => missing.push("--lambda"),
             }
         }
-        if let Some(t) = self.tolerance {
+        if let Some(r) = self.ridge {
             match method {
-                Method::Auto(c) => c.tolerance = t * 1e-6,
-                _ => missing.push("--tolerance"),
+                Method::Arx(c) => c.ridge = r,
+                Method::Auto(c) => c.set_ridge(r),
+                _ => missing.push("--ridge"),
             }
         }
         Ok(missing)
@@ -142,7 +143,7 @@ fn applies_to(flag: &str) -> &'static str {
         "--simplex-start" => "paper (with --solver simplex)",
         "--order" => "arx, rls, auto",
         "--lambda" => "rls",
-        "--tolerance" => "auto",
+        "--ridge" => "arx, auto",
         _ => "some methods",
     }
 }
@@ -172,7 +173,7 @@ mod tests {
             simplex_start: None,
             order: None,
             lambda: None,
-            tolerance: None,
+            ridge: None,
         }
     }
 
@@ -234,12 +235,25 @@ mod tests {
         };
         assert!(o.method("arx").unwrap_err().to_string().contains("`2,2`"));
         let o = MethodOptions {
-            tolerance: Some(2.0),
+            ridge: Some(0.0),
             ..options()
         };
+        let Method::Arx(c) = o.method("arx").unwrap() else {
+            unreachable!()
+        };
+        assert_eq!(c.ridge, 0.0);
         let Method::Auto(c) = o.method("auto").unwrap() else {
             unreachable!()
         };
-        assert!((c.tolerance - 2e-6).abs() < 1e-18);
+        assert!(c.candidates.iter().all(|c| match c {
+            feedid::ident::Candidate::Windowed { ridge, .. } => *ridge == 0.0,
+            _ => true,
+        }));
+        assert!(o.method("rls").unwrap_err().to_string().contains("--ridge"));
+        let o = MethodOptions {
+            ridge: Some(-1.0),
+            ..options()
+        };
+        assert!(o.method("arx").is_err() && o.method("auto").is_err());
     }
 }

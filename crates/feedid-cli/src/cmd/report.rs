@@ -81,13 +81,17 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     );
     for m in &analysis.runs {
         let s = m.identification.summary();
-        println!(
-            "  {:<32} rms {:>10.3} µm  max {:>10.3} µm  fit {:>7.2} %",
-            m.label,
-            1e6 * s.rms_error_m,
-            1e6 * s.max_abs_error_m,
-            s.fit_percent
-        );
+        match (s.rms_error_m, s.max_abs_error_m, s.fit_percent) {
+            (Some(rms), Some(max), Some(fit)) => println!(
+                "  {:<32} rms {:>10.3} µm  max {:>10.3} µm  fit {:>7.2} %  coverage {:.1} %",
+                m.label,
+                1e6 * rms,
+                1e6 * max,
+                fit,
+                s.coverage_percent
+            ),
+            _ => println!("  {:<32} no sample predicted (no error reported)", m.label),
+        }
     }
     println!(
         "  {:<32} rms {:>10.3} µm  max {:>10.3} µm",

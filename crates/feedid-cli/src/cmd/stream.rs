@@ -5,7 +5,7 @@
 //! needs none), pushes each sample into the library's streamer
 //! (`feedid::ident::stream::Streamer`, with `--command-lead` and
 //! `--extrapolate`), writes each prediction as soon as it is due as
-//! `time_s,predicted_m` rows (`feedid::io::PredictionRows`) and flushes
+//! `time_s,predicted_m,lower_m,upper_m` rows (`feedid::io::PredictionRows`) and flushes
 //! before the next line is read. With a hop shorter than the horizon a time
 //! appears in several windows' rows; the later row supersedes the earlier.
 //!
@@ -21,9 +21,9 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use feedid::ident::stream::{
-    CommandExtrapolation, HorizonCommand, Interval, StreamOptions, StreamStats,
+    CommandExtrapolation, HorizonCommand, Interval, Prediction, StreamOptions, StreamStats,
 };
-use feedid::ident::{EngineConfig, Estimator, Streamer};
+use feedid::ident::{EngineConfig, Estimator, GuardConfig, Streamer};
 use feedid::io::{PredictionRows, StreamLine, StreamReader};
 
 use crate::args::StreamArgs;
@@ -52,6 +52,13 @@ fn streamer(a: &StreamArgs, rate: Option<f64>) -> Result<Streamer<Box<dyn Estima
         bail!("--order auto chooses the orders from a whole recording; a stream needs them given (na,nb,nk; `feedid order` chooses them)");
     }
     let method = a.options.method(&a.method)?;
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // rejects NaN
+    if !(a.interval > 0.0 && a.interval < 100.0) {
+        bail!(
+            "invalid --interval {}: the probability of the prediction intervals must be in (0, 100) % (e.g. 95)",
+            a.interval
+        );
+    }
     let config = EngineConfig {
         window: a.windows.window.unwrap_or_else(|| method.default_window()),
         horizon: a.windows.horizon,
@@ -68,6 +75,10 @@ fn streamer(a: &StreamArgs, rate: Option<f64>) -> Result<Streamer<Box<dyn Estima
         // with a rate the intervals are exact: a skipped line is a gap
         dt: rate.map(|r| 1.0 / r),
         jitter_tolerance: a.recording.jitter_tol,
+        guard: GuardConfig {
+            interval: a.interval / 100.0,
+            ..GuardConfig::default()
+        },
         ..StreamOptions::default()
     };
     let s = Streamer::with_options(method.build()?, config, options)?;
@@ -106,8 +117,8 @@ enum Output {
 }
 
 /// Write a prediction's rows.
-fn write<W: Write>(rows: &mut PredictionRows<W>, time: &[f64], position: &[f64]) -> Result<Output> {
-    check(rows.write(time, position))
+fn write<W: Write>(rows: &mut PredictionRows<W>, p: &Prediction<'_>) -> Result<Output> {
+    check(rows.write(p.time, p.position, p.lower, p.upper))
 }
 
 /// A closed pipe ends the stream quietly, other write failures are errors.
@@ -179,7 +190,7 @@ fn run_on<R: BufRead, W: Write, E: Write>(
         }
         while let Some(p) = s.poll()? {
             if p.is_ok() {
-                output = write(&mut rows, p.time, p.position)?;
+                output = write(&mut rows, &p)?;
                 if let Output::Closed = output {
                     break;
                 }
@@ -190,7 +201,7 @@ fn run_on<R: BufRead, W: Write, E: Write>(
         s.finish();
         while let Some(p) = s.poll()? {
             if p.is_ok() {
-                if let Output::Closed = write(&mut rows, p.time, p.position)? {
+                if let Output::Closed = write(&mut rows, &p)? {
                     break;
                 }
             }
@@ -200,7 +211,7 @@ fn run_on<R: BufRead, W: Write, E: Write>(
     let _ = write!(
         err,
         "{}",
-        summary(&lines, &st, s.horizon_command(), rows.rows())
+        summary(&lines, &st, s.horizon_command(), rows.rows(), a.interval)
     );
     if st.lines == 0 {
         if lines.read == 0 {
@@ -268,7 +279,13 @@ fn percent(n: usize, of: usize) -> String {
 }
 
 /// The summary on standard error (several lines; never an rms over nothing).
-fn summary(lines: &Lines, st: &StreamStats, command: HorizonCommand, rows: usize) -> String {
+fn summary(
+    lines: &Lines,
+    st: &StreamStats,
+    command: HorizonCommand,
+    rows: usize,
+    interval_percent: f64,
+) -> String {
     let mut o = String::new();
     let unused = if st.unused_positions > 0 {
         format!(
@@ -306,6 +323,13 @@ fn summary(lines: &Lines, st: &StreamStats, command: HorizonCommand, rows: usize
             st.scored.rms,
             st.scored.max_abs,
             st.hold.rms
+        );
+        o += &format!(
+            "inside the {} % prediction interval: {} of the scored samples ({}); isolated outliers not fitted: {}\n",
+            interval_percent,
+            st.inside_interval,
+            percent(st.inside_interval, st.scored.samples),
+            st.outliers
         );
     } else {
         o += "scored: no sample (no prediction was compared with a measurement)\n";

@@ -80,8 +80,8 @@ const NEGATIVE: &[(&[&str], &[&str])] = &[
         &["lambda", "-0.5"],
     ),
     (
-        &["identify", "{good}", "-o", "/dev/null", "--tolerance", "-3"],
-        &["tolerance", "-3"],
+        &["identify", "{good}", "-o", "/dev/null", "--ridge", "-3"],
+        &["ridge", "-3"],
     ),
     (
         &["report", "{good}", "-o", "/dev/null", "--zoom", "-3"],

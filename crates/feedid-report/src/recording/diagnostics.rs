@@ -227,9 +227,9 @@ impl RecordingAnalysis {
                 format!("{}", s.windows),
                 format!("{}", s.failed_windows),
                 format!("{}", s.samples_predicted),
-                um(s.rms_error_m),
-                um(s.max_abs_error_m),
-                pct(s.fit_percent),
+                um(s.rms_error_m.unwrap_or(f64::NAN)),
+                um(s.max_abs_error_m.unwrap_or(f64::NAN)),
+                pct(s.fit_percent.unwrap_or(f64::NAN)),
                 if m.zoom_stats.samples > 0 {
                     um(m.zoom_stats.rms)
                 } else {

@@ -6,14 +6,14 @@
 //!
 //! | name | estimator | default window | orders | global model |
 //! |---|---|---|---|---|
-//! | `auto` | validated choice among RLS models and hold ([`AutoConfig`]); the default | 50 | of its long-memory RLS candidate | best of arx 8,8,1, oe 7,2, oe 5,1 |
+//! | `auto` | online choice among windowed and recursive unit-gain ARX candidates, scale-free, always predicts ([`AutoConfig`]); the default | 50 | of its long-memory RLS candidate | best of arx 8,8,1, oe 7,2, oe 5,1 |
 //! | `paper` | the paper's polynomial method ([`PaperConfig`]) | 20 | — | — |
-//! | `arx` | windowed ARX with exact sliding update ([`ArxConfig`]) | 200 | `na, nb, nk` | ARX with its orders |
+//! | `arx` | windowed ARX with exact sliding update ([`ArxConfig`]) | 100 | `na, nb, nk` | ARX with its orders |
 //! | `rls` | recursive least squares with forgetting ([`RlsConfig`]) | 100 | `na, nb, nk` | ARX with its orders |
 //! | `oe` | continuous-time output error over sliding windows ([`OeConfig`]) | 200 | — (poles, zeros) | OE with its poles and zeros |
 //!
-//! `auto` takes orders for its long-memory RLS candidate (default 8,8,1);
-//! its short-memory candidate (4,4,1) and hold stay as they are. Setting
+//! `auto` takes orders for its long-memory recursive candidate (default
+//! 8,8,0); its other candidates stay as they are. Setting
 //! orders on a method without an ARX regressor is an error, not ignored.
 //!
 //! # Adding a method
@@ -31,7 +31,7 @@
 //! ```
 //! use feedid::ident::{ArxOrders, Method};
 //! let mut m: Method = "arx".parse().unwrap();
-//! assert_eq!((m.name(), m.default_window()), ("arx", 200));
+//! assert_eq!((m.name(), m.default_window()), ("arx", 100));
 //! m.set_orders(ArxOrders::new(4, 4, 1)).unwrap();
 //! assert_eq!(m.label(), "ARX 4,4,1");
 //! assert_eq!(m.build().unwrap().name(), "arx");
@@ -128,7 +128,7 @@ impl Method {
     pub fn default_window(&self) -> usize {
         match self {
             Method::Paper(_) => 20,
-            Method::Arx(_) => 200,
+            Method::Arx(_) => 100,
             Method::Rls(_) => 100,
             Method::Oe(_) => 200,
             Method::Auto(_) => 50,
@@ -160,7 +160,7 @@ impl Method {
             Method::Paper(_) | Method::Oe(_) => None,
             Method::Arx(c) => Some(c.orders),
             Method::Rls(c) => Some(c.orders),
-            Method::Auto(c) => Some(c.long.orders),
+            Method::Auto(c) => c.orders(),
         }
     }
 
@@ -181,7 +181,7 @@ impl Method {
             }
             Method::Arx(c) => c.orders = orders,
             Method::Rls(c) => c.orders = orders,
-            Method::Auto(c) => c.long.orders = orders,
+            Method::Auto(c) => c.set_orders(orders)?,
         }
         Ok(())
     }
@@ -274,8 +274,16 @@ mod tests {
         }) else {
             unreachable!()
         };
-        assert_eq!(c.long.orders, o);
-        assert_eq!(c.short.orders, AutoConfig::default().short.orders);
+        // only the reported (largest) candidate takes them
+        let d = AutoConfig::default();
+        let r = d.reported().unwrap();
+        for (i, (a, b)) in c.candidates.iter().zip(&d.candidates).enumerate() {
+            if i == r {
+                assert_eq!(a.orders(), Some(o));
+            } else {
+                assert_eq!(a, b);
+            }
+        }
         for name in ["paper", "oe"] {
             let mut m: Method = name.parse().unwrap();
             let before = m.clone();
@@ -291,7 +299,7 @@ mod tests {
         // invalid orders are refused before anything changes
         let mut m: Method = "arx".parse().unwrap();
         assert!(m.set_orders(ArxOrders::new(2, 0, 1)).is_err());
-        assert_eq!(m.orders(), Some(ArxOrders::default()));
+        assert_eq!(m.orders(), Some(ArxConfig::default().orders));
     }
 
     #[test]
@@ -302,13 +310,13 @@ mod tests {
             [
                 "auto",
                 "paper LSM, qr",
-                "ARX 8,8,1",
-                "RLS 8,8,1 λ=0.999",
+                "ARX 3,3,0",
+                "RLS 8,8,0 λ=0.999",
                 "OE 3p/1z"
             ]
         );
         let windows: Vec<usize> = Method::all().iter().map(Method::default_window).collect();
-        assert_eq!(windows, [50, 20, 200, 100, 200]);
+        assert_eq!(windows, [50, 20, 100, 100, 200]);
         let mut rls: Method = "rls".parse().unwrap();
         rls.set_orders(ArxOrders::new(4, 4, 1)).unwrap();
         assert_eq!(

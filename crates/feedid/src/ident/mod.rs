@@ -21,15 +21,16 @@ pub use analysis::{
     Z_99,
 };
 pub use engine::{
-    batch, stream, EngineConfig, Estimator, FitStatus, PredictStatus, Prediction, Samples, Signals,
-    SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit, WindowOutcome, WindowRecord,
+    batch, stream, EngineConfig, Estimator, FitStatus, GuardConfig, PredictStatus, Prediction,
+    Samples, Signals, SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit,
+    WindowOutcome, WindowRecord,
 };
 pub use method::{Method, METHOD_NAMES};
 pub use methods::{
     coefficients_from_polynomials, fit_arx, fit_oe, polynomials_from_coefficients, ArxConfig,
-    ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, OeConfig,
-    OeEstimator, OeFit, OeJacobian, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode,
-    RlsConfig, RlsEstimator, SimplexSettings, SimplexStart, Solver, TimeOrigin, AUTO_CANDIDATES,
+    ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, Candidate,
+    OeConfig, OeEstimator, OeFit, OeJacobian, PaperConfig, PaperDiagnostics, PaperMethod,
+    PredictionMode, RlsConfig, RlsEstimator, SimplexSettings, SimplexStart, Solver, TimeOrigin,
     MAX_ARX_ORDER, SHIFT_AMPLIFICATION_WARNING,
 };
 pub use model::{

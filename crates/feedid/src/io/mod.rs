@@ -39,4 +39,6 @@ pub use self::source::{read_small_text, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MA
 pub use self::stream::{
     PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,
 };
-pub use self::table::{cell, write_coefficients_csv, write_predictions_csv, CoefficientRow};
+pub use self::table::{
+    cell, write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
+};

@@ -236,9 +236,9 @@ fn sample(
     }
 }
 
-/// Columns of the rows a stream writes, in order. Later columns (prediction
-/// intervals `lower_m,upper_m`) are appended, never inserted: read them by name.
-pub const PREDICTION_COLUMNS: [&str; 2] = ["time_s", "predicted_m"];
+/// Columns of the rows a stream writes, in order: time, prediction and its
+/// interval. Later columns are appended, never inserted: read them by name.
+pub const PREDICTION_COLUMNS: [&str; 4] = ["time_s", "predicted_m", "lower_m", "upper_m"];
 
 /// Writes streamed predictions as CSV rows, one per predicted sample
 /// ([`PREDICTION_COLUMNS`]; shortest round-trip numbers), and flushes after
@@ -263,11 +263,18 @@ impl<W: Write> PredictionRows<W> {
         self.out.flush()
     }
 
-    /// Write one prediction — time stamps \[s\] and predicted positions \[m\]
-    /// of its horizon samples (equal lengths) — and flush.
-    pub fn write(&mut self, time: &[f64], position: &[f64]) -> std::io::Result<()> {
-        for (t, y) in time.iter().zip(position) {
-            writeln!(self.out, "{t},{y}")?;
+    /// Write one prediction — time stamps \[s\], predicted positions \[m\]
+    /// and the bounds of their intervals \[m\] of its horizon samples
+    /// (equal lengths) — and flush.
+    pub fn write(
+        &mut self,
+        time: &[f64],
+        position: &[f64],
+        lower: &[f64],
+        upper: &[f64],
+    ) -> std::io::Result<()> {
+        for (((t, y), lo), hi) in time.iter().zip(position).zip(lower).zip(upper) {
+            writeln!(self.out, "{t},{y},{lo},{hi}")?;
             self.rows += 1;
         }
         self.out.flush()

@@ -15,29 +15,42 @@ pub fn cell(v: Option<f64>) -> String {
     }
 }
 
-/// Write `time_s,command_m,measured_m,predicted_m,simulated_m`, one row per
-/// sample of `time`; `predicted[k]` counts only where `has_prediction[k]`;
-/// empty cells where nothing was predicted or simulated (or a value is not
-/// finite).
+/// The per-sample predictions of a run, as columns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictionColumns<'a> {
+    /// Predicted position \[m\]; counts only where `has_prediction`.
+    pub predicted: &'a [f64],
+    /// Lower bound of the prediction interval \[m\].
+    pub lower: &'a [f64],
+    /// Upper bound of the prediction interval \[m\].
+    pub upper: &'a [f64],
+    /// Whether the sample was predicted.
+    pub has_prediction: &'a [bool],
+}
+
+/// Write `time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m`,
+/// one row per sample of `time`; the prediction and its interval count only
+/// where `has_prediction[k]`; empty cells where nothing was predicted or
+/// simulated (or a value is not finite).
 pub fn write_predictions_csv(
     w: &mut dyn Write,
     time: &[f64],
     command: &[f64],
     measured: &[f64],
-    predicted: &[f64],
-    has_prediction: &[bool],
+    predictions: PredictionColumns<'_>,
     simulated: Option<&[f64]>,
 ) -> std::io::Result<()> {
-    writeln!(w, "time_s,command_m,measured_m,predicted_m,simulated_m")?;
+    writeln!(
+        w,
+        "time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m"
+    )?;
     let at = |v: &[f64], k: usize| v.get(k).copied();
     // one row formatted into a reused buffer, then written whole (no
     // allocation per cell: 18 M rows for an hour at 5 kHz)
     let mut row = String::with_capacity(128);
     for (k, t) in time.iter().enumerate() {
-        let p = match has_prediction.get(k) {
-            Some(true) => at(predicted, k),
-            _ => None,
-        };
+        let has = predictions.has_prediction.get(k) == Some(&true);
+        let pick = |v: &[f64]| if has { at(v, k) } else { None };
         row.clear();
         push_cell(&mut row, Some(*t));
         row.push(',');
@@ -45,7 +58,11 @@ pub fn write_predictions_csv(
         row.push(',');
         push_cell(&mut row, at(measured, k));
         row.push(',');
-        push_cell(&mut row, p);
+        push_cell(&mut row, pick(predictions.predicted));
+        row.push(',');
+        push_cell(&mut row, pick(predictions.lower));
+        row.push(',');
+        push_cell(&mut row, pick(predictions.upper));
         row.push(',');
         push_cell(&mut row, simulated.and_then(|s| at(s, k)));
         row.push('\n');
@@ -137,14 +154,19 @@ mod tests {
             &[0.0, 0.5, 1.0],
             &[1.0, 2.0, 3.0],
             &[1.0, 2.0, 3.0],
-            &[9.0, 2.5, f64::NAN],
-            &[false, true, true],
+            PredictionColumns {
+                predicted: &[9.0, 2.5, f64::NAN],
+                lower: &[8.0, 2.25, 1.0],
+                upper: &[10.0, 2.75, 2.0],
+                has_prediction: &[false, true, true],
+            },
             Some(&[1.0, f64::INFINITY, 3.0]),
         )
         .unwrap();
         assert_eq!(
             String::from_utf8(out).unwrap(),
-            "time_s,command_m,measured_m,predicted_m,simulated_m\n0,1,1,,1\n0.5,2,2,2.5,\n1,3,3,,3\n"
+            "time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m\n\
+             0,1,1,,,,1\n0.5,2,2,2.5,2.25,2.75,\n1,3,3,,1,2,3\n"
         );
     }
 
@@ -155,18 +177,28 @@ mod tests {
         let n = vals.len();
         let rot = |s: usize| -> Vec<f64> { (0..n).map(|k| vals[(k + s) % n]).collect() };
         let (t, u, y, p, sim) = (rot(0), rot(1), rot(2), rot(3), rot(4));
+        let (lo, hi) = (rot(5), rot(6));
         let has: Vec<bool> = (0..n).map(|k| k % 3 != 0).collect();
         let mut out = Vec::new();
-        write_predictions_csv(&mut out, &t, &u, &y, &p, &has, Some(&sim)).unwrap();
-        let mut expect = String::from("time_s,command_m,measured_m,predicted_m,simulated_m\n");
+        let cols = PredictionColumns {
+            predicted: &p,
+            lower: &lo,
+            upper: &hi,
+            has_prediction: &has,
+        };
+        write_predictions_csv(&mut out, &t, &u, &y, cols, Some(&sim)).unwrap();
+        let mut expect =
+            String::from("time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m\n");
         for k in 0..n {
-            let pk = if has[k] { Some(p[k]) } else { None };
+            let pick = |v: &[f64]| if has[k] { Some(v[k]) } else { None };
             expect.push_str(&format!(
-                "{},{},{},{},{}\n",
+                "{},{},{},{},{},{},{}\n",
                 cell(Some(t[k])),
                 cell(Some(u[k])),
                 cell(Some(y[k])),
-                cell(pk),
+                cell(pick(&p)),
+                cell(pick(&lo)),
+                cell(pick(&hi)),
                 cell(Some(sim[k]))
             ));
         }

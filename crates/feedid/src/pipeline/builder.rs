@@ -2,10 +2,11 @@
 
 use crate::drive::{simulate_nominal, RigParams};
 use crate::error::{Error, Result};
-use crate::ident::engine::{run_with_progress, Progress};
+use crate::ident::engine::{run_with, Progress};
 use crate::ident::{
-    fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind, Method,
-    OrderSearch, PredictionMode, TimeOrigin, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
+    fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind,
+    GuardConfig, Method, OrderSearch, PredictionMode, TimeOrigin, RESIDUAL_LAGS,
+    SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
 use crate::plausibility::check_recording;
@@ -20,7 +21,8 @@ use crate::stats::ErrorStats;
 /// 10, hop = horizon; no order selection; the method's global model
 /// ([`Method::global_model`]) fitted for the summary; residual analysis up
 /// to lag [`RESIDUAL_LAGS`]; no nominal simulation; no extra model; no
-/// progress hook.
+/// progress hook; 95 % prediction intervals and outlier rejection
+/// ([`GuardConfig::default`]).
 #[derive(Clone)]
 pub struct Pipeline<'a> {
     method: Method,
@@ -33,6 +35,7 @@ pub struct Pipeline<'a> {
     extra_model: Option<GlobalModelKind>,
     residual_lags: Option<usize>,
     nominal: Option<RigParams>,
+    guard: GuardConfig,
     progress: Option<Progress<'a>>,
 }
 
@@ -49,6 +52,7 @@ impl std::fmt::Debug for Pipeline<'_> {
             .field("extra_model", &self.extra_model)
             .field("residual_lags", &self.residual_lags)
             .field("nominal", &self.nominal.is_some())
+            .field("guard", &self.guard)
             .field("progress", &self.progress.is_some())
             .finish()
     }
@@ -68,6 +72,7 @@ impl<'a> Pipeline<'a> {
             extra_model: None,
             residual_lags: Some(RESIDUAL_LAGS),
             nominal: None,
+            guard: GuardConfig::default(),
             progress: None,
         }
     }
@@ -149,6 +154,21 @@ impl<'a> Pipeline<'a> {
         self
     }
 
+    /// Prediction intervals and outlier rejection of the engine; default
+    /// [`GuardConfig::default`] (95 % intervals, outliers beyond 8 error
+    /// scales rejected).
+    pub fn guard(mut self, guard: GuardConfig) -> Self {
+        self.guard = guard;
+        self
+    }
+
+    /// Probability `P` of the prediction intervals, in (0, 1); default 0.95
+    /// (the rest of [`Pipeline::guard`] unchanged).
+    pub fn interval(mut self, probability: f64) -> Self {
+        self.guard.interval = probability;
+        self
+    }
+
     /// Report progress of the sliding identification as `(done, total)`
     /// samples (about 500 calls per run; the global-model fits after it are
     /// not counted). Called from the thread that runs the pipeline.
@@ -188,6 +208,7 @@ impl<'a> Pipeline<'a> {
     pub fn run(&self, recording: &Recording) -> Result<Identification> {
         let mut method = self.method.clone();
         method.validate()?;
+        self.guard.validate()?;
         let order_choice = match &self.order_search {
             None => None,
             Some(search) => {
@@ -235,7 +256,13 @@ impl<'a> Pipeline<'a> {
             // the paper's tf prediction may fall back per window: count it
             Method::Paper(paper) if paper.prediction == PredictionMode::TransferFunction => {
                 let mut estimator = (*paper).build()?;
-                let sliding = run_with_progress(&mut estimator, &signals, &config, self.progress)?;
+                let sliding = run_with(
+                    &mut estimator,
+                    &signals,
+                    &config,
+                    &self.guard,
+                    self.progress,
+                )?;
                 let fallbacks = estimator.tf_fallbacks();
                 if fallbacks > 0 {
                     warnings.push(Warning::PaperTfFallback {
@@ -247,9 +274,22 @@ impl<'a> Pipeline<'a> {
             }
             _ => {
                 let mut estimator = method.build()?;
-                run_with_progress(estimator.as_mut(), &signals, &config, self.progress)?
+                run_with(
+                    estimator.as_mut(),
+                    &signals,
+                    &config,
+                    &self.guard,
+                    self.progress,
+                )?
             }
         };
+        if sliding.stats.samples == 0 {
+            warnings.push(Warning::NothingPredicted {
+                windows: sliding.windows.len(),
+                failed: sliding.failed_windows(),
+                withheld: sliding.withheld_windows(),
+            });
+        }
 
         let simulated = match &self.nominal {
             Some(p) => Some(
@@ -323,7 +363,7 @@ impl<'a> Pipeline<'a> {
 mod tests {
     use super::*;
     use crate::drive::VirtualRig;
-    use crate::ident::{engine, ArxOrders};
+    use crate::ident::engine;
     use crate::signal::Scenario;
 
     fn ramp() -> Recording {
@@ -364,7 +404,7 @@ mod tests {
             assert_eq!(run.sliding.coefficients, alone.coefficients, "{name}");
             let s = run.summary();
             assert_eq!(s.samples_predicted, alone.stats.samples);
-            assert_eq!(s.rms_error_m, alone.stats.rms);
+            assert_eq!(s.rms_error_m, Some(alone.stats.rms));
             assert_eq!(s.window, method.default_window());
             assert!(s.global_model.is_none() && s.sim_rms_error_m.is_none());
             let json = serde_json::to_value(&s).unwrap();
@@ -384,7 +424,9 @@ mod tests {
         let hook = |d: u64, n: u64| calls.lock().unwrap().push((d, n));
         let p = Pipeline::new("arx".parse().unwrap())
             .nominal(RigParams::default())
-            .extra_model(GlobalModelKind::Arx(ArxOrders::default()))
+            .extra_model(GlobalModelKind::Arx(
+                crate::ident::ArxConfig::default().orders,
+            ))
             .progress(&hook);
         let a = p.run(&rec).unwrap();
         let b = p
@@ -405,10 +447,10 @@ mod tests {
         assert!(a.global.is_some());
         assert_eq!(a.model, a.global);
         let s = a.summary();
-        assert_eq!(s.global_model.as_deref(), Some("arx 8,8,1"));
+        assert_eq!(s.global_model.as_deref(), Some("arx 3,3,0"));
         assert!(s
             .to_string()
-            .contains("global model of the method (arx 8,8,1)"));
+            .contains("global model of the method (arx 3,3,0)"));
     }
 
     #[test]

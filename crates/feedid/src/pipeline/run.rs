@@ -77,9 +77,14 @@ impl Identification {
             } else {
                 0.0
             },
-            rms_error_m: s.stats.rms,
-            max_abs_error_m: s.stats.max_abs,
-            fit_percent: s.stats.fit_percent,
+            rms_error_m: (s.stats.samples > 0).then_some(s.stats.rms),
+            max_abs_error_m: (s.stats.samples > 0).then_some(s.stats.max_abs),
+            fit_percent: (s.stats.samples > 0)
+                .then_some(s.stats.fit_percent)
+                .filter(|v| v.is_finite()),
+            interval_percent: 100.0 * s.interval,
+            interval_coverage_percent: s.interval_coverage_percent(),
+            outliers: s.outliers.len(),
             sim_fit_percent: self
                 .global
                 .as_ref()

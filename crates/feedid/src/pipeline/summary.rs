@@ -40,12 +40,25 @@ pub struct IdentifySummary {
     pub samples_predicted: usize,
     /// Share of the recording's samples with a prediction \[%\].
     pub coverage_percent: f64,
-    /// RMS prediction error \[m\].
-    pub rms_error_m: f64,
-    /// Largest absolute prediction error \[m\].
-    pub max_abs_error_m: f64,
-    /// NRMSE fit of the k-step (k = horizon) predictions \[%\].
-    pub fit_percent: f64,
+    /// RMS prediction error over the predicted samples \[m\] (`None`, left
+    /// out of the JSON, when nothing was predicted: no figure over nothing).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rms_error_m: Option<f64>,
+    /// Largest absolute prediction error \[m\] (`None` when nothing was predicted).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_abs_error_m: Option<f64>,
+    /// NRMSE fit of the k-step (k = horizon) predictions \[%\] (`None`
+    /// when nothing was predicted).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit_percent: Option<f64>,
+    /// Probability of the prediction intervals \[%\] (`--interval`; default 95).
+    pub interval_percent: f64,
+    /// Share of the predicted samples whose measured position lies inside
+    /// its prediction interval \[%\] (`None` when nothing was predicted).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interval_coverage_percent: Option<f64>,
+    /// Measured samples rejected as isolated outliers (not fitted; still scored).
+    pub outliers: usize,
     /// NRMSE fit of the free-run simulation of the method's global model
     /// over the samples it was fitted on \[%\] (`None` without one, e.g.
     /// `paper`, or when it is not finite).
@@ -129,24 +142,38 @@ impl fmt::Display for IdentifySummary {
             self.samples_predicted,
             self.coverage_percent
         )?;
-        if self.samples_predicted == 0 {
-            // no figure over nothing
-            writeln!(
+        match (self.rms_error_m, self.max_abs_error_m, self.fit_percent) {
+            (Some(rms), Some(max), Some(fit)) => writeln!(
                 f,
-                "  prediction error: none (no sample was predicted; see the window, the tolerance and the warnings)"
-            )?;
-        } else {
-            writeln!(
-                f,
-                "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} %{}",
-                1e6 * self.rms_error_m,
-                1e6 * self.max_abs_error_m,
-                self.fit_percent,
+                "  prediction error: rms {:.3} µm, max {:.3} µm, fit {:.3} % over {:.1} % of the samples{}{}",
+                1e6 * rms,
+                1e6 * max,
+                fit,
+                self.coverage_percent,
+                match self.interval_coverage_percent {
+                    Some(c) => format!(
+                        ", {c:.1} % inside the {} % interval",
+                        self.interval_percent
+                    ),
+                    None => String::new(),
+                },
                 if self.warnings.is_empty() {
                     ""
                 } else {
                     " (see the warnings)"
                 }
+            )?,
+            // no figure over nothing
+            _ => writeln!(
+                f,
+                "  prediction error: none (no sample was predicted, coverage 0 %; see the warnings)"
+            )?,
+        }
+        if self.outliers > 0 {
+            writeln!(
+                f,
+                "  {} isolated outlier sample(s) not fitted (scored as measured)",
+                self.outliers
             )?;
         }
         if let (Some(m), Some(fit)) = (&self.global_model, self.global_fit_percent) {

@@ -21,6 +21,15 @@ pub enum Warning {
         /// The largest growth factor of the change of basis over the windows.
         amplification: f64,
     },
+    /// No sample was predicted: no error figure is reported.
+    NothingPredicted {
+        /// Windows visited.
+        windows: usize,
+        /// Windows whose fit or prediction failed.
+        failed: usize,
+        /// Windows whose prediction the method withheld.
+        withheld: usize,
+    },
     /// Paper method with the window time origin: the output model
     /// `P5·τ⁵ + P6·τ⁶ + P7·τ⁷` is zero with its first four derivatives at each
     /// window's first sample, so it cannot represent an axis that is away from
@@ -54,6 +63,27 @@ impl fmt::Display for Warning {
                  cannot predict a moving axis)",
                 g.log10().min(16.0)
             ),
+            Warning::NothingPredicted {
+                windows,
+                failed,
+                withheld,
+            } => {
+                write!(f, "no sample was predicted, so no error is reported: ")?;
+                if *windows == 0 {
+                    write!(
+                        f,
+                        "the recording is too short for one window and its horizon"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "of {windows} windows, {failed} failed (the method could not fit or \
+                         predict them: too little motion, an unstable or non-finite model) and \
+                         {withheld} were withheld; try another method, a longer window or \
+                         `--method auto`, which always predicts"
+                    )
+                }
+            }
             Warning::PaperWindowOrigin => write!(
                 f,
                 "paper method, time origin window: the output model P5·τ⁵ + P6·τ⁶ + P7·τ⁷ \

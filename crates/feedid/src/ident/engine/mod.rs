@@ -4,14 +4,17 @@
 
 pub mod batch;
 mod estimator;
+mod guard;
 mod signals;
 mod sliding;
 pub mod stream;
 
 pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
+pub use guard::{Guard, GuardConfig, MIN_HISTORY};
 pub use signals::{Samples, Signals};
 pub(crate) use sliding::fit_and_predict;
 pub use sliding::{
-    run, run_with_progress, EngineConfig, Progress, SlidingResult, WindowIter, WindowRecord,
+    run, run_with, run_with_progress, EngineConfig, Progress, SlidingResult, WindowIter,
+    WindowRecord,
 };
 pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};

@@ -41,6 +41,7 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use crate::error::{Error, Result};
+use crate::ident::engine::guard::{Guard, GuardConfig};
 use crate::ident::{Estimator, PredictStatus, Signals, WindowOutcome};
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
@@ -175,7 +176,18 @@ pub struct SlidingResult {
     pub predicted: Vec<f64>,
     /// Whether sample k was predicted.
     pub has_prediction: Vec<bool>,
-    /// Error statistics over all predicted samples.
+    /// Lower bound of the prediction interval per sample \[m\]; meaningful only where `has_prediction`.
+    pub lower: Vec<f64>,
+    /// Upper bound of the prediction interval per sample \[m\]; meaningful only where `has_prediction`.
+    pub upper: Vec<f64>,
+    /// Probability of the prediction intervals ([`GuardConfig::interval`]).
+    pub interval: f64,
+    /// Predicted samples whose measured position lies inside its interval.
+    pub inside_interval: usize,
+    /// Samples rejected as outliers (absolute indices, ascending): replaced
+    /// by their prediction in what the estimator saw; scored as measured.
+    pub outliers: Vec<usize>,
+    /// Error statistics over all predicted samples (against the measured position).
     pub stats: ErrorStats,
     /// Wall time of identification and prediction only (no I/O).
     pub elapsed: Duration,
@@ -188,6 +200,21 @@ impl SlidingResult {
             Some(true) => self.predicted.get(k).copied(),
             _ => None,
         }
+    }
+
+    /// Interval bounds at sample `k`, if it was predicted.
+    pub fn interval_at(&self, k: usize) -> Option<(f64, f64)> {
+        match self.has_prediction.get(k) {
+            Some(true) => Some((self.lower[k], self.upper[k])),
+            _ => None,
+        }
+    }
+
+    /// Share of the predicted samples whose measured position lies inside
+    /// its prediction interval \[%\]; `None` if nothing was predicted.
+    pub fn interval_coverage_percent(&self) -> Option<f64> {
+        (self.stats.samples > 0)
+            .then(|| 100.0 * self.inside_interval as f64 / self.stats.samples as f64)
     }
 
     /// Coefficients of window `w`.
@@ -222,13 +249,14 @@ impl SlidingResult {
     }
 }
 
-/// Slide `estimator` over `signals` (offset 0) and collect predictions and statistics.
+/// Slide `estimator` over `signals` (offset 0) and collect predictions,
+/// intervals and statistics (default [`GuardConfig`]).
 pub fn run<E: Estimator + ?Sized>(
     estimator: &mut E,
     signals: &Signals<'_>,
     config: &EngineConfig,
 ) -> Result<SlidingResult> {
-    run_with_progress(estimator, signals, config, None)
+    run_with(estimator, signals, config, &GuardConfig::default(), None)
 }
 
 /// A progress hook: `progress(done, total)` in samples (called from the
@@ -243,6 +271,23 @@ pub fn run_with_progress<E: Estimator + ?Sized>(
     config: &EngineConfig,
     progress: Option<Progress<'_>>,
 ) -> Result<SlidingResult> {
+    run_with(
+        estimator,
+        signals,
+        config,
+        &GuardConfig::default(),
+        progress,
+    )
+}
+
+/// [`run_with_progress`] with the interval and outlier settings `guard`.
+pub fn run_with<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    config: &EngineConfig,
+    guard: &GuardConfig,
+    progress: Option<Progress<'_>>,
+) -> Result<SlidingResult> {
     signals.check_lengths()?;
     let n = signals.len();
     let est_warm = estimator.warm_up();
@@ -255,7 +300,17 @@ pub fn run_with_progress<E: Estimator + ?Sized>(
     let mut windows = Vec::with_capacity(windows_expected);
     let mut predicted = vec![0.0; n];
     let mut has_prediction = vec![false; n];
+    let mut lower = vec![0.0; n];
+    let mut upper = vec![0.0; n];
     let mut buf = vec![0.0; config.horizon];
+    let mut lo = vec![0.0; config.horizon];
+    let mut hi = vec![0.0; config.horizon];
+    let mut guard = Guard::new(*guard, config.horizon, config.hop())?;
+    let raw = signals.all();
+    // what the estimator sees: the measured position with outliers replaced
+    // (a copy made at the first outlier)
+    let mut cleaned: Option<Vec<f64>> = None;
+    let mut outliers = Vec::new();
 
     estimator.reset();
     let total = n as u64;
@@ -272,12 +327,49 @@ pub fn run_with_progress<E: Estimator + ?Sized>(
                 next_report = horizon.start.saturating_add(step);
             }
         }
+        guard.observe(
+            window.end,
+            |k| raw.position[k],
+            |k, v| {
+                cleaned.get_or_insert_with(|| raw.position.to_vec())[k] = v;
+                outliers.push(k);
+            },
+        );
+        let seen = match &cleaned {
+            Some(c) => Signals::new(
+                raw.time,
+                raw.command,
+                c,
+                signals.dt(),
+                signals.motion_start(),
+            ),
+            None => *signals,
+        };
         let coef = &mut coefficients[w * nc..(w + 1) * nc];
-        let out = &mut buf[..horizon.len()];
-        let record = fit_and_predict(estimator, signals, window, horizon, coef, out);
+        let h = horizon.len();
+        let out = &mut buf[..h];
+        let record = fit_and_predict(estimator, &seen, window.clone(), horizon, coef, out);
         if record.outcome.predicted() {
+            let y = seen.all().position;
+            let win = &y[window.clone()];
+            let (mn, mx) = win
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let (lo, hi) = (&mut lo[..h], &mut hi[..h]);
+            guard.predicted(
+                record.horizon.start,
+                out,
+                y[window.end - 1],
+                mx - mn,
+                lo,
+                hi,
+            );
             predicted[record.horizon.clone()].copy_from_slice(out);
             has_prediction[record.horizon.clone()].fill(true);
+            lower[record.horizon.clone()].copy_from_slice(lo);
+            upper[record.horizon.clone()].copy_from_slice(hi);
         }
         windows.push(record);
     }
@@ -287,10 +379,12 @@ pub fn run_with_progress<E: Estimator + ?Sized>(
     }
 
     let mut acc = ErrorAccumulator::default();
-    let y = signals.all().position;
+    let mut inside_interval = 0;
+    let y = raw.position;
     for k in 0..n {
         if has_prediction[k] {
             acc.push(y[k], predicted[k]);
+            inside_interval += usize::from(lower[k] <= y[k] && y[k] <= upper[k]);
         }
     }
     Ok(SlidingResult {
@@ -300,6 +394,11 @@ pub fn run_with_progress<E: Estimator + ?Sized>(
         windows,
         predicted,
         has_prediction,
+        lower,
+        upper,
+        interval: guard.config().interval,
+        inside_interval,
+        outliers,
         stats: acc.finish(),
         elapsed,
     })

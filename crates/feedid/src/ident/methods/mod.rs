@@ -11,7 +11,7 @@ mod rls;
 
 pub(crate) use arx::fit_arx_rows;
 pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit};
-pub use auto::{AutoConfig, AutoEstimator, AUTO_CANDIDATES};
+pub use auto::{AutoConfig, AutoEstimator, Candidate};
 pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit, OeJacobian};
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,

@@ -105,26 +105,34 @@ pub struct RlsConfig {
     pub p0: f64,
     /// Bound on `tr P`; default `None` = the initial trace `n·p0`.
     pub max_trace: Option<f64>,
-    /// Minimum command range over the regressor span for an update \[m\];
-    /// default 1e-9; 0 disables the gate (every sample updates).
+    /// Minimum command range over the regressor span for an update,
+    /// relative to the scale `s`; default 1e-6; 0 disables the gate (every
+    /// sample updates).
     pub min_excitation: f64,
-    /// Scale `s` of the deviation coordinates \[m\]; default 1e-3.
-    pub scale: f64,
-    /// Distance from the frame `r₀` that moves the frame \[m\]; default 1e-3.
+    /// Scale `s` of the deviation coordinates \[m\]; default `None`: from
+    /// the data, the larger of the ranges of command and position over the
+    /// first window in which either moves (so that units and offsets do not
+    /// change the estimates).
+    pub scale: Option<f64>,
+    /// Distance from the frame `r₀` that moves the frame, relative to the
+    /// scale `s`; default 1 (`∞`: the frame never moves).
     pub frame_span: f64,
+    /// Poles must lie strictly inside this radius for a prediction; default 1.0.
+    pub max_pole_radius: f64,
 }
 
 impl Default for RlsConfig {
     fn default() -> Self {
         Self {
-            orders: ArxOrders::new(8, 8, 1),
+            orders: ArxOrders::new(8, 8, 0),
             lambda: 0.999,
             window: None,
-            p0: 1e4,
+            p0: 1e6,
             max_trace: None,
-            min_excitation: 1e-9,
-            scale: 1e-3,
-            frame_span: 1e-3,
+            min_excitation: 0.0,
+            scale: None,
+            frame_span: 1.0,
+            max_pole_radius: 1.0,
         }
     }
 }
@@ -146,11 +154,7 @@ impl RlsConfig {
                 reason: "must be in (0, 1]",
             });
         }
-        for (name, v) in [
-            ("p0", self.p0),
-            ("scale", self.scale),
-            ("frame_span", self.frame_span),
-        ] {
+        for (name, v) in [("p0", self.p0), ("scale", self.scale.unwrap_or(1.0))] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::InvalidParameter {
                     name,
@@ -159,7 +163,14 @@ impl RlsConfig {
                 });
             }
         }
-        if !(self.min_excitation >= 0.0) {
+        if !(self.frame_span > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "frame_span",
+                value: self.frame_span,
+                reason: "must be > 0 (∞: the frame never moves)",
+            });
+        }
+        if !(self.min_excitation >= 0.0 && self.min_excitation.is_finite()) {
             return Err(Error::InvalidParameter {
                 name: "min_excitation",
                 value: self.min_excitation,
@@ -201,6 +212,10 @@ pub struct RlsEstimator {
     schur: Vec<f64>,
     r0: f64,
     framed: bool,
+    /// The last estimate whose poles passed the check (empty: none yet).
+    stable: Vec<f64>,
+    /// The scale `s` in use (0 until the data have moved).
+    s: f64,
     cursor: Option<usize>,
     /// Absolute index of the first processed sample since the reset.
     start: Option<usize>,
@@ -224,6 +239,8 @@ impl RlsEstimator {
             schur: vec![0.0; n + 1],
             r0: 0.0,
             framed: false,
+            stable: Vec::with_capacity(n),
+            s: 0.0,
             cursor: None,
             start: None,
             updates: 0,
@@ -273,7 +290,7 @@ impl RlsEstimator {
             mn = mn.min(v);
             mx = mx.max(v);
         }
-        mx - mn > self.config.min_excitation || self.config.min_excitation == 0.0
+        mx - mn > self.config.min_excitation * self.s || self.config.min_excitation == 0.0
     }
 
     /// Load the scaled regressor of sample `k` (local) into `psi`; returns the target.
@@ -284,7 +301,7 @@ impl RlsEstimator {
         let o = &self.config.orders;
         let (na, nb, nk) = (o.na, o.nb, o.nk);
         let r = self.r0;
-        let s = 1.0 / self.config.scale;
+        let s = 1.0 / self.s;
         let (pa, pb) = self.psi.split_at_mut(na);
         for (p, &v) in pa.iter_mut().zip(y[k - na..k].iter().rev()) {
             *p = -(v - r) * s;
@@ -377,7 +394,45 @@ impl RlsEstimator {
     }
 }
 
-/// [`add_kernel`] with the common sizes as constants (unrolled, vectorised).
+/// Whether the CPU has AVX2 (selects the vectorised RLS update).
+pub(crate) fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// One exponentially weighted RLS update (the update of [`RlsEstimator`],
+/// shared with `auto`'s recursive candidates): `p` row-major `n×n` and
+/// exactly symmetric, `g` a scratch of length `n`, trace bound `max`
+/// (∞ = none), `avx` from [`has_avx2`]. Returns the a-priori error, or
+/// `Err(e)` if `λ + ψᵀPψ` is not positive (nothing updated).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn rls_update(
+    avx: bool,
+    p: &mut [f64],
+    psi: &[f64],
+    theta: &mut [f64],
+    g: &mut [f64],
+    target: f64,
+    lambda: f64,
+    max: f64,
+) -> std::result::Result<f64, f64> {
+    let n = psi.len();
+    #[cfg(target_arch = "x86_64")]
+    if avx {
+        // SAFETY: callers pass `avx` from `has_avx2`.
+        return unsafe { add_avx2(n, p, psi, theta, g, target, lambda, max) };
+    }
+    let _ = avx;
+    add_sized(n, p, psi, theta, g, target, lambda, max)
+}
+
+/// [`add_kernel`] with the sizes up to 16 as constants (unrolled, vectorised).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn add_sized(
@@ -390,7 +445,16 @@ fn add_sized(
     lambda: f64,
     max: f64,
 ) -> std::result::Result<f64, f64> {
-    add_kernel(n, p, psi, theta, g, target, lambda, max)
+    // each arm inlines the kernel with a constant size (unrolled loops)
+    macro_rules! sized {
+        ($($k:literal)*) => {
+            match n {
+                $($k => add_kernel($k, p, psi, theta, g, target, lambda, max),)*
+                _ => add_kernel(n, p, psi, theta, g, target, lambda, max),
+            }
+        };
+    }
+    sized!(2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
 }
 
 /// [`add_sized`] compiled for AVX2 (4-wide vectors). No FMA contraction
@@ -517,6 +581,8 @@ impl Estimator for RlsEstimator {
     fn reset(&mut self) {
         self.reset_covariance();
         self.framed = false;
+        self.stable.clear();
+        self.s = self.config.scale.unwrap_or(0.0);
         self.cursor = None;
         self.start = None;
         self.updates = 0;
@@ -553,11 +619,34 @@ impl Estimator for RlsEstimator {
         let local_first = start.max(base + lag) - base;
         let mut sse = 0.0;
         let mut count = 0usize;
+        if self.s == 0.0 {
+            // the scale from the first data that move (units and offsets cancel)
+            let range = |v: &[f64]| {
+                let (lo, hi) = v
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                        (a.min(x), b.max(x))
+                    });
+                hi - lo
+            };
+            let from = cursor - base - lag;
+            let s = range(&y[from..]).max(range(&u[from..]));
+            if s > 0.0 && s.is_finite() {
+                self.s = s;
+            } else {
+                // nothing moves yet: nothing to learn
+                self.cursor = Some(window.end);
+                coef.fill(0.0);
+                return Err(Error::Singular {
+                    context: "rls (no exciting sample yet)",
+                });
+            }
+        }
         for k in (cursor - base)..(window.end - base) {
             if !self.framed {
                 self.r0 = y[k - 1];
                 self.framed = true;
-            } else if (y[k - 1] - self.r0).abs() > self.config.frame_span {
+            } else if (y[k - 1] - self.r0).abs() > self.config.frame_span * self.s {
                 self.r0 = y[k - 1];
                 if let Some(w) = self.config.window {
                     self.rebuild_window(y, u, local_first, k, w);
@@ -604,7 +693,7 @@ impl Estimator for RlsEstimator {
         let nc = coef.len().min(self.n);
         coef[..nc].copy_from_slice(&self.theta[..nc]);
         let rms = if count > 0 {
-            (sse / count as f64).sqrt() * self.config.scale
+            (sse / count as f64).sqrt() * self.s
         } else {
             0.0
         };
@@ -628,14 +717,22 @@ impl Estimator for RlsEstimator {
                 context: "rls prediction (no model)",
             });
         }
-        if !poles_inside(&self.theta[..orders.na], 1.0, &mut self.schur) {
+        if poles_inside(
+            &self.theta[..orders.na],
+            self.config.max_pole_radius,
+            &mut self.schur,
+        ) {
+            self.stable.clear();
+            self.stable.extend_from_slice(&self.theta);
+        } else if self.stable.is_empty() {
             return Err(Error::InvalidModel {
                 reason: "RLS estimate has unstable poles",
             });
         }
+        // the current estimate if it passed the check, else the last one that did
         predict_horizon(
             &orders,
-            &self.theta,
+            &self.stable,
             0.0,
             signals,
             window,
@@ -737,7 +834,7 @@ mod tests {
     }
 
     #[test]
-    fn unstable_estimate_is_never_used_for_a_prediction() {
+    fn unstable_estimate_is_never_used_for_a_prediction_the_last_stable_one_is() {
         // data from an unstable system: y[k] = 1.05 y[k-1] + u[k-1]
         let mut rng = ChaCha8Rng::seed_from_u64(6);
         let n = 100;
@@ -750,6 +847,7 @@ mod tests {
             lambda: 1.0,
             p0: 1e10,
             min_excitation: 0.0,
+            max_pole_radius: 1.0,
             ..RlsConfig::default()
         }
         .build()
@@ -760,14 +858,23 @@ mod tests {
         let mut out = [0.0; 5];
         let e = rls.predict(&s, 2..60, 60..65, &mut out).unwrap_err();
         assert!(matches!(e, Error::InvalidModel { .. }), "{e}");
-        // window by window: a prediction exactly when the estimate is stable
+        // window by window: a prediction once an estimate was stable (from
+        // the last stable estimate), none before
         let mut rls = rls.config().build().unwrap();
-        let mut unstable = 0;
+        let (mut unstable, mut last_stable) = (0, None);
         for end in (25..95).step_by(5) {
             rls.fit(&s, end - 20..end, &mut coef).unwrap();
             let stable = poles_inside(&rls.theta()[..1], 1.0, &mut [0.0; 2]);
+            if stable {
+                last_stable = Some(rls.theta().to_vec());
+            }
             let r = rls.predict(&s, end - 20..end, end..end + 5, &mut out);
-            assert_eq!(r.is_ok(), stable, "window ending at {end}: {coef:?}");
+            assert_eq!(
+                r.is_ok(),
+                last_stable.is_some(),
+                "window ending at {end}: {coef:?}"
+            );
+            assert!(r.is_err() || out.iter().all(|v| v.is_finite()));
             unstable += usize::from(!stable);
         }
         assert!(unstable > 0);
@@ -783,7 +890,8 @@ mod tests {
             lambda: 1.0,
             p0: 1e10,
             max_trace: Some(f64::INFINITY),
-            frame_span: 1.0,
+            frame_span: f64::INFINITY,
+            scale: Some(1e-3),
             min_excitation: 0.0,
             ..RlsConfig::default()
         };
@@ -857,7 +965,8 @@ mod tests {
             orders,
             window: Some(w),
             p0: 1e8,
-            frame_span: 1.0,
+            frame_span: f64::INFINITY,
+            scale: Some(1e-3),
             min_excitation: 0.0,
             ..RlsConfig::default()
         }
@@ -886,7 +995,8 @@ mod tests {
                 window,
                 p0: 1e12,
                 max_trace: Some(f64::INFINITY),
-                frame_span: 1.0,
+                frame_span: f64::INFINITY,
+                scale: Some(1e-3),
                 ..RlsConfig::default()
             }
             .build()
@@ -914,6 +1024,7 @@ mod tests {
             orders: ArxOrders::new(2, 2, 1),
             lambda: 0.95,
             max_trace: Some(f64::INFINITY),
+            min_excitation: 1e-6,
             ..RlsConfig::default()
         }
         .build()

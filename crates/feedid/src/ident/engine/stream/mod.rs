@@ -118,6 +118,17 @@
 //! samples, the baseline of holding each window's last measured position
 //! ([`StreamStats::hold`]).
 //!
+//! # Intervals and outliers
+//!
+//! The stream carries the batch engine's guard ([`crate::ident::engine::Guard`],
+//! settings [`StreamOptions::guard`]): each prediction comes with its
+//! interval ([`Prediction::lower`], [`Prediction::upper`]) from the
+//! method's own scored errors, and an isolated wild sample is replaced by
+//! its prediction in what the estimator sees (scored as measured; counted
+//! in [`StreamStats::outliers`], the share inside the intervals in
+//! [`StreamStats::interval_coverage_percent`]). A gap restarts the guard
+//! with the windows.
+//!
 //! ```
 //! use feedid::ident::stream::{StreamOptions, Streamer};
 //! use feedid::ident::{EngineConfig, Method};

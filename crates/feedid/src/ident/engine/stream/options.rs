@@ -7,6 +7,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
+use crate::ident::engine::GuardConfig;
 use crate::recording::DEFAULT_JITTER_TOLERANCE;
 
 /// Relative deviation of a sampling interval from the expected one beyond
@@ -160,6 +161,9 @@ pub struct StreamOptions {
     /// it is reported as irregular (kept); beyond the larger of this and
     /// [`GAP_DEVIATION`] it is a gap. Default 0.01, as for a recording.
     pub jitter_tolerance: f64,
+    /// Prediction intervals and outlier rejection, as in the batch engine;
+    /// default [`GuardConfig::default`] (95 %).
+    pub guard: GuardConfig,
 }
 
 impl Default for StreamOptions {
@@ -170,6 +174,7 @@ impl Default for StreamOptions {
             extrapolation: CommandExtrapolation::default(),
             dt: None,
             jitter_tolerance: DEFAULT_JITTER_TOLERANCE,
+            guard: GuardConfig::default(),
         }
     }
 }
@@ -177,6 +182,7 @@ impl Default for StreamOptions {
 impl StreamOptions {
     /// Check the values (a positive finite `dt`, a finite non-negative tolerance).
     pub fn validate(&self) -> Result<()> {
+        self.guard.validate()?;
         if let Some(dt) = self.dt {
             if !(dt.is_finite() && dt > 0.0) {
                 return Err(Error::InvalidParameter {

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::ident::engine::stream::options::{
     Arrival, CommandExtrapolation, HorizonCommand, Interval, Jump, StreamOptions,
 };
-use crate::ident::engine::{fit_and_predict, EngineConfig};
+use crate::ident::engine::{fit_and_predict, EngineConfig, Guard};
 use crate::ident::{Estimator, Signals, WindowOutcome};
 use crate::recording::MOTION_THRESHOLD;
 use crate::stats::{ErrorAccumulator, ErrorStats};
@@ -17,9 +17,8 @@ const MAX_CAPACITY: usize = 1 << 26;
 
 /// One window's prediction, borrowed from the streamer's buffers.
 ///
-/// Per horizon sample: its time and predicted position (the columns a
-/// consumer writes; prediction intervals, when a method gives them, will be
-/// two more slices of the same length).
+/// Per horizon sample: its time, predicted position and prediction interval
+/// (the columns a consumer writes).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Prediction<'a> {
     /// Samples fitted (absolute indices, 0 = the first sample of the stream).
@@ -32,6 +31,11 @@ pub struct Prediction<'a> {
     pub time: &'a [f64],
     /// Predicted positions \[m\]; empty unless [`Prediction::is_ok`].
     pub position: &'a [f64],
+    /// Lower bounds of the prediction intervals \[m\] (as the batch
+    /// engine's, [`crate::ident::GuardConfig`]); as long as `position`.
+    pub lower: &'a [f64],
+    /// Upper bounds of the prediction intervals \[m\]; as long as `position`.
+    pub upper: &'a [f64],
     /// Horizon samples whose position had already arrived when this
     /// prediction was made (0: a forecast of the whole horizon).
     pub already_measured: usize,
@@ -83,6 +87,19 @@ pub struct StreamStats {
     pub scored: ErrorStats,
     /// The baseline on the same samples: each window's last measured position held.
     pub hold: ErrorStats,
+    /// Scored samples whose measured position lay inside the prediction interval.
+    pub inside_interval: usize,
+    /// Samples rejected as isolated outliers (not fitted; scored as measured).
+    pub outliers: usize,
+}
+
+impl StreamStats {
+    /// Share of the scored samples inside their prediction interval \[%\];
+    /// `None` before any sample is scored.
+    pub fn interval_coverage_percent(&self) -> Option<f64> {
+        (self.scored.samples > 0)
+            .then(|| 100.0 * self.inside_interval as f64 / self.scored.samples as f64)
+    }
 }
 
 /// A line or position that revealed a gap, stored once the predictions due
@@ -112,11 +129,19 @@ pub struct Streamer<E: Estimator = Box<dyn Estimator>> {
     off: usize,
     t: Vec<f64>,
     u: Vec<f64>,
+    /// Position as the estimator sees it (outliers replaced by their prediction).
     y: Vec<f64>,
-    /// Latest prediction per sample, its hold baseline, and whether there is one.
+    /// Position as measured (scored).
+    raw: Vec<f64>,
+    /// Latest prediction per sample, its interval, its hold baseline, and
+    /// whether there is one.
     p: Vec<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
     base: Vec<f64>,
     has: Vec<bool>,
+    /// Prediction intervals and outlier rejection, as in the batch engine.
+    guard: Guard,
     /// Commands / positions stored (absolute counts).
     nc: usize,
     np: usize,
@@ -149,6 +174,9 @@ pub struct Streamer<E: Estimator = Box<dyn Estimator>> {
     pending: Option<Pending>,
     coef: Vec<f64>,
     pred: Vec<f64>,
+    pred_lo: Vec<f64>,
+    pred_hi: Vec<f64>,
+    inside: usize,
     lines: usize,
     unused: usize,
     windows: usize,
@@ -214,6 +242,7 @@ impl<E: Estimator> Streamer<E> {
         };
         let cap = 2 * span;
         let ncoef = estimator.coefficient_names().len();
+        let guard = Guard::new(options.guard, config.horizon, hop)?;
         let mut s = Self {
             future: estimator.uses_future_command(),
             est: estimator,
@@ -227,9 +256,13 @@ impl<E: Estimator> Streamer<E> {
             t: vec![0.0; cap],
             u: vec![0.0; cap],
             y: vec![0.0; cap],
+            raw: vec![0.0; cap],
             p: vec![0.0; cap],
+            lo: vec![0.0; cap],
+            hi: vec![0.0; cap],
             base: vec![0.0; cap],
             has: vec![false; cap],
+            guard,
             nc: 0,
             np: 0,
             top: 0,
@@ -251,6 +284,9 @@ impl<E: Estimator> Streamer<E> {
             pending: None,
             coef: vec![0.0; ncoef],
             pred: vec![0.0; config.horizon],
+            pred_lo: vec![0.0; config.horizon],
+            pred_hi: vec![0.0; config.horizon],
+            inside: 0,
             lines: 0,
             unused: 0,
             windows: 0,
@@ -287,13 +323,16 @@ impl<E: Estimator> Streamer<E> {
         self.irregular = 0;
         self.acc = ErrorAccumulator::default();
         self.acc_hold = ErrorAccumulator::default();
+        self.inside = 0;
         self.begin_segment();
+        self.guard.reset_outliers();
     }
 
     /// Start a segment at sample `np` (commands already stored from there on
     /// are kept; see [`Streamer::restart_segment`]).
     fn begin_segment(&mut self) {
         self.est.reset();
+        self.guard.reset_segment();
         self.has.fill(false);
         self.top = self.np;
         self.scored = self.np;
@@ -382,6 +421,8 @@ impl<E: Estimator> Streamer<E> {
             irregular_intervals: self.irregular,
             scored: self.acc.finish(),
             hold: self.acc_hold.finish(),
+            inside_interval: self.inside,
+            outliers: self.guard.outliers(),
         }
     }
 
@@ -567,6 +608,13 @@ impl<E: Estimator> Streamer<E> {
                 future.fill(f64::NAN);
             }
         }
+        // isolated wild samples measured since the last window: replaced by
+        // their prediction in what the estimator sees (as the batch engine)
+        {
+            let (raw, y) = (&self.raw, &mut self.y);
+            self.guard
+                .observe(we, |k| raw[k - off], |k, v| y[k - off] = v);
+        }
         let motion_start = match self.motion_idx {
             Some(i) if i < np => self.motion_time,
             Some(i) => t_last + (i + 1 - np) as f64 * dt,
@@ -585,8 +633,19 @@ impl<E: Estimator> Streamer<E> {
         let record = fit_and_predict(&mut self.est, &signals, s..we, we..he, &mut self.coef, out);
         let ok = record.outcome.predicted();
         let already = np.clamp(we, he) - we;
+        let (lo, hi) = (&mut self.pred_lo[..he - we], &mut self.pred_hi[..he - we]);
         if ok {
+            let win = &self.y[s - off..we - off];
+            let (mn, mx) = win
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            self.guard
+                .predicted(we, out, self.y[we - 1 - off], mx - mn, lo, hi);
             self.p[we - off..he - off].copy_from_slice(out);
+            self.lo[we - off..he - off].copy_from_slice(lo);
+            self.hi[we - off..he - off].copy_from_slice(hi);
             self.has[we - off..he - off].fill(true);
             let hold = self.y[we - 1 - off];
             self.base[we - off..he - off].fill(hold);
@@ -607,6 +666,8 @@ impl<E: Estimator> Streamer<E> {
             horizon: we..he,
             time: &self.t[we - off..he - off],
             position: if ok { &self.pred[..he - we] } else { &[] },
+            lower: if ok { &self.pred_lo[..he - we] } else { &[] },
+            upper: if ok { &self.pred_hi[..he - we] } else { &[] },
             already_measured: already,
             coefficients: &self.coef,
             residual_rms: record.residual_rms,
@@ -723,7 +784,7 @@ impl<E: Estimator> Streamer<E> {
         }
         // keep only the commands ahead of the last position
         let (a, b) = (self.np - self.off, self.nc - self.off);
-        for v in [&mut self.t, &mut self.u, &mut self.y] {
+        for v in [&mut self.t, &mut self.u, &mut self.y, &mut self.raw] {
             v.copy_within(a..b, 0);
         }
         self.off = self.np;
@@ -737,6 +798,7 @@ impl<E: Estimator> Streamer<E> {
         self.u[i] = command;
         self.t[i] = f64::NAN;
         self.y[i] = f64::NAN;
+        self.raw[i] = f64::NAN;
         if self.nc == self.seg {
             self.c_first = command;
         } else if self.motion_idx.is_none() && (command - self.c_first).abs() > MOTION_THRESHOLD {
@@ -755,6 +817,7 @@ impl<E: Estimator> Streamer<E> {
         let i = self.np - self.off;
         self.t[i] = t;
         self.y[i] = position;
+        self.raw[i] = position;
         if self.np == self.seg {
             self.seg_t0 = t;
         }
@@ -775,8 +838,10 @@ impl<E: Estimator> Streamer<E> {
         while self.scored < limit {
             let i = self.scored - self.off;
             if self.has[i] {
-                self.acc.push(self.y[i], self.p[i]);
-                self.acc_hold.push(self.y[i], self.base[i]);
+                let y = self.raw[i];
+                self.acc.push(y, self.p[i]);
+                self.acc_hold.push(y, self.base[i]);
+                self.inside += usize::from(self.lo[i] <= y && y <= self.hi[i]);
             }
             self.scored += 1;
         }
@@ -799,7 +864,10 @@ impl<E: Estimator> Streamer<E> {
             &mut self.t,
             &mut self.u,
             &mut self.y,
+            &mut self.raw,
             &mut self.p,
+            &mut self.lo,
+            &mut self.hi,
             &mut self.base,
         ] {
             v.copy_within(a..b, 0);

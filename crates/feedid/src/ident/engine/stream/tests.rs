@@ -130,6 +130,8 @@ type WindowSummary = (Range<usize>, Range<usize>, WindowOutcome, Vec<f64>);
 struct Collected {
     windows: Vec<WindowSummary>,
     predicted: Vec<f64>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
     has: Vec<bool>,
     /// Time stamp each prediction gave its sample.
     time: Vec<f64>,
@@ -143,9 +145,13 @@ fn collect_from(out: &mut Collected, p: Prediction<'_>, measured: usize) {
     assert_eq!(p.time.len(), p.horizon.len());
     if p.is_ok() {
         assert_eq!(p.position.len(), p.horizon.len());
+        assert_eq!(p.lower.len(), p.horizon.len());
+        assert_eq!(p.upper.len(), p.horizon.len());
         for (j, k) in p.horizon.clone().enumerate() {
             if k < out.predicted.len() {
                 out.predicted[k] = p.position[j];
+                out.lower[k] = p.lower[j];
+                out.upper[k] = p.upper[j];
                 out.time[k] = p.time[j];
                 out.has[k] = true;
             }
@@ -177,6 +183,8 @@ fn empty_stats() -> StreamStats {
         irregular_intervals: 0,
         scored: z,
         hold: z,
+        inside_interval: 0,
+        outliers: 0,
     }
 }
 
@@ -215,6 +223,8 @@ fn stream<E: Estimator>(
     let mut out = Collected {
         windows: Vec::new(),
         predicted: vec![0.0; m],
+        lower: vec![0.0; m],
+        upper: vec![0.0; m],
         has: vec![false; m],
         time: vec![0.0; m],
         arrivals: Vec::new(),
@@ -305,11 +315,16 @@ fn assert_same(c: &Collected, b: &SlidingResult, rel: f64, what: &str) {
     for k in 0..n {
         assert_eq!(c.has[k], b.has_prediction[k], "{what}: sample {k}");
         if c.has[k] {
-            let (a, e) = (c.predicted[k], b.predicted[k]);
-            assert!(
-                (a - e).abs() <= rel * scale,
-                "{what}: sample {k}: {a:e} vs {e:e}"
-            );
+            for (a, e) in [
+                (c.predicted[k], b.predicted[k]),
+                (c.lower[k], b.lower[k]),
+                (c.upper[k], b.upper[k]),
+            ] {
+                assert!(
+                    (a - e).abs() <= rel * scale,
+                    "{what}: sample {k}: {a:e} vs {e:e}"
+                );
+            }
         }
     }
     assert_eq!(c.stats.samples, n);
@@ -326,6 +341,7 @@ fn assert_same(c: &Collected, b: &SlidingResult, rel: f64, what: &str) {
 fn assert_same_score(c: &Collected, b: &SlidingResult, rel: f64, what: &str) {
     let scale = b.predicted.iter().fold(1e-300_f64, |m, v| m.max(v.abs()));
     assert_eq!(c.stats.scored.samples, b.stats.samples, "{what}");
+    assert_eq!(c.stats.outliers, b.outliers.len(), "{what}");
     assert!(
         (c.stats.scored.rms - b.stats.rms).abs() <= 1e-9 * b.stats.rms + rel * scale,
         "{what}: rms {} vs {}",

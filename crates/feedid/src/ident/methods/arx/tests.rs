@@ -273,6 +273,7 @@ fn unstable_window_model_is_rejected() {
     let mut est = ArxConfig {
         orders: ArxOrders::new(1, 1, 1),
         dc_gain_bounds: (f64::NEG_INFINITY, f64::INFINITY),
+        max_pole_radius: 1.0,
         offset: true,
         ..ArxConfig::default()
     }
@@ -450,15 +451,21 @@ fn reference_prediction(
 
 #[test]
 fn default_window_predictions_match_a_batch_svd_fit_on_rig_and_random_data() {
-    // the default estimator (8,8,1, ridge 1e-8: the two stacks and the
+    // the estimator at orders 8,8,1, ridge 1e-8 (the two stacks and the
     // Hessenberg solve) against a from-scratch SVD fit of every window
     for (name, (t, u, y)) in [
         ("rig chirp", rig_chirp(0.6)),
         ("random ARX", random_arx8(21, 3000)),
     ] {
-        let orders = ArxOrders::default();
+        let orders = ArxOrders::new(8, 8, 1);
         let s = Signals::new(&t, &u, &y, t[1] - t[0], 0.0);
-        let mut est = ArxConfig::default().build().unwrap();
+        let mut est = ArxConfig {
+            orders,
+            ridge: 1e-8,
+            ..ArxConfig::default()
+        }
+        .build()
+        .unwrap();
         let range = y.iter().fold(f64::NEG_INFINITY, |a, &v| a.max(v))
             - y.iter().fold(f64::INFINITY, |a, &v| a.min(v));
         let (w, h, hop) = (200, 10, 10);

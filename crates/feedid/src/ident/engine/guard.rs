@@ -1,0 +1,541 @@
+//! What the engine does around every estimator: prediction intervals from
+//! the method's own scored errors, and the rejection of isolated wild
+//! samples (outliers) before any estimator fits them.
+//!
+//! # Prediction intervals
+//!
+//! Every prediction of a window is *scored* once its samples are measured:
+//! the absolute error `e = |y[k] − ŷ[k]|` of the prediction `j` samples
+//! ahead (`j = 0 … H−1`) updates the half-width `q_j` of that step ahead,
+//! an online estimate of the `P`-quantile of the errors there
+//! ([`GuardConfig::interval`]):
+//!
+//! ```text
+//! q_j ← q_j · e^{η·P}        if e > q_j,
+//! q_j ← q_j · e^{−η·(1−P)}   otherwise        (η = GuardConfig::adaptation)
+//! ```
+//!
+//! (the first error sets `q_j`). In the long run a share `1 − P` of the
+//! errors lies beyond `q_j`, whatever their scale (the updates are
+//! multiplicative: a recording in other units gives proportional widths),
+//! and a jump of the errors is followed within tens of horizons. A new
+//! prediction `ŷ` at `j` samples ahead gets the interval `ŷ ± q_j`. Until
+//! [`MIN_HISTORY`] errors are known at `j`, the half-width is the distance
+//! from the last measured position to the prediction plus the range of the
+//! measured position over the window (wide, not calibrated). The share of
+//! measured samples inside their interval is reported as the interval
+//! coverage; it is close to `P` when the recent errors are representative
+//! of the next ones, lower after a sudden change of the motion.
+//!
+//! # Outliers
+//!
+//! Before each fit, the samples measured since the last fit are compared
+//! with their most recent prediction (`j` samples ahead). A sample is an
+//! *outlier* when its error exceeds [`GuardConfig::outlier`] times the
+//! error scale at `j` — the exponentially weighted rms of the recent errors
+//! there (weight η, [`GuardConfig::adaptation`]), at least the resolution
+//! of the data (the smallest non-zero change between consecutive samples,
+//! one count of a quantised encoder) — once [`MIN_HISTORY`] errors are
+//! known at `j`, while the samples just before and after it are within
+//! theirs: a wild sample is isolated, two in a row are a change of the
+//! motion and are kept. The last sample before a fit has no successor yet:
+//! it is an outlier only if its error also exceeds the factor times the
+//! largest change of the position over `H` samples seen so far (a jump no
+//! motion of the recording could make). An outlier is replaced, in what
+//! the estimators see, by its prediction: it is neither fitted nor used as
+//! the start of a prediction, and its error does not join the history. The
+//! measured value is kept for the scores: the statistics of a run are over
+//! the measured positions.
+//!
+//! All buffers are allocated in [`Guard::new`]; the per-sample work is a
+//! constant number of operations per pending prediction (at most
+//! `⌈H / hop⌉ + 1`).
+
+// Negated comparisons are deliberate (they reject NaN).
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::error::{Error, Result};
+
+/// Errors needed at a step ahead before its interval is calibrated and
+/// outliers are detected there.
+pub const MIN_HISTORY: usize = 20;
+
+/// Settings of the engine's prediction intervals and outlier rejection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GuardConfig {
+    /// Probability `P` of the prediction interval, in (0, 1); default 0.95.
+    pub interval: f64,
+    /// A measured sample whose error exceeds this many times the recent rms
+    /// error at its step ahead (at least the data's resolution), its
+    /// neighbours' not, is an outlier (see the module doc); `None` keeps
+    /// every sample; default `Some(8.0)`.
+    pub outlier: Option<f64>,
+    /// Rate η of the interval's adaptation, in (0, 1]: after a scored error
+    /// its half-width is multiplied by `e^{η·P}` (error beyond it) or
+    /// `e^{−η·(1−P)}` (within it); default 0.1 (a jump of the errors is
+    /// caught up within tens of horizons).
+    pub adaptation: f64,
+}
+
+impl Default for GuardConfig {
+    fn default() -> Self {
+        Self {
+            interval: 0.95,
+            outlier: Some(8.0),
+            adaptation: 0.1,
+        }
+    }
+}
+
+impl GuardConfig {
+    /// Check the settings (`interval` in (0, 1), `outlier` > 1, `adaptation` in (0, 1]).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.interval > 0.0 && self.interval < 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "interval",
+                value: self.interval,
+                reason: "must be in (0, 1) (e.g. 0.95)",
+            });
+        }
+        if let Some(k) = self.outlier {
+            if !(k.is_finite() && k > 1.0) {
+                return Err(Error::InvalidParameter {
+                    name: "outlier",
+                    value: k,
+                    reason: "must be finite and > 1",
+                });
+            }
+        }
+        if !(self.adaptation > 0.0 && self.adaptation <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "interval adaptation",
+                value: self.adaptation,
+                reason: "must be in (0, 1]",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// An online estimate of the `P`-quantile of the absolute errors at one
+/// step ahead: multiplied by `up = e^{η·P}` after an error beyond it and
+/// by `down = e^{−η·(1−P)}` after one within it, so that in the long run a
+/// share `1 − P` of the errors lies beyond it.
+#[derive(Debug, Clone, Copy)]
+struct Tracker {
+    q: f64,
+    n: usize,
+}
+
+impl Tracker {
+    const NEW: Self = Self { q: 0.0, n: 0 };
+
+    fn push(&mut self, e: f64, up: f64, down: f64) {
+        if self.q == 0.0 {
+            self.q = e;
+        } else if e > self.q {
+            self.q *= up;
+        } else {
+            self.q *= down;
+        }
+        self.n += 1;
+    }
+}
+
+/// A newly measured sample during [`Guard::observe`].
+#[derive(Debug, Clone, Copy)]
+struct Checked {
+    y: f64,
+    /// Its latest prediction and how many samples ahead it was made.
+    latest: Option<(f64, usize)>,
+    /// `|y − prediction|` (0 without a prediction).
+    excess: f64,
+    exceeds: bool,
+}
+
+/// A prediction not yet fully measured.
+#[derive(Debug, Clone)]
+struct Pending {
+    start: usize,
+    len: usize,
+    values: Vec<f64>,
+}
+
+/// The engine's interval and outlier state for one run (see the module doc).
+#[derive(Debug, Clone)]
+pub struct Guard {
+    config: GuardConfig,
+    horizon: usize,
+    trackers: Vec<Tracker>,
+    up: f64,
+    down: f64,
+    /// Pending predictions, oldest first (a ring of `slots.len()`).
+    slots: Vec<Pending>,
+    first: usize,
+    count: usize,
+    /// Samples below this absolute index have been checked.
+    checked: Option<usize>,
+    /// Whether the last checked sample exceeded its outlier limit.
+    previous_exceeds: bool,
+    /// The samples of the current check (scratch).
+    batch: Vec<Checked>,
+    /// The last `H` cleaned samples (a ring) and how many were seen.
+    recent: Vec<f64>,
+    seen: usize,
+    /// Largest change of the cleaned position over `H` samples so far \[m\].
+    motion: f64,
+    /// Exponentially weighted mean squared error per step ahead \[m²\].
+    mean_square: Vec<f64>,
+    /// Smallest non-zero change between consecutive measured samples \[m\]
+    /// (the encoder's resolution, for quantised data).
+    resolution: f64,
+    /// The last measured sample (for the resolution).
+    last: Option<f64>,
+    outliers: usize,
+}
+
+impl Guard {
+    /// A guard for horizons of `horizon` samples made every `hop` samples.
+    pub fn new(config: GuardConfig, horizon: usize, hop: usize) -> Result<Self> {
+        config.validate()?;
+        let horizon = horizon.max(1);
+        let slots = horizon.div_ceil(hop.max(1)) + 1;
+        Ok(Self {
+            config,
+            horizon,
+            trackers: vec![Tracker::NEW; horizon],
+            up: (config.adaptation * config.interval).exp(),
+            down: (-config.adaptation * (1.0 - config.interval)).exp(),
+            slots: (0..slots)
+                .map(|_| Pending {
+                    start: 0,
+                    len: 0,
+                    values: vec![0.0; horizon],
+                })
+                .collect(),
+            first: 0,
+            count: 0,
+            checked: None,
+            previous_exceeds: false,
+            batch: Vec::new(),
+            recent: vec![0.0; horizon],
+            seen: 0,
+            motion: 0.0,
+            mean_square: vec![0.0; horizon],
+            resolution: f64::INFINITY,
+            last: None,
+            outliers: 0,
+        })
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &GuardConfig {
+        &self.config
+    }
+
+    /// Forget everything (a new recording).
+    pub fn reset(&mut self) {
+        self.reset_segment();
+        self.outliers = 0;
+    }
+
+    /// Forget the errors and pending predictions but keep the outlier count
+    /// (a new segment of a stream).
+    pub fn reset_segment(&mut self) {
+        self.trackers.fill(Tracker::NEW);
+        self.first = 0;
+        self.count = 0;
+        self.checked = None;
+        self.previous_exceeds = false;
+        self.seen = 0;
+        self.motion = 0.0;
+        self.mean_square.fill(0.0);
+        self.resolution = f64::INFINITY;
+        self.last = None;
+    }
+
+    /// Set the outlier count to 0.
+    pub fn reset_outliers(&mut self) {
+        self.outliers = 0;
+    }
+
+    /// Outliers found since the reset.
+    pub fn outliers(&self) -> usize {
+        self.outliers
+    }
+
+    /// Check the samples measured since the last call, up to `end`
+    /// (exclusive): score the pending predictions on `position(k)` (the
+    /// measured value) and call `replace(k, prediction)` for each outlier.
+    pub fn observe(
+        &mut self,
+        end: usize,
+        position: impl Fn(usize) -> f64,
+        mut replace: impl FnMut(usize, f64),
+    ) {
+        let from = match self.checked {
+            Some(c) => c,
+            None => {
+                // nothing was predicted before the first window ends
+                self.checked = Some(end);
+                return;
+            }
+        };
+        let n_slots = self.slots.len();
+        // pass 1: each new sample, its latest prediction and whether its
+        // error exceeds the limit
+        self.batch.clear();
+        for k in from..end {
+            let y = position(k);
+            let mut latest: Option<(f64, usize)> = None;
+            for i in 0..self.count {
+                let p = &self.slots[(self.first + i) % n_slots];
+                if k >= p.start && k < p.start + p.len {
+                    latest = Some((p.values[k - p.start], k - p.start));
+                }
+            }
+            let limit = |j: usize| {
+                self.config
+                    .outlier
+                    .filter(|_| self.trackers[j].n >= MIN_HISTORY)
+                    .map(|f| f * self.mean_square[j].sqrt().max(self.resolution))
+            };
+            let (excess, exceeds) = match latest {
+                Some((yh, j)) => {
+                    let e = (y - yh).abs();
+                    (e, limit(j).is_some_and(|l| e > l))
+                }
+                None => (0.0, false),
+            };
+            self.batch.push(Checked {
+                y,
+                latest,
+                excess,
+                exceeds,
+            });
+        }
+        // pass 2: an outlier exceeds its limit, the samples on both sides do
+        // not; the last sample (its successor unknown) must also exceed the
+        // largest motion over a horizon seen so far
+        let n = self.batch.len();
+        for i in 0..n {
+            let c = self.batch[i];
+            let k = from + i;
+            let before = if i == 0 {
+                self.previous_exceeds
+            } else {
+                self.batch[i - 1].exceeds
+            };
+            let outlier = c.exceeds
+                && !before
+                && if i + 1 < n {
+                    !self.batch[i + 1].exceeds
+                } else {
+                    c.excess > self.config.outlier.unwrap_or(f64::INFINITY) * self.motion
+                };
+            let y_clean = match (outlier, c.latest) {
+                (true, Some((yh, _))) => {
+                    replace(k, yh);
+                    self.outliers += 1;
+                    yh
+                }
+                _ => c.y,
+            };
+            if let Some(prev) = self.last {
+                let d = (c.y - prev).abs();
+                if d > 0.0 && d < self.resolution {
+                    self.resolution = d;
+                }
+            }
+            self.last = Some(c.y);
+            // the largest motion over a horizon, on the cleaned samples
+            let h = self.recent.len();
+            if self.seen >= h {
+                let old = self.recent[self.seen % h];
+                self.motion = self.motion.max((y_clean - old).abs());
+            }
+            self.recent[self.seen % h] = y_clean;
+            self.seen += 1;
+            if !outlier {
+                let w = self.config.adaptation;
+                for s in 0..self.count {
+                    let p = &self.slots[(self.first + s) % n_slots];
+                    if k >= p.start && k < p.start + p.len {
+                        let j = k - p.start;
+                        let e = (c.y - p.values[j]).abs();
+                        if e.is_finite() {
+                            self.trackers[j].push(e, self.up, self.down);
+                            let ms = &mut self.mean_square[j];
+                            *ms = if self.trackers[j].n == 1 {
+                                e * e
+                            } else {
+                                (1.0 - w) * *ms + w * e * e
+                            };
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(c) = self.batch.last() {
+            self.previous_exceeds = c.exceeds;
+        }
+        // drop the predictions whose samples are all checked
+        while self.count > 0 {
+            let p = &self.slots[self.first];
+            if p.start + p.len <= end {
+                self.first = (self.first + 1) % n_slots;
+                self.count -= 1;
+            } else {
+                break;
+            }
+        }
+        self.checked = Some(end.max(from));
+    }
+
+    /// Record a window's prediction `values` of the samples from `start`
+    /// and write its interval bounds; `last` is the last measured position
+    /// and `spread` the range of the measured position over the window
+    /// (the interval's half-width before the errors are known).
+    pub fn predicted(
+        &mut self,
+        start: usize,
+        values: &[f64],
+        last: f64,
+        spread: f64,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) {
+        let n_slots = self.slots.len();
+        if self.count == n_slots {
+            self.first = (self.first + 1) % n_slots;
+            self.count -= 1;
+        }
+        let len = values.len().min(self.horizon);
+        let slot = &mut self.slots[(self.first + self.count) % n_slots];
+        slot.start = start;
+        slot.len = len;
+        slot.values[..len].copy_from_slice(&values[..len]);
+        self.count += 1;
+        if self.checked.is_none() {
+            self.checked = Some(start);
+        }
+        for (j, ((v, lo), hi)) in values
+            .iter()
+            .zip(lower.iter_mut())
+            .zip(upper.iter_mut())
+            .enumerate()
+            .take(len)
+        {
+            let t = &self.trackers[j];
+            let q = if t.n >= MIN_HISTORY {
+                t.q
+            } else {
+                (v - last).abs() + spread
+            };
+            *lo = v - q;
+            *hi = v + q;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tracker_settles_at_the_quantile_of_stationary_errors() {
+        // uniform errors on [0, 1): the 0.9-quantile is 0.9, and a share
+        // of about 0.1 of new errors lies beyond the tracked value
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let g = Guard::new(
+            GuardConfig {
+                interval: 0.9,
+                ..GuardConfig::default()
+            },
+            1,
+            1,
+        )
+        .unwrap();
+        let mut t = Tracker::NEW;
+        let (mut beyond, mut total, mut sum_q) = (0, 0, 0.0);
+        for i in 0..200_000 {
+            let e: f64 = rng.random();
+            if i >= 1000 {
+                total += 1;
+                beyond += usize::from(e > t.q);
+                sum_q += t.q;
+            }
+            t.push(e, g.up, g.down);
+        }
+        let share = beyond as f64 / total as f64;
+        assert!((share - 0.1).abs() < 0.005, "{share}");
+        let mean_q = sum_q / total as f64;
+        assert!((mean_q - 0.9).abs() < 0.02, "{mean_q}");
+        // scale-free: errors × 1e-6 give q × 1e-6 exactly
+        let (mut a, mut b) = (Tracker::NEW, Tracker::NEW);
+        for i in 0..1000 {
+            let e = ((i * 37 % 101) as f64) / 101.0;
+            a.push(e, g.up, g.down);
+            b.push(e * 1e-6, g.up, g.down);
+        }
+        assert!((b.q - 1e-6 * a.q).abs() <= 1e-15 * a.q);
+    }
+
+    #[test]
+    fn an_isolated_wild_sample_is_replaced_by_its_prediction_and_a_step_is_not() {
+        let mut g = Guard::new(GuardConfig::default(), 5, 5).unwrap();
+        // a ramp predicted with small errors, then a glitch, later a real step
+        let mut y: Vec<f64> = (0..400)
+            .map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64))
+            .collect();
+        y[203] += 1e3;
+        for v in &mut y[300..] {
+            *v += 50.0;
+        }
+        let mut clean = y.clone();
+        let (mut lo, mut hi) = ([0.0; 5], [0.0; 5]);
+        let mut replaced = Vec::new();
+        let mut start = 10;
+        while start + 5 <= 400 {
+            g.observe(
+                start,
+                |k| y[k],
+                |k, v| {
+                    replaced.push(k);
+                    clean[k] = v;
+                },
+            );
+            let pred: Vec<f64> = (start..start + 5).map(|k| k as f64 + 0.02).collect();
+            let last = clean[start - 1];
+            g.predicted(start, &pred, last, 1.0, &mut lo, &mut hi);
+            start += 5;
+        }
+        assert!(replaced.contains(&203), "{replaced:?}");
+        assert!((clean[203] - 203.02).abs() < 1e-12);
+        // the step at 300: its first sample may be taken for a glitch, the
+        // second one is kept (a second wild sample in a row is a change)
+        assert!(!replaced.contains(&301), "{replaced:?}");
+        assert_eq!(clean[301], y[301]);
+    }
+
+    #[test]
+    fn invalid_settings_are_refused() {
+        for c in [
+            GuardConfig {
+                interval: 1.0,
+                ..GuardConfig::default()
+            },
+            GuardConfig {
+                outlier: Some(0.5),
+                ..GuardConfig::default()
+            },
+            GuardConfig {
+                adaptation: 0.0,
+                ..GuardConfig::default()
+            },
+        ] {
+            assert!(c.validate().is_err());
+        }
+    }
+}

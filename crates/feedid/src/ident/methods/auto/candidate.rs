@@ -1,0 +1,546 @@
+//! `auto`'s candidate predictors: hold, the command, and unit-gain ARX
+//! models ([`super::model`]) fitted recursively (exponential forgetting) or
+//! over a sliding window of samples.
+
+// Negated comparisons are deliberate (they reject NaN).
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use std::fmt;
+use std::ops::Range;
+
+use super::model;
+use crate::error::{Error, Result};
+use crate::ident::methods::rls::{has_avx2, rls_update};
+use crate::ident::{ArxOrders, Signals};
+
+/// Initial covariance `P₀ = p0·I` of the recursive candidates, in
+/// coordinates scaled by the largest regressor of the first informative
+/// window (and the bound on `tr P / n`): a weak prior, learnt over within a
+/// few dozen samples.
+const P0: f64 = 1e6;
+
+/// One candidate predictor of `auto`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Candidate {
+    /// The last measured position, held over the horizon.
+    Hold,
+    /// The command at the predicted instant (an axis with feed-forward
+    /// follows it within its small following error).
+    Command,
+    /// Unit-gain ARX ([`super::model`]) by exponentially weighted recursive
+    /// least squares with forgetting factor `lambda` (memory ≈ 1/(1 − λ)
+    /// samples); a sample updates the estimate only if its regression row
+    /// is not all zero (an exactly still axis carries no information).
+    Recursive {
+        /// Orders `na ≥ 1, nb ≥ 1, nk`.
+        orders: ArxOrders,
+        /// Forgetting factor λ ∈ (0, 1].
+        lambda: f64,
+    },
+    /// Unit-gain ARX by least squares over the last `window` samples,
+    /// refitted at every window, with a ridge `ridge·‖Ψ‖²_F/n` relative to
+    /// the regression (0 = none; rank-deficient columns are dropped).
+    Windowed {
+        /// Orders `na ≥ 1, nb ≥ 1, nk`.
+        orders: ArxOrders,
+        /// Rows fitted \[samples\].
+        window: usize,
+        /// Relative ridge ≥ 0.
+        ridge: f64,
+    },
+}
+
+impl fmt::Display for Candidate {
+    /// A short name: `hold`, `command`, `rls 2,2,0 λ=0.99`, `ls 2,2,0 W=100`
+    /// (with the ridge if any: `ls 2,2,0 W=100 ρ=1e-6`).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Candidate::Hold => f.write_str("hold"),
+            Candidate::Command => f.write_str("command"),
+            Candidate::Recursive { orders: o, lambda } => {
+                write!(f, "rls {},{},{} λ={lambda}", o.na, o.nb, o.nk)
+            }
+            Candidate::Windowed {
+                orders: o,
+                window,
+                ridge,
+            } => {
+                write!(f, "ls {},{},{} W={window}", o.na, o.nb, o.nk)?;
+                if *ridge > 0.0 {
+                    write!(f, " ρ={ridge:e}")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl Candidate {
+    /// The orders of an identified candidate.
+    pub fn orders(&self) -> Option<ArxOrders> {
+        match self {
+            Candidate::Hold | Candidate::Command => None,
+            Candidate::Recursive { orders, .. } | Candidate::Windowed { orders, .. } => {
+                Some(*orders)
+            }
+        }
+    }
+
+    /// Samples needed before the first regression row.
+    pub fn warm_up(&self) -> usize {
+        self.orders().map_or(1, |o| model::lag(&o))
+    }
+
+    /// Check the settings (`na ≥ 1`, valid orders, λ ∈ (0, 1], window ≥ 2, ridge ≥ 0).
+    pub fn validate(&self) -> Result<()> {
+        if let Some(o) = self.orders() {
+            o.validate()?;
+            if o.na == 0 {
+                return Err(Error::InvalidParameter {
+                    name: "na",
+                    value: 0.0,
+                    reason: "auto's unit-gain models need na >= 1",
+                });
+            }
+        }
+        match *self {
+            Candidate::Recursive { lambda, .. } if !(lambda > 0.0 && lambda <= 1.0) => {
+                Err(Error::InvalidParameter {
+                    name: "lambda",
+                    value: lambda,
+                    reason: "must be in (0, 1]",
+                })
+            }
+            Candidate::Windowed { window, .. } if window < 2 => Err(Error::InvalidParameter {
+                name: "window",
+                value: window as f64,
+                reason: "an auto candidate's window must be at least 2 samples",
+            }),
+            Candidate::Windowed { ridge, .. } if !(ridge.is_finite() && ridge >= 0.0) => {
+                Err(Error::InvalidParameter {
+                    name: "ridge",
+                    value: ridge,
+                    reason: "must be finite and >= 0",
+                })
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A candidate with its state.
+#[derive(Debug, Clone)]
+pub(crate) struct Predictor {
+    spec: Candidate,
+    /// Free parameters of the unit-gain model.
+    theta: Vec<f64>,
+    /// Whether the model has been fitted (hold and command: always).
+    fitted: bool,
+    state: State,
+}
+
+#[derive(Debug, Clone)]
+enum State {
+    Plain,
+    Recursive(Box<Recursive>),
+    Windowed(Box<Windowed>),
+}
+
+#[derive(Debug, Clone)]
+struct Recursive {
+    p: Vec<f64>,
+    psi: Vec<f64>,
+    g: Vec<f64>,
+    /// Next sample to process (absolute).
+    cursor: Option<usize>,
+    /// Scale of the regressors (0 until an informative window arrived).
+    scale: f64,
+    avx: bool,
+}
+
+/// Least squares over the last `W/2 … W` samples without downdating: two
+/// triangular factors of `[Ψ t]` grown by Givens rotations, the older one
+/// (which started `W/2` rows earlier) fitted, replaced by the newer one
+/// when it holds `W` rows.
+#[derive(Debug, Clone)]
+struct Windowed {
+    /// Row-major `(n+1)×(n+1)` upper-triangular factors: older, newer.
+    factors: [Vec<f64>; 2],
+    rows: [usize; 2],
+    cursor: Option<usize>,
+    psi: Vec<f64>,
+    row: Vec<f64>,
+    /// Scratch of the ridge solve (`(n+1)×n` and `n`).
+    small: Vec<f64>,
+    rhs: Vec<f64>,
+    tail: Vec<f64>,
+}
+
+impl Predictor {
+    /// A fresh predictor (the settings are validated by the caller).
+    pub(crate) fn new(spec: Candidate) -> Self {
+        let n = spec.orders().map_or(0, |o| model::n_free(&o));
+        let state = match spec {
+            Candidate::Hold | Candidate::Command => State::Plain,
+            Candidate::Recursive { .. } => State::Recursive(Box::new(Recursive {
+                p: vec![0.0; n * n],
+                psi: vec![0.0; n],
+                g: vec![0.0; n],
+                cursor: None,
+                scale: 0.0,
+                avx: has_avx2(),
+            })),
+            Candidate::Windowed { .. } => State::Windowed(Box::new(Windowed {
+                factors: [vec![0.0; (n + 1) * (n + 1)], vec![0.0; (n + 1) * (n + 1)]],
+                rows: [0, 0],
+                cursor: None,
+                psi: vec![0.0; n],
+                row: vec![0.0; n + 1],
+                small: vec![0.0; n * n],
+                rhs: vec![0.0; n],
+                tail: vec![0.0; n],
+            })),
+        };
+        let mut p = Self {
+            spec,
+            theta: vec![0.0; n],
+            fitted: false,
+            state,
+        };
+        p.reset();
+        p
+    }
+
+    /// The candidate.
+    pub(crate) fn spec(&self) -> &Candidate {
+        &self.spec
+    }
+
+    /// Free parameters of the unit-gain model (empty for hold and command).
+    pub(crate) fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+
+    /// Forget the model but keep the position in the data (a model that
+    /// predicted implausibly starts learning again from the next sample).
+    pub(crate) fn restart(&mut self) {
+        let cursor = match &self.state {
+            State::Recursive(r) => r.cursor,
+            State::Windowed(l) => l.cursor,
+            State::Plain => None,
+        };
+        self.reset();
+        match &mut self.state {
+            State::Recursive(r) => r.cursor = cursor,
+            State::Windowed(l) => l.cursor = cursor,
+            State::Plain => {}
+        }
+    }
+
+    /// Forget all state.
+    pub(crate) fn reset(&mut self) {
+        self.theta.fill(0.0);
+        self.fitted = matches!(self.spec, Candidate::Hold | Candidate::Command);
+        match &mut self.state {
+            State::Recursive(r) => {
+                r.cursor = None;
+                r.scale = 0.0;
+                reset_covariance(&mut r.p, self.theta.len());
+            }
+            State::Windowed(l) => {
+                l.cursor = None;
+                for f in &mut l.factors {
+                    f.fill(0.0);
+                }
+                l.rows = [0, 0];
+            }
+            State::Plain => {}
+        }
+    }
+
+    /// Learn from the samples up to `end` (exclusive); `start` is the first
+    /// sample of the engine's first window (where a recursive candidate
+    /// begins). Returns whether the model can predict.
+    pub(crate) fn fit(&mut self, signals: &Signals<'_>, start: usize, end: usize) -> bool {
+        let Some(o) = self.spec.orders() else {
+            return true;
+        };
+        let lag = model::lag(&o);
+        let first = signals.offset() + lag;
+        match (&mut self.state, self.spec) {
+            (State::Recursive(r), Candidate::Recursive { lambda, .. }) => {
+                let mut cursor = r.cursor.unwrap_or(start.max(first));
+                if cursor < first || cursor > end {
+                    // the data moved under us (a new recording): start over
+                    self.theta.fill(0.0);
+                    self.fitted = false;
+                    r.scale = 0.0;
+                    reset_covariance(&mut r.p, self.theta.len());
+                    cursor = start.max(first).min(end);
+                }
+                let Ok(w) = signals.window(cursor..end, lag, "auto candidate") else {
+                    return self.fitted;
+                };
+                let (y, u) = (w.position, w.command);
+                let n = self.theta.len();
+                let rows = lag..lag + (end - cursor);
+                if r.scale == 0.0 {
+                    r.scale = largest_row_entry(&o, y, u, rows.clone(), &mut r.psi);
+                }
+                if r.scale > 0.0 {
+                    let inv = 1.0 / r.scale;
+                    let max_trace = n as f64 * P0;
+                    for k in rows {
+                        let t = model::row(&o, y, u, k, &mut r.psi);
+                        if t == 0.0 && r.psi.iter().all(|&v| v == 0.0) {
+                            continue;
+                        }
+                        for v in r.psi.iter_mut() {
+                            *v *= inv;
+                        }
+                        let _ = rls_update(
+                            r.avx,
+                            &mut r.p,
+                            &r.psi,
+                            &mut self.theta,
+                            &mut r.g,
+                            t * inv,
+                            lambda,
+                            max_trace,
+                        );
+                        self.fitted = true;
+                    }
+                    if !self.theta.iter().all(|v| v.is_finite()) {
+                        self.theta.fill(0.0);
+                        reset_covariance(&mut r.p, n);
+                        self.fitted = false;
+                    }
+                }
+                r.cursor = Some(end);
+                self.fitted
+            }
+            (State::Windowed(l), Candidate::Windowed { window, ridge, .. }) => {
+                let mut cursor = l.cursor.unwrap_or(start.max(first));
+                if cursor < first || cursor > end {
+                    self.theta.fill(0.0);
+                    self.fitted = false;
+                    for f in &mut l.factors {
+                        f.fill(0.0);
+                    }
+                    l.rows = [0, 0];
+                    cursor = start.max(first).min(end);
+                }
+                let Ok(w) = signals.window(cursor..end, lag, "auto candidate") else {
+                    return self.fitted;
+                };
+                let (y, u) = (w.position, w.command);
+                let n = self.theta.len();
+                let half = (window / 2).max(1);
+                for k in lag..lag + (end - cursor) {
+                    let t = model::row(&o, y, u, k, &mut l.psi);
+                    if t == 0.0 && l.psi.iter().all(|&v| v == 0.0) {
+                        continue;
+                    }
+                    for f in &mut l.factors {
+                        l.row[..n].copy_from_slice(&l.psi);
+                        l.row[n] = t;
+                        givens_add(f, &mut l.row);
+                    }
+                    l.rows[0] += 1;
+                    l.rows[1] += 1;
+                    if l.rows[1] >= half {
+                        let [a, b] = &mut l.factors;
+                        std::mem::swap(a, b);
+                        b.fill(0.0);
+                        l.rows = [l.rows[1], 0];
+                    }
+                }
+                l.cursor = Some(end);
+                if l.rows[0] >= n
+                    && solve_ridge(
+                        &l.factors[0],
+                        n,
+                        ridge,
+                        &mut l.small,
+                        &mut l.tail,
+                        &mut l.rhs,
+                    )
+                    && l.rhs.iter().all(|v| v.is_finite())
+                {
+                    self.theta.copy_from_slice(&l.rhs);
+                    self.fitted = true;
+                }
+                self.fitted
+            }
+            _ => self.fitted,
+        }
+    }
+
+    /// Predict `out` over `horizon` (starting at `window_end`) from the last fit.
+    pub(crate) fn predict(
+        &self,
+        signals: &Signals<'_>,
+        horizon: Range<usize>,
+        past: &mut Vec<f64>,
+        out: &mut [f64],
+    ) -> Result<()> {
+        let e = horizon.start;
+        match self.spec {
+            Candidate::Hold => {
+                let w = signals.window(e..e, 1, "auto hold")?;
+                out.fill(w.position[0]);
+            }
+            Candidate::Command => {
+                let w = signals.window(horizon.clone(), 0, "auto command")?;
+                out.copy_from_slice(w.command);
+            }
+            Candidate::Recursive { orders, .. } | Candidate::Windowed { orders, .. } => {
+                if !self.fitted {
+                    return Err(Error::Singular {
+                        context: "auto candidate (not fitted yet)",
+                    });
+                }
+                let lag = model::lag(&orders);
+                let w = signals.window(horizon.clone(), lag, "auto candidate prediction")?;
+                let need = orders.na.max(1) + out.len();
+                if past.len() < need {
+                    past.resize(need, 0.0);
+                }
+                model::predict(&orders, &self.theta, w.position, w.command, lag, past, out);
+            }
+        }
+        if out.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err(Error::NonFinite {
+                channel: "auto candidate prediction".to_string(),
+                index: e,
+                value: f64::NAN,
+            })
+        }
+    }
+}
+
+/// Rotate the row `row` (length `m`) into the row-major `m×m` upper-triangular
+/// factor `r` (Givens rotations; `row` is destroyed).
+fn givens_add(r: &mut [f64], row: &mut [f64]) {
+    let m = row.len();
+    for i in 0..m {
+        let x = row[i];
+        if x == 0.0 {
+            continue;
+        }
+        let d = r[i * m + i];
+        let rho = (d * d + x * x).sqrt();
+        if !(rho > 0.0) {
+            continue;
+        }
+        let inv = 1.0 / rho;
+        let (c, s) = (d * inv, x * inv);
+        r[i * m + i] = rho;
+        for j in i + 1..m {
+            let a = r[i * m + j];
+            let b = row[j];
+            r[i * m + j] = c * a + s * b;
+            row[j] = c * b - s * a;
+        }
+    }
+}
+
+/// Solve `min ‖R·θ − z‖² + λ‖θ‖²` from the `(n+1)×(n+1)` factor of `[Ψ t]`
+/// (`R` its leading `n×n` block, `z` its last column above the diagonal),
+/// `λ = max(ridge, 1e-12)·‖R‖²_F/n` (the relative ridge; 1e-12 keeps a
+/// rank-deficient window defined); the solution goes to `theta`.
+fn solve_ridge(
+    f: &[f64],
+    n: usize,
+    ridge: f64,
+    small: &mut [f64],
+    row_tail: &mut [f64],
+    theta: &mut [f64],
+) -> bool {
+    let m = n + 1;
+    let mut frob = 0.0;
+    for i in 0..n {
+        for j in i..n {
+            small[i * n + j] = f[i * m + j];
+            frob += f[i * m + j] * f[i * m + j];
+        }
+        for j in 0..i {
+            small[i * n + j] = 0.0;
+        }
+        theta[i] = f[i * m + n];
+    }
+    if !(frob > 0.0 && frob.is_finite()) {
+        return false;
+    }
+    let lambda = ridge.max(1e-12) * frob / n as f64;
+    let root = lambda.sqrt();
+    // fold the rows √λ·e_k (right-hand side 0) into the triangle
+    for k in 0..n {
+        let mut extra_rhs = 0.0;
+        // the row √λ·e_k is zero before column k
+        row_tail.fill(0.0);
+        row_tail[k] = root;
+        for i in k..n {
+            let x = row_tail[i];
+            if x == 0.0 {
+                continue;
+            }
+            let d = small[i * n + i];
+            let rho = (d * d + x * x).sqrt();
+            let inv = 1.0 / rho;
+            let (c, s) = (d * inv, x * inv);
+            small[i * n + i] = rho;
+            for j in i + 1..n {
+                let a = small[i * n + j];
+                let b = row_tail[j];
+                small[i * n + j] = c * a + s * b;
+                row_tail[j] = c * b - s * a;
+            }
+            let a = theta[i];
+            theta[i] = c * a + s * extra_rhs;
+            extra_rhs = c * extra_rhs - s * a;
+        }
+    }
+    // back substitution
+    for i in (0..n).rev() {
+        let mut v = theta[i];
+        for j in i + 1..n {
+            v -= small[i * n + j] * theta[j];
+        }
+        let d = small[i * n + i];
+        if !(d.abs() > 0.0) {
+            return false;
+        }
+        theta[i] = v / d;
+    }
+    true
+}
+
+fn reset_covariance(p: &mut [f64], n: usize) {
+    p.fill(0.0);
+    for i in 0..n {
+        p[i * n + i] = P0;
+    }
+}
+
+/// Largest magnitude of a regressor or target over the rows (0 if all zero or not finite).
+fn largest_row_entry(
+    o: &ArxOrders,
+    y: &[f64],
+    u: &[f64],
+    rows: Range<usize>,
+    psi: &mut [f64],
+) -> f64 {
+    let mut m = 0.0f64;
+    for k in rows {
+        let t = model::row(o, y, u, k, psi);
+        m = psi.iter().fold(m.max(t.abs()), |m, v| m.max(v.abs()));
+    }
+    if m.is_finite() {
+        m
+    } else {
+        0.0
+    }
+}

@@ -1,0 +1,148 @@
+//! Settings of `auto`.
+
+// Negated comparisons are deliberate (they reject NaN).
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use super::candidate::Candidate;
+use super::estimator::AutoEstimator;
+use crate::error::{Error, Result};
+use crate::ident::ArxOrders;
+
+/// Settings of the `auto` method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AutoConfig {
+    /// The candidate predictors; default [`AutoConfig::default_candidates`].
+    pub candidates: Vec<Candidate>,
+    /// Weight α of the newest horizon in a candidate's score (per regime),
+    /// in (0, 1]; default 0.1 (chosen on the drive zoo).
+    pub memory: f64,
+    /// A candidate's prediction is discarded when it leaves the last
+    /// measured position by more than this factor times the experienced
+    /// motion (the largest range of the measured position over `H + 1`
+    /// consecutive samples so far), ≥ 1; default 4. Until the axis has
+    /// moved, only predictions that stay where it is pass.
+    pub plausibility: f64,
+}
+
+impl Default for AutoConfig {
+    fn default() -> Self {
+        Self {
+            candidates: Self::default_candidates(),
+            memory: 0.1,
+            plausibility: 4.0,
+        }
+    }
+}
+
+impl AutoConfig {
+    /// The default candidates (see the module doc of `auto`).
+    pub fn default_candidates() -> Vec<Candidate> {
+        let rls = |na, nb, lambda| Candidate::Recursive {
+            orders: ArxOrders::new(na, nb, 0),
+            lambda,
+        };
+        vec![
+            Candidate::Windowed {
+                orders: ArxOrders::new(2, 2, 0),
+                window: 100,
+                ridge: 1e-6,
+            },
+            rls(3, 3, 0.995),
+            rls(4, 4, 0.999),
+            rls(6, 6, 0.999),
+            rls(8, 8, 0.9995),
+        ]
+    }
+
+    /// Index of the candidate whose orders `--order` sets and whose
+    /// coefficients are reported: the recursive candidate with the longest
+    /// memory (largest λ; the first of equals), else the windowed one with
+    /// the longest window; `None` without an identified candidate.
+    pub fn reported(&self) -> Option<usize> {
+        let memory = |c: &Candidate| match *c {
+            Candidate::Recursive { lambda, .. } => Some((1, lambda)),
+            Candidate::Windowed { window, .. } => Some((0, window as f64)),
+            Candidate::Hold | Candidate::Command => None,
+        };
+        let mut best: Option<(usize, (i32, f64))> = None;
+        for (i, c) in self.candidates.iter().enumerate() {
+            if let Some(m) = memory(c) {
+                if best.map_or(true, |(_, b)| m.0 > b.0 || (m.0 == b.0 && m.1 > b.1)) {
+                    best = Some((i, m));
+                }
+            }
+        }
+        best.map(|(i, _)| i)
+    }
+
+    /// The orders of the reported candidate ([`AutoConfig::reported`]).
+    pub fn orders(&self) -> Option<ArxOrders> {
+        self.reported().and_then(|i| self.candidates[i].orders())
+    }
+
+    /// Set the orders of the reported candidate ([`AutoConfig::reported`]);
+    /// an error without an identified candidate or for invalid orders.
+    pub fn set_orders(&mut self, orders: ArxOrders) -> Result<()> {
+        let i = self.reported().ok_or(Error::InvalidParameter {
+            name: "orders",
+            value: 0.0,
+            reason: "auto has no identified candidate to take them",
+        })?;
+        let mut c = self.candidates[i];
+        match &mut c {
+            Candidate::Recursive { orders: o, .. } | Candidate::Windowed { orders: o, .. } => {
+                *o = orders
+            }
+            Candidate::Hold | Candidate::Command => {}
+        }
+        c.validate()?;
+        self.candidates[i] = c;
+        Ok(())
+    }
+
+    /// Set the ridge of every windowed candidate (relative, ≥ 0; checked
+    /// by [`AutoConfig::validate`]).
+    pub fn set_ridge(&mut self, ridge: f64) {
+        for c in &mut self.candidates {
+            if let Candidate::Windowed { ridge: r, .. } = c {
+                *r = ridge;
+            }
+        }
+    }
+
+    /// Validate and build the estimator.
+    pub fn build(&self) -> Result<AutoEstimator> {
+        self.validate()?;
+        Ok(AutoEstimator::new(self.clone()))
+    }
+
+    /// Check the settings (at least one candidate, each valid; memory in
+    /// (0, 1], plausibility ≥ 1).
+    pub fn validate(&self) -> Result<()> {
+        if self.candidates.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "candidates",
+                value: 0.0,
+                reason: "auto needs at least one candidate",
+            });
+        }
+        for c in &self.candidates {
+            c.validate()?;
+        }
+        if !(self.memory > 0.0 && self.memory <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "memory",
+                value: self.memory,
+                reason: "must be in (0, 1]",
+            });
+        }
+        if !(self.plausibility.is_finite() && self.plausibility >= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "plausibility",
+                value: self.plausibility,
+                reason: "must be finite and >= 1",
+            });
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,410 @@
+//! The `auto` estimator: every candidate learns from every sample and
+//! predicts every horizon; each prediction is scored once measured, per
+//! regime of the command, and the candidate with the best score in the
+//! coming horizon's regime predicts.
+
+use std::ops::Range;
+
+use super::candidate::{Candidate, Predictor};
+use super::config::AutoConfig;
+use super::model;
+use crate::error::{Error, Result};
+use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::solve::Termination;
+
+/// Regimes of a horizon, scored apart: 0 = the command is still over the
+/// window and the horizon, 1 = it moves at a constant speed over the
+/// horizon and the `H` samples before it, 2 = its speed changes there.
+pub const REGIMES: usize = 3;
+
+/// Relative change of the command's speed below which it counts as constant.
+const CONSTANT_SPEED: f64 = 1e-3;
+
+/// Relative margin by which a candidate's score must beat the current
+/// choice's to replace it (hysteresis). Scores of candidates that predict
+/// alike cross often, and near a crossing the last bits of the data (a
+/// recording read in mm instead of m) would decide between them: the
+/// margin makes such switches rare, so the predictions do not depend on
+/// the unit, and keeps the choice from chattering.
+const TIE: f64 = 0.02;
+
+/// Whether score `a` beats score `b` (a scored candidate beats an
+/// unscored one; scores within [`TIE`] are a tie, which `a` loses).
+fn beats(a: Option<f64>, b: Option<f64>) -> bool {
+    match (a, b) {
+        (Some(_), None) => true,
+        (Some(a), Some(b)) => a < b * (1.0 - TIE),
+        _ => false,
+    }
+}
+
+/// A candidate, its pending prediction and its scores.
+#[derive(Debug, Clone)]
+struct Member {
+    predictor: Predictor,
+    /// The last prediction, not yet scored.
+    pending: Vec<f64>,
+    pending_start: usize,
+    pending_len: usize,
+    /// Regime of the pending prediction's horizon.
+    pending_regime: usize,
+    /// Exponentially weighted mean squared error per horizon \[m²\], per regime.
+    score: [f64; REGIMES],
+    scored: [usize; REGIMES],
+    /// Whether the candidate can predict (fitted).
+    ready: bool,
+}
+
+impl Member {
+    fn new(c: Candidate) -> Self {
+        Self {
+            predictor: Predictor::new(c),
+            pending: Vec::new(),
+            pending_start: 0,
+            pending_len: 0,
+            pending_regime: 2,
+            score: [0.0; REGIMES],
+            scored: [0; REGIMES],
+            ready: false,
+        }
+    }
+
+    /// The score in regime `r`, else in the first scored regime, else none.
+    fn score_in(&self, r: usize) -> Option<f64> {
+        if self.scored[r] > 0 {
+            Some(self.score[r])
+        } else {
+            (0..REGIMES)
+                .find(|&q| self.scored[q] > 0)
+                .map(|q| self.score[q])
+        }
+    }
+}
+
+/// The `auto` estimator (method name `"auto"`); see the module doc.
+#[derive(Debug, Clone)]
+pub struct AutoEstimator {
+    config: AutoConfig,
+    members: Vec<Member>,
+    selected: Option<usize>,
+    /// The candidate whose coefficients are reported.
+    reported: Option<usize>,
+    /// First sample of the first window since the reset.
+    start: Option<usize>,
+    past: Vec<f64>,
+    arx: Vec<f64>,
+    /// Regime of the next horizon (decided at the fit).
+    regime: usize,
+    /// Horizon length of the last prediction (10 before the first).
+    horizon: usize,
+    /// Largest range of the measured position over `H + 1` consecutive
+    /// samples seen so far \[m\] (the experienced motion over a horizon).
+    experience: f64,
+    /// Samples below this index are in `experience`.
+    experienced_to: usize,
+}
+
+impl AutoEstimator {
+    pub(super) fn new(config: AutoConfig) -> Self {
+        let members = config.candidates.iter().map(|&c| Member::new(c)).collect();
+        let reported = config.reported();
+        let n_arx = reported
+            .and_then(|r| config.candidates[r].orders())
+            .map_or(0, |o| o.n_params());
+        Self {
+            config,
+            members,
+            selected: None,
+            reported,
+            start: None,
+            past: Vec::new(),
+            arx: vec![0.0; n_arx],
+            regime: 2,
+            horizon: 10,
+            experience: 0.0,
+            experienced_to: 0,
+        }
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &AutoConfig {
+        &self.config
+    }
+
+    /// Index into [`AutoConfig::candidates`] of the candidate chosen at the last fit.
+    pub fn selected(&self) -> Option<usize> {
+        self.selected
+    }
+
+    /// Regime of the horizon after the last fit (see [`REGIMES`]).
+    pub fn regime(&self) -> usize {
+        self.regime
+    }
+
+    /// Each candidate's score in the current regime: its exponentially
+    /// weighted mean squared error per horizon \[m²\], `None` before its
+    /// first scored horizon.
+    pub fn scores(&self) -> impl Iterator<Item = Option<f64>> + '_ {
+        let r = self.regime;
+        self.members.iter().map(move |m| m.score_in(r))
+    }
+
+    /// Score every pending prediction on the samples now known (`< end`).
+    fn score_pending(&mut self, signals: &Signals<'_>, end: usize) {
+        let alpha = self.config.memory;
+        for m in &mut self.members {
+            if m.pending_len == 0 {
+                continue;
+            }
+            let from = m.pending_start.max(signals.offset());
+            let to = (m.pending_start + m.pending_len).min(end);
+            if let (true, Ok(w)) = (to > from, signals.window(from..to, 0, "auto scoring")) {
+                let p = &m.pending[from - m.pending_start..to - m.pending_start];
+                let mse = w
+                    .position
+                    .iter()
+                    .zip(p)
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+                    / (to - from) as f64;
+                let r = m.pending_regime;
+                if mse.is_finite() {
+                    m.score[r] = if m.scored[r] == 0 {
+                        mse
+                    } else {
+                        (1.0 - alpha) * m.score[r] + alpha * mse
+                    };
+                    m.scored[r] += 1;
+                }
+            }
+            m.pending_len = 0;
+        }
+    }
+
+    /// Extend the experienced motion over the samples measured up to `end`.
+    fn learn_experience(&mut self, signals: &Signals<'_>, end: usize) {
+        let h = self.horizon;
+        let from = self.experienced_to.max(signals.offset() + h).min(end);
+        if let Ok(w) = signals.window(from..end, h, "auto experience") {
+            let y = w.position;
+            for k in h..y.len() {
+                let (mut lo, mut hi) = (y[k], y[k]);
+                for &v in &y[k - h..k] {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+                if hi - lo > self.experience {
+                    self.experience = hi - lo;
+                }
+            }
+        }
+        self.experienced_to = end.max(self.experienced_to);
+    }
+
+    /// The ready candidate with the lowest score in the current regime
+    /// (unscored candidates last); ties ([`TIE`]) keep the previous choice,
+    /// else the first in the order of the settings.
+    fn choose(&self) -> Option<usize> {
+        let r = self.regime;
+        let mut choice: Option<(usize, Option<f64>)> = self
+            .selected
+            .filter(|&i| self.members[i].ready)
+            .map(|i| (i, self.members[i].score_in(r)));
+        for (i, m) in self.members.iter().enumerate() {
+            if !m.ready || choice.is_some_and(|(c, _)| c == i) {
+                continue;
+            }
+            let s = m.score_in(r);
+            if choice.map_or(true, |(_, b)| beats(s, b)) {
+                choice = Some((i, s));
+            }
+        }
+        choice.map(|(i, _)| i)
+    }
+}
+
+/// The regime (see [`REGIMES`]) of the horizon `end..end + h` after a
+/// window starting at `from`, from the command (cut at the end of the data).
+fn regime(signals: &Signals<'_>, from: usize, end: usize, h: usize) -> usize {
+    let to = (end + h).min(signals.end());
+    let Ok(w) = signals.window(from..to, 0, "auto regime") else {
+        return 2;
+    };
+    let u = w.command;
+    let Some(&u0) = u.first() else {
+        return 2;
+    };
+    if u.iter().all(|&v| v == u0) {
+        return 0;
+    }
+    // the speed over the horizon and the h samples before it
+    let tail = &u[u.len().saturating_sub(2 * h + 1)..];
+    let (mut d1, mut d2) = (0.0f64, 0.0f64);
+    for p in tail.windows(3) {
+        d1 = d1.max((p[2] - p[1]).abs());
+        d2 = d2.max((p[2] - 2.0 * p[1] + p[0]).abs());
+    }
+    if d2 <= CONSTANT_SPEED * d1 {
+        1
+    } else {
+        2
+    }
+}
+
+/// The last measured position of the window.
+fn last_position(signals: &Signals<'_>, window: Range<usize>) -> Result<f64> {
+    let w = signals.window(window.end..window.end, 1, "auto window")?;
+    Ok(w.position[0])
+}
+
+impl Estimator for AutoEstimator {
+    fn name(&self) -> &'static str {
+        "auto"
+    }
+
+    /// `candidate` (index into [`AutoConfig::candidates`]; −1 while none
+    /// is fitted and the last position is held),
+    /// `expected_error_m` (its recent rms error over a horizon of the
+    /// coming regime), then the ARX coefficients `a1 …, b_nk …` of the
+    /// reported candidate ([`AutoConfig::reported`], the one `--order` sets).
+    fn coefficient_names(&self) -> Vec<String> {
+        let mut names = vec!["candidate".to_string(), "expected_error_m".to_string()];
+        if let Some(o) = self
+            .reported
+            .and_then(|r| self.config.candidates[r].orders())
+        {
+            names.extend(o.coefficient_names());
+        }
+        names
+    }
+
+    fn warm_up(&self) -> usize {
+        self.config
+            .candidates
+            .iter()
+            .map(Candidate::warm_up)
+            .max()
+            .unwrap_or(1)
+    }
+
+    fn reset(&mut self) {
+        // in place: a stream resets at every gap and allocates nothing after warm-up
+        for m in &mut self.members {
+            m.predictor.reset();
+            m.pending_len = 0;
+            m.pending_start = 0;
+            m.pending_regime = 2;
+            m.score = [0.0; REGIMES];
+            m.scored = [0; REGIMES];
+            m.ready = false;
+        }
+        self.selected = None;
+        self.start = None;
+        self.regime = 2;
+        self.experience = 0.0;
+        self.experienced_to = 0;
+    }
+
+    fn fit(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        coef: &mut [f64],
+    ) -> Result<WindowFit> {
+        if window.is_empty() || window.end > signals.end() {
+            return Err(Error::TooFewSamples {
+                what: "auto window",
+                needed: window.end.max(signals.offset() + 1),
+                actual: signals.end(),
+            });
+        }
+        self.score_pending(signals, window.end);
+        self.learn_experience(signals, window.end);
+        self.regime = regime(signals, window.start, window.end, self.horizon);
+        let start = *self.start.get_or_insert(window.start);
+        for m in &mut self.members {
+            m.ready = m.predictor.fit(signals, start, window.end);
+        }
+        self.selected = self.choose();
+        coef.fill(0.0);
+        if let Some(x) = coef.get_mut(0) {
+            *x = self.selected.map_or(-1.0, |c| c as f64);
+        }
+        if let (Some(x), Some(c)) = (coef.get_mut(1), self.selected) {
+            *x = self.members[c].score_in(self.regime).map_or(0.0, f64::sqrt);
+        }
+        if let Some(r) = self.reported {
+            let p = &self.members[r].predictor;
+            if let (Some(o), Some(rest)) = (p.spec().orders(), coef.get_mut(2..)) {
+                let n = o.n_params().min(rest.len()).min(self.arx.len());
+                model::arx_coefficients(&o, p.theta(), &mut self.arx);
+                rest[..n].copy_from_slice(&self.arx[..n]);
+            }
+        }
+        Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+    }
+
+    /// The chosen candidate's prediction; if it cannot predict (or its
+    /// prediction is implausible), the best-scored candidate that can.
+    fn predict(
+        &mut self,
+        signals: &Signals<'_>,
+        window: Range<usize>,
+        horizon: Range<usize>,
+        out: &mut [f64],
+    ) -> Result<PredictStatus> {
+        let h = out.len();
+        self.horizon = h.max(1);
+        let last = last_position(signals, window)?;
+        let limit = self.config.plausibility * self.experience;
+        for m in &mut self.members {
+            m.pending_len = 0;
+            if !m.ready {
+                continue;
+            }
+            if m.pending.len() < h {
+                m.pending.resize(h, 0.0);
+            }
+            let buf = &mut m.pending[..h];
+            let ok = m
+                .predictor
+                .predict(signals, horizon.clone(), &mut self.past, buf)
+                .is_ok();
+            if ok && buf.iter().all(|p| (p - last).abs() <= limit) {
+                m.pending_start = horizon.start;
+                m.pending_len = h;
+                m.pending_regime = self.regime;
+            } else if ok && self.experience > 0.0 {
+                // an implausible model (wound up, or fitted on noise) learns again
+                m.predictor.restart();
+                m.ready = false;
+            }
+        }
+        let usable = |m: &Member| m.pending_len == h;
+        let chosen = match self.selected {
+            Some(c) if usable(&self.members[c]) => Some(c),
+            _ => {
+                let r = self.regime;
+                let mut best: Option<(usize, Option<f64>)> = None;
+                for (i, m) in self.members.iter().enumerate().filter(|(_, m)| usable(m)) {
+                    let s = m.score_in(r);
+                    if best.map_or(true, |(_, b)| beats(s, b)) {
+                        best = Some((i, s));
+                    }
+                }
+                best.map(|(i, _)| i)
+            }
+        };
+        match chosen {
+            Some(c) => {
+                out.copy_from_slice(&self.members[c].pending[..h]);
+                Ok(PredictStatus::Predicted)
+            }
+            // every candidate is implausible or unfitted: hold the last position
+            None => {
+                out.fill(last);
+                Ok(PredictStatus::Predicted)
+            }
+        }
+    }
+}

@@ -1,0 +1,73 @@
+//! `auto`: a multiple-model predictor that picks the model, its order and
+//! its memory from the data while it runs, and always predicts.
+//!
+//! # Candidates
+//!
+//! Every candidate ([`Candidate`], default [`AutoConfig::default_candidates`])
+//! is a *unit-gain ARX model written in increments from the last measured
+//! position* (module `model`): with `A(1) = B(1)` (a position servo follows its
+//! set-point with unit gain),
+//!
+//! ```text
+//! y[k] − y[k−1] = −Σ_{i=2..na} a_i·(y[k−i] − y[k−1]) + Σ_{j=0..nb−1} b_j·(u[k−nk−j] − y[k−1]),
+//! ```
+//!
+//! a regression whose regressors and target are all differences of
+//! positions. An offset of the recording cancels exactly and a change of
+//! unit scales every row alike, so the estimates `θ` do not depend on
+//! units or offsets, and nothing in `auto` is an absolute length: the
+//! recursive candidates scale their coordinates by the largest regressor of
+//! their first informative window, the windowed ones use a ridge relative
+//! to `‖Ψ‖²_F/n`, the plausibility check below is relative to the motion the
+//! recording has shown. `θ = 0` is the hold predictor. The defaults are
+//!
+//! - `ls 2,2,0 W=100 ρ=1e-6`: least squares over the last 100 samples,
+//!   refitted at every window (short memory, quick after a change);
+//! - `rls 3,3,0 λ=0.995`, `rls 4,4,0 λ=0.999`, `rls 6,6,0 λ=0.999`,
+//!   `rls 8,8,0 λ=0.9995`: exponentially weighted recursive least squares
+//!   (memories of 200 to 2000 samples, low to high orders).
+//!
+//! All use `nk = 0`, the command at the predicted instant: the command is a
+//! planned trajectory, known ahead, and at low sampling rates it is what
+//! matters. They were chosen on the drive zoo ([`crate::zoo`], example
+//! `zoo_sweep`), not on one recording. `--order` sets the orders of the
+//! long-memory recursive candidate (the one whose coefficients are
+//! reported, [`AutoConfig::reported`]); `--ridge` the ridge of the windowed
+//! ones.
+//!
+//! # Choice
+//!
+//! Every candidate learns from every sample and predicts every horizon
+//! `H` samples ahead, running its equation forward from the last measured
+//! position on the known command. Once a horizon is measured, each
+//! candidate's prediction is scored by its mean squared error `e²` over
+//! the horizon, and its score in the horizon's *regime* of the command —
+//! still, constant speed, or changing speed ([`AutoEstimator::regime`]) — becomes
+//! `s ← (1 − α)·s + α·e²` (α = [`AutoConfig::memory`], default 0.1). At
+//! each window the ready candidate with the lowest score in the coming
+//! horizon's regime predicts (an unscored regime borrows the candidate's
+//! first scored one). Scores are compared with one another only, so they
+//! carry no threshold and no unit.
+//!
+//! A candidate's prediction is *implausible* when it leaves the last
+//! measured position by more than [`AutoConfig::plausibility`] times the
+//! largest motion of the position over `H + 1` samples so far: the
+//! candidate is then restarted (a wound-up or noise-fitted model learns
+//! again) and the best-scored plausible candidate predicts instead. If none
+//! can, `auto` holds the last position. So every window after the first
+//! gets a prediction: `auto` never withholds.
+//!
+//! How far to trust a prediction is the engine's prediction interval
+//! ([`crate::ident::engine::Guard`]): the quantile of the method's own
+//! recent scored errors at each step ahead. Isolated wild samples
+//! (glitches) are rejected there before `auto` or any other method fits
+//! them.
+
+mod candidate;
+mod config;
+mod estimator;
+mod model;
+
+pub use candidate::Candidate;
+pub use config::AutoConfig;
+pub use estimator::AutoEstimator;

@@ -528,6 +528,21 @@ pub struct CompensateArgs {
     /// Keep the model's DC gain instead of rescaling it to 1 (a position loop has 1).
     #[arg(long)]
     pub keep_dc_gain: bool,
+    /// The axis before the first desired sample: rest (at the first value) or moving (a segment cut from a longer program, at the first sample's velocity).
+    #[arg(long, default_value = "rest", value_name = "rest|moving")]
+    pub start: String,
+    /// Send the plain command when the model expects the rms error to fall less than this many times.
+    #[arg(long, default_value_t = 1.25, value_name = "X")]
+    pub min_benefit: f64,
+    /// Send the plain command when the model's free-run position fit is below this [%].
+    #[arg(long, default_value_t = 90.0, value_name = "PCT")]
+    pub min_fit: f64,
+    /// Always send the compensated command (no fall-back to the plain one).
+    #[arg(long)]
+    pub no_fallback: bool,
+    /// A recording of the axis (time_s,command_m,position_m; e.g. the identification run) on which the model's fits are measured for the fall-back [default: the model file's fit].
+    #[arg(long, value_name = "rec.csv", requires = "model")]
+    pub check: Option<PathBuf>,
     /// Use an unstable physical model anyway (its simulation diverges; refused by default).
     #[arg(long)]
     pub allow_unstable: bool,

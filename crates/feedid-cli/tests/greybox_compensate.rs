@@ -534,3 +534,110 @@ fn compensate_bad_inputs_name_the_culprit_and_leave_nothing() {
     );
     assert!(!cmd.exists());
 }
+
+/// A desired trajectory file `time_s,position_m` from positions at 5 kHz.
+fn desired_file(dir: &Path, name: &str, x: &[f64]) -> PathBuf {
+    let out = dir.join(name);
+    let mut text = String::from("time_s,position_m\n");
+    for (k, v) in x.iter().enumerate() {
+        text.push_str(&format!("{},{v}\n", k as f64 * 2e-4));
+    }
+    std::fs::write(&out, text).unwrap();
+    out
+}
+
+#[test]
+fn compensate_succeeds_on_segments_moving_at_their_end_or_from_their_first_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = dir.path().join("rig.toml");
+    run_ok(&["model", "--save-params", p(&rig)]);
+    // the ramp: 10 ms of rest, then 50 mm/s up to the last sample
+    let ramp: Vec<f64> = (0..1000)
+        .map(|k| 0.05 * ((k as f64 - 50.0) * 2e-4).max(0.0))
+        .collect();
+    // a jerk-limited start from rest at t = 0 (200 m/s³ up to 2 m/s², then 2 m/s²)
+    let jerk: Vec<f64> = (0..1000)
+        .map(|k| {
+            let t = k as f64 * 2e-4;
+            if t < 0.01 {
+                200.0 * t.powi(3) / 6.0
+            } else {
+                let (x1, v1) = (200.0 * 1e-6 / 6.0, 200.0 * 1e-4 / 2.0);
+                let s = t - 0.01;
+                x1 + v1 * s + s * s
+            }
+        })
+        .collect();
+    // a cut segment: moving at 50 mm/s from the first to the last sample
+    let segment: Vec<f64> = (0..1000).map(|k| 0.01 + 0.05 * k as f64 * 2e-4).collect();
+    let cmd = dir.path().join("cmd.csv");
+    for (name, x, extra) in [
+        ("ramp.csv", &ramp, vec![]),
+        ("jerk.csv", &jerk, vec![]),
+        ("segment.csv", &segment, vec!["--start", "moving"]),
+    ] {
+        let des = desired_file(dir.path(), name, x);
+        let summary = dir.path().join(format!("{name}.json"));
+        let mut args = vec![
+            "compensate",
+            "--desired",
+            p(&des),
+            "--params",
+            p(&rig),
+            "-o",
+            p(&cmd),
+            "--summary",
+            p(&summary),
+        ];
+        args.extend(extra);
+        let out = run_ok(&args);
+        assert!(out.contains("command sent: compensated"), "{name}: {out}");
+        let v = json(&summary);
+        assert!(v["fallback"].is_null(), "{name}");
+        let plain = v["predicted_plain_error"]["rms"].as_f64().unwrap();
+        let comp = v["predicted_error"]["rms"].as_f64().unwrap();
+        assert!(comp < 0.1 * plain, "{name}: {comp} vs {plain}");
+        // the figures quoted are the command's in the file, from rest
+        let (h, rows) = csv(&cmd);
+        let u = col(&h, &rows, "command_m");
+        let mut vmax = 0.0_f64;
+        let mut prev = if name == "segment.csv" { u[0] } else { x[0] };
+        for w in &u {
+            vmax = vmax.max((w - prev).abs() / 2e-4);
+            prev = *w;
+        }
+        let quoted = v["peak_velocity"].as_f64().unwrap();
+        assert!(quoted <= 1.0, "{name}: {quoted}");
+        if name != "segment.csv" {
+            assert!(
+                (vmax - quoted).abs() < 1e-6 * quoted.max(1e-3),
+                "{name}: {vmax} vs {quoted}"
+            );
+        }
+    }
+    // a velocity step at t = 0 from rest is refused with the figures, plain's included
+    let step_cmd = dir.path().join("step_cmd.csv");
+    let step = desired_file(
+        dir.path(),
+        "step.csv",
+        &(0..1000)
+            .map(|k| 0.05 * k as f64 * 2e-4)
+            .collect::<Vec<_>>(),
+    );
+    assert_fails(
+        &feedid(&[
+            "compensate",
+            "--desired",
+            p(&step),
+            "--params",
+            p(&rig),
+            "-o",
+            p(&step_cmd),
+        ]),
+        &[
+            "acceleration",
+            "limit 30",
+            "desired trajectory itself at 250",
+        ],
+    );
+}

@@ -249,6 +249,26 @@ pub enum Error {
     },
 
     // --- compensate
+    /// No smoothing allowed brings the compensated command within a limit,
+    /// and the plain trajectory exceeds it too.
+    #[error("the command {quantity} cannot be brought within the limit {limit} {unit}: with the most smoothing allowed (σ up to {smoothing_ms:.3} ms) the compensated command still peaks at {achievable:.4} {unit} at t = {time:.4} s, and the desired trajectory itself at {plain:.4} {unit}; raise the limit or --max-smoothing, or slow the trajectory")]
+    LimitUnreachable {
+        /// `"velocity"` or `"acceleration"`.
+        quantity: &'static str,
+        /// The smallest peak the compensated command reached (magnitude).
+        achievable: f64,
+        /// Time of that peak \[s\].
+        time: f64,
+        /// The limit.
+        limit: f64,
+        /// The plain trajectory's own peak.
+        plain: f64,
+        /// Unit of the values.
+        unit: &'static str,
+        /// Largest σ tried \[ms\].
+        smoothing_ms: f64,
+    },
+
     /// A computed command violates a velocity or acceleration limit.
     #[error("command {quantity} {value:.4} {unit} at t = {time:.4} s exceeds the limit {limit} {unit}; {hint}")]
     LimitExceeded {

@@ -6,8 +6,8 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use feedid::compensate::{
-    compensate_model, compensate_params, verify_on_rig, CompensateConfig, Compensation, Smoothing,
-    Verification, ZeroHandling,
+    compensate_model, compensate_params, verify_on_rig, CompensateConfig, Compensation,
+    ModelQuality, Smoothing, StartMode, Verification, ZeroHandling,
 };
 use feedid::drive::{RigEffects, VirtualRig};
 use feedid::greybox::LoopModel;
@@ -23,6 +23,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     ins.extend(a.params.as_deref());
     ins.extend(a.rig.as_deref());
     ins.extend(a.effects.as_deref());
+    ins.extend(a.check.as_deref());
     let mut outs = vec![a.output.as_path()];
     outs.extend(a.verify_out.as_deref());
     outs.extend(a.summary.as_deref());
@@ -33,12 +34,17 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             anyhow::anyhow!("invalid --smooth `{s}`: expected a time in seconds or auto")
         })?),
     };
-    let cfg = CompensateConfig {
+    let start: StartMode = a.start.parse()?;
+    let mut cfg = CompensateConfig {
         smoothing,
         max_velocity: a.max_velocity,
         max_acceleration: a.max_acceleration,
         max_smoothing: a.max_smoothing,
         unit_dc_gain: !a.keep_dc_gain,
+        start,
+        min_benefit: a.min_benefit,
+        min_fit_percent: a.min_fit,
+        fallback: !a.no_fallback,
         ..CompensateConfig::default()
     };
     cfg.validate()?;
@@ -73,6 +79,29 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     let (source, comp) = match (&a.model, &a.params) {
         (Some(path), _) => {
             let file = crate::cmd::load_model_file(path)?;
+            cfg.quality = match &a.check {
+                Some(check) => {
+                    let r = read_recording(check, &ReadOptions::default())?;
+                    let model_dt = match &file.model {
+                        feedid::ident::LinearModel::Discrete { dt, .. } => *dt,
+                        feedid::ident::LinearModel::Continuous { .. } => r.dt(),
+                    };
+                    if (r.dt() - model_dt).abs() > 1e-6 * model_dt {
+                        anyhow::bail!(
+                            "{}: sample time {} s differs from the model's {} s",
+                            check.display(),
+                            r.dt(),
+                            model_dt
+                        );
+                    }
+                    ModelQuality::from_run(&file.model, r.command(), r.position(), r.dt())
+                        .map_err(|e| anyhow::anyhow!("{}: {e}", check.display()))?
+                }
+                None => ModelQuality {
+                    position_fit_percent: file.identified_by.as_ref().map(|p| p.fit_percent),
+                    error_fit_percent: None,
+                },
+            };
             let comp = compensate_model(&file.model, desired, dt, &cfg)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             let how = match &file.identified_by {
@@ -117,7 +146,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         rec.len(),
         rec.rate_hz()
     );
-    describe(&mut text, &comp);
+    describe(&mut text, &comp, &cfg.quality);
 
     let verification = match &verify_rig {
         Some(rig) => Some(verify_on_rig(rig, desired, &comp.command, rec.rate_hz())?),
@@ -198,6 +227,9 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     }
     outputs.commit()?;
     print!("{text}");
+    if let Some(f) = &comp.fallback {
+        eprintln!("warning: the plain desired trajectory is sent as the command: {f}");
+    }
     if !comp.exact_inverse {
         eprintln!(
             "warning: the model has zeros on the unit circle; they were approximated (zero phase error), so even the model does not follow exactly"
@@ -232,7 +264,7 @@ fn json_limit(v: f64) -> serde_json::Value {
     }
 }
 
-fn describe(t: &mut String, c: &Compensation) {
+fn describe(t: &mut String, c: &Compensation, q: &ModelQuality) {
     let count = |h: ZeroHandling| c.zeros.iter().filter(|z| z.handling == h).count();
     let _ = writeln!(
         t,
@@ -244,12 +276,38 @@ fn describe(t: &mut String, c: &Compensation) {
         count(ZeroHandling::AntiCausal),
         count(ZeroHandling::ZeroPhase)
     );
+    let fit = |v: Option<f64>| v.map_or("unknown".to_string(), |f| format!("{f:.2} %"));
     let _ = writeln!(
         t,
-        "  smoothing σ {:.3} ms; command peak velocity {:.4} m/s, peak acceleration {:.3} m/s²",
+        "  start: {}; end velocity {:.6} m/s held after the last sample; model fit: position {}, following error {}",
+        match c.start {
+            StartMode::Rest => "at rest",
+            StartMode::Moving => "moving",
+        },
+        c.end_velocity,
+        fit(q.position_fit_percent),
+        fit(q.error_fit_percent)
+    );
+    let _ = writeln!(
+        t,
+        "  model's prediction: plain command rms {}, compensated rms {}, expected benefit {:.2}×",
+        micrometres(c.benefit.predicted_plain_rms_m),
+        micrometres(c.benefit.predicted_compensated_rms_m),
+        c.benefit.expected_benefit
+    );
+    let _ = writeln!(
+        t,
+        "  command sent: {}; smoothing σ up to {:.3} ms on {:.1} % of the samples; peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
+        match &c.fallback {
+            None => "compensated".to_string(),
+            Some(f) => format!("plain ({f})"),
+        },
         1e3 * c.smoothing_s,
+        100.0 * c.smoothed_share,
         c.peak_velocity,
-        c.peak_acceleration
+        c.peak_velocity_time_s,
+        c.peak_acceleration,
+        c.peak_acceleration_time_s
     );
     let _ = writeln!(
         t,

@@ -17,10 +17,16 @@
 //! 2. every pole factor `(1 − p·q⁻¹)` as a two-tap FIR filter;
 //! 3. zeros inside the unit circle (`|z| < 1 − δ`): causal recursion
 //!    `v[k] = t[k] + z·v[k−1]` (stable);
-//! 4. zeros on the unit circle (`||z| − 1| ≤ δ`) cannot be inverted by a
-//!    bounded filter: replaced by the zero-phase-error approximation of
+//! 4. zeros on or near the unit circle cannot be inverted by a bounded (or
+//!    a short) filter: replaced by the zero-phase-error approximation of
 //!    Tomizuka's ZPETC, `1/(1 − z·q⁻¹) ≈ (1 − z·q)/(1 − z)²` (exact gain at
-//!    DC, zero phase, gain error growing with frequency);
+//!    DC, zero phase, gain error growing with frequency). "Near" is
+//!    `||z| − 1| ≤ δ` for a zero in the left half plane (`Re z < 0`, where
+//!    the exact inverse would ring at up to the Nyquist frequency with gain
+//!    `1/||z| − 1|`: the spurious zeros of an identified model lie there),
+//!    and `||z| − 1| ≤ 2e-4` elsewhere (a slow zero near `z = 1` is inverted
+//!    exactly unless its inverse would take more than 200 000 samples to
+//!    settle: the approximation is poor at low frequency);
 //! 5. zeros outside (`|z| > 1 + δ`, e.g. the sampling zeros of a model of
 //!    relative degree ≥ 3): anti-causal recursion run backwards from the end,
 //!    `u[k−1] = (u[k] − w[k])/z`, started at the steady state — the exact
@@ -51,7 +57,12 @@ use crate::lti::{poly_roots, DiscreteStateSpace, StateSpace};
 const SETTLE: f64 = 1e-17;
 
 /// Longest extension of the trajectory \[samples\].
-const MAX_TAIL: usize = 2_000_000;
+const MAX_TAIL: usize = 200_000;
+
+/// Half-width of the band around the unit circle where a zero in the right
+/// half plane gets the zero-phase approximation: closer, its exact inverse
+/// would take more than [`MAX_TAIL`] samples to settle.
+const SLOW_BAND: f64 = 2e-4;
 
 /// How one zero of the model is inverted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -94,12 +105,30 @@ impl Factor {
         }
     }
 
+    /// Real part of the root(s).
+    fn real_part(self) -> f64 {
+        match self {
+            Factor::Real(z) => z,
+            Factor::Pair(c1, _) => 0.5 * c1,
+        }
+    }
+
     /// Modulus of the root(s).
     fn modulus(self) -> f64 {
         match self {
             Factor::Real(z) => z.abs(),
             Factor::Pair(_, c2) => c2.abs().sqrt(),
         }
+    }
+}
+
+/// Half-width of the band around the unit circle where a zero with real
+/// part `re` gets the zero-phase approximation (see the module doc).
+fn band_of(re: f64, margin: f64) -> f64 {
+    if re < 0.0 {
+        margin.max(SLOW_BAND)
+    } else {
+        SLOW_BAND
     }
 }
 
@@ -138,6 +167,7 @@ pub struct StableInverse {
     anticausal: Vec<Factor>,
     zeros: Vec<ZeroInfo>,
     tail: usize,
+    settle: usize,
 }
 
 impl StableInverse {
@@ -176,9 +206,10 @@ impl StableInverse {
         let mut anticausal = Vec::new();
         for f in factors(zeros)? {
             let m = f.modulus();
-            if m < 1.0 - margin {
+            let band = band_of(f.real_part(), margin);
+            if m < 1.0 - band {
                 causal.push(f);
-            } else if m > 1.0 + margin {
+            } else if m > 1.0 + band {
                 anticausal.push(f);
             } else {
                 if f.at_one().abs() < 1e-12 {
@@ -194,13 +225,14 @@ impl StableInverse {
             .iter()
             .map(|z| {
                 let m = z.norm();
+                let band = band_of(z.re, margin);
                 ZeroInfo {
                     re: z.re,
                     im: z.im,
                     modulus: m,
-                    handling: if m < 1.0 - margin {
+                    handling: if m < 1.0 - band {
                         ZeroHandling::Causal
-                    } else if m > 1.0 + margin {
+                    } else if m > 1.0 + band {
                         ZeroHandling::AntiCausal
                     } else {
                         ZeroHandling::ZeroPhase
@@ -220,7 +252,17 @@ impl StableInverse {
                 });
             }
         }
-        if tail > MAX_TAIL {
+        let mut settle = tail;
+        for f in &anticausal {
+            let m = f.modulus();
+            let n = (SETTLE.ln() / (1.0 / m).ln()).ceil();
+            settle = settle.max(if n.is_finite() {
+                n as usize + 4
+            } else {
+                MAX_TAIL
+            });
+        }
+        if tail > MAX_TAIL || settle > MAX_TAIL {
             return Err(Error::InvalidModel {
                 reason: "a zero is so close to the unit circle that its inverse does not settle; increase the unit-circle margin",
             });
@@ -234,6 +276,7 @@ impl StableInverse {
             anticausal,
             zeros: zeros_info,
             tail,
+            settle,
         })
     }
 
@@ -306,6 +349,13 @@ impl StableInverse {
     /// Samples appended after the trajectory for the causal sections to settle.
     pub fn tail(&self) -> usize {
         self.tail
+    }
+
+    /// Samples over which any section's response to a change has decayed
+    /// below 1e-17 of it, forward (causal zeros) or backward (anti-causal
+    /// zeros, i.e. the pre-actuation); at least [`StableInverse::tail`].
+    pub fn settle(&self) -> usize {
+        self.settle
     }
 
     /// The input `u` whose response is `y` (both deviations from the rest
@@ -547,5 +597,45 @@ mod tests {
     fn zero_at_one_is_refused() {
         let e = StableInverse::from_polynomials(&[0.0, 1.0, -1.0], &[1.0, -0.5], 1e-6).unwrap_err();
         assert!(e.to_string().contains("z = 1"), "{e}");
+    }
+
+    #[test]
+    fn zpetc_makes_the_loop_zero_phase_with_gain_cos_squared() {
+        // G = q⁻¹·(1 + q⁻¹)/2: zero at −1; G·Ĝ⁻¹ = (q + 2 + q⁻¹)/4 = cos²(ω/2)
+        let b = [0.0, 0.5, 0.5];
+        let a = [1.0];
+        let inv = StableInverse::from_polynomials(&b, &a, 0.05).unwrap();
+        assert_eq!(inv.zeros()[0].handling, ZeroHandling::ZeroPhase);
+        let w = 0.7;
+        let y: Vec<f64> = (0..400).map(|k| (w * k as f64).cos()).collect();
+        let mut u = vec![0.0; 400];
+        inv.apply_into(&y, &mut u, &mut Vec::new()).unwrap();
+        let back = simulate(&b, &a, &u);
+        let gain = (w / 2.0).cos().powi(2);
+        for k in 10..390 {
+            assert!((back[k] - gain * y[k]).abs() < 1e-12, "{k}");
+        }
+    }
+
+    #[test]
+    fn only_left_half_plane_zeros_near_the_circle_are_approximated() {
+        // zeros −0.97 (ZPETC with margin 0.05) and 0.97 (exact, causal)
+        let beta =
+            crate::lti::poly_from_roots(&[Complex::new(-0.97, 0.0), Complex::new(0.97, 0.0)]);
+        let mut b = vec![0.0];
+        b.extend_from_slice(&beta);
+        let inv = StableInverse::from_polynomials(&b, &[1.0, -0.5], 0.05).unwrap();
+        let h: Vec<_> = inv
+            .zeros()
+            .iter()
+            .map(|z| (z.re > 0.0, z.handling))
+            .collect();
+        assert!(h.contains(&(false, ZeroHandling::ZeroPhase)));
+        assert!(h.contains(&(true, ZeroHandling::Causal)));
+        // an anti-causal zero's settle length covers its decay, 1e-17 = 1.5^−n
+        let beta = crate::lti::poly_from_roots(&[Complex::new(1.5, 0.0)]);
+        let inv = StableInverse::from_polynomials(&beta, &[1.0], 0.05).unwrap();
+        let n = (1e-17_f64.ln() / (1.0 / 1.5_f64).ln()).ceil() as usize;
+        assert!(inv.settle() >= n);
     }
 }

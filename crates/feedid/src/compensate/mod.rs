@@ -7,19 +7,25 @@
 //!   model as a cascade of first- and second-order sections; zeros outside
 //!   the unit circle (the sampling zeros of a feed drive) are inverted
 //!   anti-causally, zeros on it by Tomizuka's zero-phase approximation.
-//! * [`compensate`], [`compensate_model`], [`compensate_params`]: smoothing
-//!   of the desired trajectory chosen to respect the command's velocity and
-//!   acceleration limits, the command and the model's prediction.
+//! * [`compensate`], [`compensate_model`], [`compensate_params`]: the
+//!   command (plain trajectory plus the correction the axis needs), smoothed
+//!   only where the command's velocity and acceleration limits need it,
+//!   segments moving at either end, and the model's prediction.
+//! * [`Benefit`], [`ModelQuality`], [`Fallback`]: "never worse" — the plain
+//!   command is sent when the model expects little benefit or fits poorly.
 //! * [`verify_on_rig`]: tracking error on the virtual rig before and after.
 
+mod benefit;
 mod command;
 mod inverse;
 mod smoothing;
 mod verify;
 
+pub use benefit::{Benefit, Fallback, ModelQuality};
 pub use command::{
     compensate, compensate_model, compensate_params, CompensateConfig, Compensation, Smoothing,
+    StartMode,
 };
 pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
-pub use smoothing::gaussian_smooth;
+pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, taper_profile};
 pub use verify::{verify_on_rig, TrackingError, Verification};

@@ -177,6 +177,10 @@ impl DiscreteStateSpace {
     /// DC gain D + C·(I − A)⁻¹·B; a pole at z = 1 is an error.
     pub fn dc_gain(&self) -> Result<f64> {
         let n = self.order();
+        if n == 0 {
+            // a static gain: no state to solve for
+            return Ok(self.d);
+        }
         let m = DMatrix::<f64>::identity(n, n) - &self.a;
         let x = m.lu().solve(&self.b).ok_or(Error::Singular {
             context: "discrete DC gain (pole at z = 1)",

@@ -1,0 +1,251 @@
+//! "Never worse": how good the model is, what the compensation is expected
+//! to gain, and when to send the plain command instead.
+//!
+//! The model `G` predicts, for the plain command `y_d` and for the
+//! compensated command `u`, the tracking errors
+//!
+//! ```text
+//! e_plain = G·y_d − y_d,      e_comp = G·u − y_d            (rms over the trajectory)
+//! ```
+//!
+//! The model is not the axis: on a recording of the axis (the identification
+//! run or another) its free-run error `y − ŷ` is compared with the following
+//! error `y − u` there. The **error fit**
+//!
+//! ```text
+//! fit_e = 100·(1 − ‖y − ŷ‖ / ‖(y − u) − mean(y − u)‖)   [%]
+//! ```
+//!
+//! is the share of the axis's following error that the model explains (the
+//! position fit, `100·(1 − ‖y − ŷ‖/‖y − ȳ‖)`, is dominated by the motion
+//! itself and says little on an axis with feed-forward, whose following
+//! error is tiny). What the model does not explain stays after compensation,
+//! so the expected rms and benefit are
+//!
+//! ```text
+//! e_expected = rms(e_comp) + (1 − fit_e/100)·rms(e_plain)
+//! benefit    = rms(e_plain) / e_expected
+//! ```
+//!
+//! (with no error fit given, `e_expected = rms(e_comp)`). The plain command
+//! is sent instead — a [`Fallback`], reported with a warning — when the
+//! position fit is below [`super::CompensateConfig::min_fit_percent`], when
+//! the benefit is below [`super::CompensateConfig::min_benefit`], or when
+//! the compensated command cannot meet the limits but the plain one does.
+
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::ident::LinearModel;
+
+/// How well a model reproduces the axis (free run over a recording).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct ModelQuality {
+    /// Free-run position fit \[%\] (NRMSE; e.g. `identify --model-out`'s).
+    pub position_fit_percent: Option<f64>,
+    /// Share of the following error the model explains \[%\] (module doc).
+    pub error_fit_percent: Option<f64>,
+}
+
+impl ModelQuality {
+    /// Both fits of `model` run free (deviations from the first sample,
+    /// the model rescaled to unit DC gain as the compensation uses it) on
+    /// the `command` of a recording of the axis at interval `dt` \[s\],
+    /// against its measured `position`.
+    ///
+    /// ```
+    /// use feedid::compensate::ModelQuality;
+    /// use feedid::ident::LinearModel;
+    /// let m = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+    /// let u: Vec<f64> = (0..500).map(|k| ((k / 50) % 2) as f64).collect();
+    /// let y = m.simulate(&u).unwrap();
+    /// let q = ModelQuality::from_run(&m, &u, &y, 1e-3).unwrap();
+    /// assert!(q.error_fit_percent.unwrap() > 99.999);
+    /// ```
+    pub fn from_run(
+        model: &LinearModel,
+        command: &[f64],
+        position: &[f64],
+        dt: f64,
+    ) -> Result<Self> {
+        if command.len() != position.len() {
+            return Err(Error::LengthMismatch {
+                what: "command and position of the model check",
+                expected: command.len(),
+                actual: position.len(),
+            });
+        }
+        if command.len() < 10 {
+            return Err(Error::TooFewSamples {
+                what: "a model check",
+                needed: 10,
+                actual: command.len(),
+            });
+        }
+        let (u0, y0) = (command[0], position[0]);
+        let dev: Vec<f64> = command.iter().map(|u| u - u0).collect();
+        let mut yd = model.simulate_at(&dev, dt)?;
+        // as the compensation uses it: rescaled to unit DC gain
+        let g = model.discrete_state_space(Some(dt))?.dc_gain()?;
+        if g.is_finite() && g.abs() > 1e-12 {
+            for v in &mut yd {
+                *v /= g;
+            }
+        }
+        let n = command.len() as f64;
+        let mean_y = position.iter().sum::<f64>() / n;
+        let mean_f = position
+            .iter()
+            .zip(command)
+            .map(|(y, u)| y - u)
+            .sum::<f64>()
+            / n;
+        let (mut sse, mut ssy, mut ssf) = (0.0, 0.0, 0.0);
+        for k in 0..command.len() {
+            let yhat = y0 + yd[k];
+            sse += (position[k] - yhat).powi(2);
+            ssy += (position[k] - mean_y).powi(2);
+            ssf += (position[k] - command[k] - mean_f).powi(2);
+        }
+        let fit = |ss: f64| {
+            if ss > 0.0 && sse.is_finite() {
+                Some(100.0 * (1.0 - (sse / ss).sqrt()))
+            } else {
+                None
+            }
+        };
+        Ok(Self {
+            position_fit_percent: fit(ssy),
+            error_fit_percent: fit(ssf),
+        })
+    }
+}
+
+/// The model's prediction of the benefit (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Benefit {
+    /// Predicted rms of the plain command's tracking error \[m\].
+    pub predicted_plain_rms_m: f64,
+    /// Predicted rms of the compensated command's tracking error \[m\].
+    pub predicted_compensated_rms_m: f64,
+    /// Expected rms after compensation, with the model's unexplained share \[m\].
+    pub expected_compensated_rms_m: f64,
+    /// `predicted_plain_rms_m / expected_compensated_rms_m`.
+    pub expected_benefit: f64,
+}
+
+impl Benefit {
+    /// From the predicted rms errors and the model's quality.
+    pub fn new(plain_rms: f64, compensated_rms: f64, quality: &ModelQuality) -> Self {
+        let unexplained = quality
+            .error_fit_percent
+            .map(|f| (1.0 - f / 100.0).clamp(0.0, 1.0))
+            .unwrap_or(0.0);
+        let expected = compensated_rms + unexplained * plain_rms;
+        let expected_benefit = if expected > 0.0 {
+            plain_rms / expected
+        } else if plain_rms > 0.0 {
+            f64::INFINITY
+        } else {
+            1.0
+        };
+        Self {
+            predicted_plain_rms_m: plain_rms,
+            predicted_compensated_rms_m: compensated_rms,
+            expected_compensated_rms_m: expected,
+            expected_benefit,
+        }
+    }
+}
+
+/// Why the plain command is sent instead of the compensated one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum Fallback {
+    /// The model's free-run position fit is below the minimum.
+    PoorFit {
+        /// The fit \[%\].
+        fit_percent: f64,
+        /// The minimum \[%\].
+        min_percent: f64,
+    },
+    /// The expected benefit is below the minimum.
+    SmallBenefit {
+        /// The expected benefit (plain rms / compensated rms).
+        expected: f64,
+        /// The minimum.
+        min: f64,
+    },
+    /// The compensated command exceeds a limit even with the most smoothing
+    /// allowed, and the plain command does not.
+    Limits {
+        /// `"velocity"` or `"acceleration"`.
+        quantity: &'static str,
+        /// The smallest peak the compensated command reached.
+        achievable: f64,
+        /// The limit.
+        limit: f64,
+    },
+}
+
+impl std::fmt::Display for Fallback {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Fallback::PoorFit {
+                fit_percent,
+                min_percent,
+            } => write!(
+                f,
+                "the model's free-run fit {fit_percent:.1} % is below {min_percent} %"
+            ),
+            Fallback::SmallBenefit { expected, min } => write!(
+                f,
+                "the model expects the compensation to reduce the rms error only {expected:.2}-fold (minimum {min})"
+            ),
+            Fallback::Limits {
+                quantity,
+                achievable,
+                limit,
+            } => write!(
+                f,
+                "the compensated command's {quantity} cannot be brought below {achievable:.4} (limit {limit}) with the smoothing allowed, and the plain command's can"
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_fit_measures_the_explained_share_of_the_following_error() {
+        // axis: first-order lag; model: the same lag with a 10 % wrong pole shift
+        let axis = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+        let u: Vec<f64> = (0..2000).map(|k| (k as f64 * 0.01).sin()).collect();
+        let y = axis.simulate(&u).unwrap();
+        let exact = ModelQuality::from_run(&axis, &u, &y, 1e-3).unwrap();
+        assert!(exact.error_fit_percent.unwrap() > 100.0 - 1e-9);
+        // a model that predicts y = u (no dynamics) explains none of it
+        let none = LinearModel::discrete(vec![1.0], vec![1.0], 1e-3).unwrap();
+        let q = ModelQuality::from_run(&none, &u, &y, 1e-3).unwrap();
+        let e = q.error_fit_percent.unwrap();
+        // ‖y − u‖ / ‖(y − u) − mean‖ ≥ 1 → fit ≤ 0
+        assert!(e <= 1e-9, "{e}");
+        assert!(q.position_fit_percent.unwrap() > 50.0);
+    }
+
+    #[test]
+    fn benefit_adds_the_unexplained_share() {
+        let q = ModelQuality {
+            position_fit_percent: Some(99.0),
+            error_fit_percent: Some(90.0),
+        };
+        let b = Benefit::new(10.0, 0.5, &q);
+        assert!((b.expected_compensated_rms_m - 1.5).abs() < 1e-12);
+        assert!((b.expected_benefit - 10.0 / 1.5).abs() < 1e-12);
+        let b = Benefit::new(10.0, 0.5, &ModelQuality::default());
+        assert!((b.expected_benefit - 20.0).abs() < 1e-12);
+        assert_eq!(Benefit::new(0.0, 0.0, &q).expected_benefit, 1.0);
+    }
+}

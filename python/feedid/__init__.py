@@ -1,0 +1,623 @@
+"""feedid: short-time identification and prediction of machine-tool feed drives.
+
+NumPy in, NumPy out, over the Rust library's identification pipeline (the
+same computation as the command-line tool ``feedid identify``, not a call
+of it)::
+
+    import feedid
+    rec = feedid.simulate("multisine", seed=1)          # the virtual rig
+    run = feedid.identify(rec, method="auto")            # or (time, command, position)
+    run.predicted, run.lower, run.upper                  # [m], NaN where not predicted
+    run.summary["rms_error_m"]                           # summary.json's keys
+
+Units: time in seconds, positions and commands in metres, rates in Hz,
+windows, horizons and hops in samples.
+
+Errors raise :class:`feedid.Error`: :class:`feedid.InputError` (also a
+``ValueError``) for bad data or arguments, :class:`feedid.FileError` (also an
+``OSError``) for files that cannot be read; the messages are the CLI's.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _feedid
+from ._feedid import Recording
+
+__all__ = [
+    "Error",
+    "InputError",
+    "FileError",
+    "Recording",
+    "Identification",
+    "Streamer",
+    "read",
+    "identify",
+    "simulate",
+    "model",
+    "compensate",
+    "__version__",
+]
+
+__version__: str = _feedid.__version__
+
+PathLike = Union[str, "os.PathLike[str]"]
+Params = Union[None, PathLike, Mapping[str, Any]]
+
+
+class Error(Exception):
+    """Any error reported by feedid (the message is the command-line tool's)."""
+
+
+class InputError(Error, ValueError):
+    """Bad data or arguments: a missing column, NaN, non-monotone time, too
+    few samples, an unknown method or option, parameters without a usable
+    model."""
+
+
+class FileError(Error, OSError):
+    """A file that cannot be opened or read (the message names it)."""
+
+
+def _params(params: Params) -> Dict[str, Any]:
+    """Rig parameters as the native functions take them."""
+    if params is None:
+        return {}
+    if isinstance(params, Mapping):
+        return {"params_json": json.dumps(dict(params))}
+    return {"params_path": os.fspath(params)}
+
+
+def _array(x: Any, name: str) -> np.ndarray:
+    """A 1-D contiguous float64 array: the input itself when it already is
+    one (no copy), else NumPy's conversion."""
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    if a.ndim != 1:
+        raise InputError(f"{name}: expected a 1-D array, got shape {a.shape}")
+    return a
+
+
+_METHOD_OPTIONS = ("solver", "time_origin", "prediction", "simplex_start", "lambda", "lambda_", "ridge")
+
+
+def _method_options(order: Any, options: Mapping[str, Any]) -> Dict[str, Any]:
+    """``order`` and the method options as the native functions take them."""
+    out: Dict[str, Any] = {}
+    for key, value in options.items():
+        if key not in _METHOD_OPTIONS:
+            raise TypeError(
+                f"unknown option {key!r}; method options are: "
+                "solver, time_origin, prediction, simplex_start (paper), lambda (rls), "
+                "ridge (arx, auto)"
+            )
+        out["lambda_" if key == "lambda" else key] = value
+    if order is not None:
+        if isinstance(order, str):
+            out["order"] = order
+        else:
+            out["order"] = ",".join(str(int(v)) for v in order)
+    return out
+
+
+def read(
+    path: PathLike,
+    time: Optional[Union[str, int]] = None,
+    command: Optional[Union[str, int]] = None,
+    position: Optional[Union[str, int]] = None,
+    unit: str = "m",
+    *,
+    rate: Optional[float] = None,
+    delimiter: Optional[str] = None,
+    header: Optional[bool] = None,
+    scale: Optional[float] = None,
+    time_unit: str = "s",
+    jitter_tol: float = 0.01,
+) -> Recording:
+    """Read a recording from a CSV/text file or a MATLAB MAT-file, as
+    ``feedid identify`` reads it (same options, same defaults, same messages).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (``.mat`` or MAT content: a MAT-file; anything else: text).
+    time, command, position : str or int, optional
+        Column (header name or 1-based index) or MAT variable of the time,
+        the position command and the measured position. Defaults (text):
+        ``time_s``, ``command_m``, ``position_m``; a MAT-file needs command
+        and position named, and time or ``rate``.
+    unit : str
+        Unit of command and position in the file: ``m`` (default), ``mm``,
+        ``um``, ``nm``; converted to metres.
+    rate : float, optional
+        Sampling rate [Hz] for a file without a time column (t_k = k / rate).
+    delimiter : str, optional
+        ``,`` ``;`` ``tab`` or ``space``; default: detected.
+    header : bool, optional
+        Whether the first row is a header; default: detected.
+    scale : float, optional
+        Metres per file unit (encoder counts and the like; overrides ``unit``).
+    time_unit : str
+        Unit of the time column: ``s`` (default), ``ms``, ``us``.
+    jitter_tol : float
+        Largest relative deviation of a sampling interval from the mean
+        (default 0.01).
+
+    Returns
+    -------
+    Recording
+        ``.time`` [s], ``.command`` [m], ``.position`` [m] as read-only
+        float64 NumPy views (no copies), ``.rate_hz`` [Hz], ``.dt`` [s].
+
+    Raises
+    ------
+    FileError
+        The file cannot be opened or read.
+    InputError
+        A missing column, a cell that is not a number, NaN, time not
+        increasing, too few samples.
+    """
+    return _feedid.read(
+        os.fspath(path),
+        time=None if time is None else str(time),
+        command=None if command is None else str(command),
+        position=None if position is None else str(position),
+        rate=rate,
+        delimiter=delimiter,
+        header=header,
+        unit=unit,
+        scale=scale,
+        time_unit=time_unit,
+        jitter_tol=jitter_tol,
+    )
+
+
+class Identification:
+    """The result of :func:`identify`.
+
+    Attributes
+    ----------
+    time, command, position : numpy.ndarray
+        The recording identified: time [s], command [m], measured position [m].
+    predicted : numpy.ndarray
+        Predicted position per sample [m]; NaN where nothing was predicted
+        (before the first window's horizon, failed or withheld windows).
+    lower, upper : numpy.ndarray
+        Prediction interval per sample [m] (probability ``interval``, 95 %
+        by default); NaN where nothing was predicted.
+    coefficients : numpy.ndarray
+        Per-window coefficients, shape (windows, len(coefficient_names)).
+    coefficient_names : list of str
+        The coefficients' names (the columns of coefficients.csv).
+    window_start, window_end : numpy.ndarray
+        Sample range ``[start, end)`` of each window (int64).
+    window_outcome : list of str
+        What became of each window (``converged``, ``fallback``, ``failed``, ...).
+    simulated : numpy.ndarray
+        The nominal physical model driven by the command [m] (predictions.csv's
+        ``simulated_m``).
+    summary : dict
+        The run's summary with the keys of ``feedid identify --summary``'s
+        summary.json (``rms_error_m``, ``coverage_percent``, ...).
+    model : dict or None
+        The method's global model (as ``--model-out`` writes it), if fitted;
+        usable by :func:`compensate`.
+    warnings : list of str
+        What the user should know about this run (also in the summary).
+    """
+
+    def __init__(self, recording: Recording, parts: Dict[str, Any]):
+        self.recording = recording
+        self.time: np.ndarray = recording.time
+        self.command: np.ndarray = recording.command
+        self.position: np.ndarray = recording.position
+        self.predicted: np.ndarray = parts["predicted"]
+        self.lower: np.ndarray = parts["lower"]
+        self.upper: np.ndarray = parts["upper"]
+        self.coefficients: np.ndarray = parts["coefficients"]
+        self.coefficient_names: List[str] = list(parts["coefficient_names"])
+        self.window_start: np.ndarray = parts["window_start"]
+        self.window_end: np.ndarray = parts["window_end"]
+        self.window_outcome: List[str] = list(parts["window_outcome"])
+        self.simulated: Optional[np.ndarray] = parts["simulated"]
+        self.summary: Dict[str, Any] = json.loads(parts["summary_json"])
+        model_json = parts["model_json"]
+        self.model: Optional[Dict[str, Any]] = (
+            None if model_json is None else json.loads(model_json)
+        )
+        self.warnings: List[str] = list(parts["warnings"])
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return (
+            f"Identification(method={s['method']!r}, samples={s['samples']}, "
+            f"windows={s['windows']}, coverage={s['coverage_percent']:.1f} %, "
+            f"rms_error_m={s['rms_error_m']:.3e})"
+        )
+
+    def to_pandas(self) -> "Any":
+        """The per-sample table as a pandas DataFrame: ``time_s``,
+        ``command_m``, ``measured_m``, ``predicted_m``, ``lower_m``,
+        ``upper_m``, ``simulated_m`` (predictions.csv's columns plus the
+        interval; NaN where empty). Needs pandas."""
+        try:
+            import pandas as pd
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("to_pandas() needs pandas: pip install pandas") from e
+        cols = {
+            "time_s": self.time,
+            "command_m": self.command,
+            "measured_m": self.position,
+            "predicted_m": self.predicted,
+            "lower_m": self.lower,
+            "upper_m": self.upper,
+        }
+        if self.simulated is not None:
+            cols["simulated_m"] = self.simulated
+        return pd.DataFrame(cols)
+
+    def coefficients_to_pandas(self) -> "Any":
+        """The per-window coefficients as a pandas DataFrame (coefficients.csv's
+        content): ``start_s``, ``end_s``, ``outcome`` and one column per name."""
+        import pandas as pd
+
+        t = self.time
+        df = pd.DataFrame(self.coefficients, columns=self.coefficient_names)
+        df.insert(0, "start_s", t[self.window_start] if len(t) else [])
+        df.insert(1, "end_s", t[np.maximum(self.window_end - 1, 0)] if len(t) else [])
+        df.insert(2, "outcome", self.window_outcome)
+        return df
+
+
+def identify(
+    time: Union[Recording, Any],
+    command: Any = None,
+    position: Any = None,
+    method: str = "auto",
+    window: Optional[int] = None,
+    horizon: int = 10,
+    order: Optional[Union[str, Sequence[int]]] = None,
+    *,
+    hop: Optional[int] = None,
+    params: Params = None,
+    allow_unstable: bool = False,
+    jitter_tol: float = 0.01,
+    nominal: bool = True,
+    global_model: bool = True,
+    residuals: bool = True,
+    interval: float = 95.0,
+    **options: Any,
+) -> Identification:
+    """Identify a recording in short sliding windows and predict the next
+    samples, as ``feedid identify`` does (same defaults, same numbers).
+
+    Call as ``identify(recording, ...)`` or ``identify(time, command, position, ...)``.
+
+    Parameters
+    ----------
+    time : Recording or array_like
+        A :class:`Recording`, or the sample times [s] (strictly increasing,
+        uniformly sampled within ``jitter_tol``).
+    command, position : array_like
+        Position command [m] and measured position [m] (with ``time`` as
+        arrays). Contiguous float64 arrays are read in place; the library
+        keeps one checked copy of the three.
+    method : str
+        ``auto`` (default), ``arx``, ``rls``, ``oe``, ``paper``.
+    window : int, optional
+        Window length W [samples]; default: the method's own (as the CLI).
+    horizon : int
+        Prediction horizon H [samples]; default 10 (2 ms at 5 kHz).
+    order : str or (na, nb, nk), optional
+        ARX orders of arx, rls, auto (``"8,8,1"`` or ``(8, 8, 1)``), or
+        ``"auto"`` to choose them from the recording by BIC.
+    hop : int, optional
+        Shift between windows [samples]; default the horizon.
+    params : path or dict, optional
+        Rig parameters (a rig.toml, or a dict of its sections) of the nominal
+        model simulated beside the predictions; default the built-in rig.
+    allow_unstable : bool
+        Use an unstable nominal model anyway (default False: refused).
+    jitter_tol : float
+        Sampling jitter tolerance of arrays (relative; default 0.01).
+    nominal, global_model, residuals : bool
+        What ``feedid identify`` computes beside the sliding predictions
+        (default True, all three): the nominal model's simulation (the
+        summary's ``sim_*`` and ``nominal_fit_percent``, ``simulated``), the
+        method's global model and its free-run fit (``global_model``,
+        ``global_fit_percent``, ``model``), the residual analysis
+        (``residuals``). On long recordings they cost several times the
+        sliding identification (README, "Python"): False leaves them out
+        and their keys out of the summary.
+    interval : float
+        Probability of the prediction intervals ``lower``/``upper`` [%],
+        in (0, 100); default 95 (``--interval``).
+    **options
+        Method options: ``solver``, ``time_origin``, ``prediction``,
+        ``simplex_start`` (paper), ``lambda`` (rls forgetting factor),
+        ``ridge`` (arx, auto: ridge of the least squares).
+
+    Returns
+    -------
+    Identification
+        ``predicted``, ``lower``, ``upper`` [m] (NaN where nothing was
+        predicted), ``coefficients`` (windows × names), ``summary`` (dict,
+        summary.json's keys), ``to_pandas()``.
+
+    The identification runs with the GIL released: threads identifying
+    several recordings run in parallel.
+    """
+    if isinstance(time, Recording):
+        if command is not None or position is not None:
+            raise TypeError("identify(recording, ...) takes no command or position arrays")
+        rec = time
+    else:
+        if command is None or position is None:
+            raise TypeError("identify(time, command, position, ...) needs all three arrays")
+        rec = Recording(
+            _array(time, "time"),
+            _array(command, "command"),
+            _array(position, "position"),
+            jitter_tol=jitter_tol,
+        )
+    parts = _feedid.identify(
+        rec,
+        method=method,
+        window=window,
+        horizon=horizon,
+        hop=hop,
+        allow_unstable=allow_unstable,
+        nominal=nominal,
+        global_model=global_model,
+        residuals=residuals,
+        interval=interval,
+        **_params(params),
+        **_method_options(order, options),
+    )
+    return Identification(rec, parts)
+
+
+class Streamer:
+    """Streaming identification: push one line ``(t, u, y)`` at a time and
+    get each window's prediction of the next ``horizon`` samples as soon as
+    it is due (``feedid stream`` as a library call).
+
+    Parameters
+    ----------
+    rate : float, optional
+        Sampling rate [Hz]; with it the intervals are exact (a skipped line
+        is a gap). Default: the running mean interval.
+    method : str
+        ``auto`` (default), ``arx``, ``rls``, ``oe``, ``paper``.
+    window : int, optional
+        Window length W [samples]; default the method's own.
+    horizon : int
+        Prediction horizon H [samples]; default 10.
+    hop : int, optional
+        Shift between windows [samples]; default the horizon.
+    command_lead : int
+        The command on each pushed line belongs to the sample this many
+        lines later (a CNC interpolator runs ahead); default 0.
+    extrapolate : str, optional
+        How the command over a horizon not yet received is filled: ``hold``,
+        ``velocity``, ``acceleration`` (default) or ``wait`` (each window
+        waits for its command: the predictions then equal :func:`identify`'s).
+    jitter_tol : float
+        Relative interval deviation reported as irregular (default 0.01).
+    order : str or (na, nb, nk), optional
+        ARX orders (``"auto"`` is refused: a stream needs them given).
+    interval : float
+        Probability of the prediction intervals [%]; default 95.
+    **options
+        Method options as for :func:`identify`.
+
+    ``push`` and ``finish`` return lists of ``(time [s], predicted [m],
+    lower [m], upper [m])``.
+    """
+
+    def __init__(
+        self,
+        rate: Optional[float] = None,
+        method: str = "auto",
+        window: Optional[int] = None,
+        horizon: int = 10,
+        command_lead: int = 0,
+        *,
+        hop: Optional[int] = None,
+        extrapolate: Optional[str] = None,
+        jitter_tol: float = 0.01,
+        order: Optional[Union[str, Sequence[int]]] = None,
+        interval: float = 95.0,
+        **options: Any,
+    ):
+        self._s = _feedid.Streamer(
+            interval=interval,
+            rate=rate,
+            method=method,
+            window=window,
+            horizon=horizon,
+            hop=hop,
+            command_lead=command_lead,
+            extrapolate=extrapolate,
+            jitter_tol=jitter_tol,
+            **_method_options(order, options),
+        )
+
+    def push(self, t: float, u: float, y: float) -> List[Tuple[float, float, float, float]]:
+        """Push one line: time ``t`` [s], command ``u`` [m] (of the sample
+        ``command_lead`` lines later), measured position ``y`` [m]. Returns
+        the predictions that became due. A time not after the previous one
+        raises :class:`InputError` (nothing is stored)."""
+        return self._s.push(float(t), float(u), float(y))
+
+    def push_many(
+        self, t: Any, u: Any, y: Any
+    ) -> List[Tuple[float, float, float, float]]:
+        """Push many lines at once (equal-length arrays; GIL released);
+        returns the predictions that became due, in order."""
+        return self._s.push_many(_array(t, "t"), _array(u, "u"), _array(y, "y"))
+
+    def finish(self) -> List[Tuple[float, float, float, float]]:
+        """End of the input: the predictions still due."""
+        return self._s.finish()
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        """Counters and scores so far: lines, samples, windows,
+        predicted_ahead, predicted_late, gaps, rms_error_m (None before any
+        sample was scored), hold_rms_error_m (the hold baseline on the same
+        samples), interval_coverage_percent, outliers, ..."""
+        return self._s.stats
+
+    @property
+    def dt(self) -> Optional[float]:
+        """The sampling interval in use [s] (None before two samples)."""
+        return self._s.dt
+
+
+def simulate(
+    scenario: str,
+    seed: int = 1,
+    duration: Optional[float] = None,
+    rate: float = 5000.0,
+    params: Params = None,
+    linear: bool = False,
+    *,
+    effects: Optional[PathLike] = None,
+    allow_unstable: bool = False,
+) -> Recording:
+    """Simulate a test command on the nonlinear virtual rig (``feedid simulate``).
+
+    Parameters
+    ----------
+    scenario : str
+        ``ramp``, ``step``, ``scurve``, ``chirp``, ``prbs``, ``multisine``.
+    seed : int
+        Random seed of the command and the measurement noise (default 1;
+        ``feedid simulate``'s is 0: give it to compare).
+    duration : float, optional
+        Duration [s]; default the scenario's own.
+    rate : float
+        Sampling rate [Hz]; default 5000.
+    params : path or dict, optional
+        Rig parameters (rig.toml or a dict of its sections); default the
+        built-in rig.
+    linear : bool
+        Without friction, limits, quantisation and noise (default False).
+    effects : path, optional
+        An effects.toml (friction law, limits, noise); not with ``linear``.
+    allow_unstable : bool
+        Simulate an unstable parameter set anyway (default False: refused).
+
+    Returns
+    -------
+    Recording
+        time [s], command [m], measured position [m], and the channels
+        ``true_position`` [m], ``current`` [A], ``velocity`` [m/s]
+        (``rec.true_position`` ...).
+    """
+    return _feedid.simulate(
+        scenario,
+        seed=seed,
+        duration=duration,
+        rate=rate,
+        linear=linear,
+        effects=None if effects is None else os.fspath(effects),
+        allow_unstable=allow_unstable,
+        **_params(params),
+    )
+
+
+def model(params: Params = None, d1: str = "corrected") -> Dict[str, Any]:
+    """The nominal model in numbers, as ``feedid model --json``: transfer
+    function coefficients, poles [rad/s], damping, bandwidth, steady-state
+    errors.
+
+    ``params``: rig.toml path or dict (default the built-in rig); ``d1``:
+    ``corrected`` (default) or ``paper`` (the paper's printed D1).
+    """
+    return json.loads(_feedid.model(d1=d1, **_params(params)))
+
+
+def compensate(
+    time: Any,
+    desired: Any,
+    model: Union[None, "Identification", Mapping[str, Any], PathLike] = None,
+    *,
+    position_loop: str = "sampled",
+    smooth: Union[None, float, str] = None,
+    max_smoothing: float = 0.02,
+    max_velocity: float = 1.0,
+    max_acceleration: float = 30.0,
+    keep_dc_gain: bool = False,
+    allow_unstable: bool = False,
+) -> Dict[str, Any]:
+    """The command that makes a model follow the desired trajectory
+    (``feedid compensate``).
+
+    Parameters
+    ----------
+    time, desired : array_like
+        Time [s] and desired position [m].
+    model
+        An :class:`Identification` (its global model), a model dict or
+        model.json path (``feedid identify --model-out``), a rig.toml path or
+        parameter dict (the physical model), or None (the built-in rig).
+    position_loop : str
+        Physical model only: ``sampled`` (default) or ``continuous``.
+    smooth : float or "auto", optional
+        Gaussian smoothing σ [s] of the desired trajectory; default auto (the
+        smallest that keeps the limits).
+    max_smoothing : float
+        Largest automatic σ [s]; default 0.02.
+    max_velocity, max_acceleration : float
+        Command limits [m/s], [m/s²]; defaults 1.0 and 30.0.
+    keep_dc_gain : bool
+        Keep the model's DC gain (default False: scaled to 1).
+
+    Returns
+    -------
+    dict
+        ``command`` [m] and ``predicted`` [m] (NumPy), and the summary's
+        keys (``predicted_error``, ``smoothing_s``, ``peak_velocity``, ...).
+    """
+    kw: Dict[str, Any] = {}
+    if isinstance(model, Identification):
+        if model.model is None:
+            raise InputError("this identification has no global model to compensate with")
+        kw["model_json"] = json.dumps(model.model)
+    elif isinstance(model, Mapping):
+        if "model" in model:
+            kw["model_json"] = json.dumps(dict(model))
+        else:
+            kw.update(_params(model))
+    elif model is not None:
+        path = os.fspath(model)
+        if path.lower().endswith(".toml"):
+            kw["params_path"] = path
+        else:
+            kw["model_path"] = path
+    if isinstance(smooth, str):
+        if smooth.strip() != "auto":
+            raise InputError(f"invalid smooth `{smooth}`: expected a time in seconds or auto")
+        smooth = None
+    command, predicted, summary = _feedid.compensate(
+        _array(time, "time"),
+        _array(desired, "desired"),
+        position_loop=position_loop,
+        smooth=smooth,
+        max_smoothing=max_smoothing,
+        max_velocity=max_velocity,
+        max_acceleration=max_acceleration,
+        keep_dc_gain=keep_dc_gain,
+        allow_unstable=allow_unstable,
+        **kw,
+    )
+    out: Dict[str, Any] = json.loads(summary)
+    out["command"] = command
+    out["predicted"] = predicted
+    return out

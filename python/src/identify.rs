@@ -1,0 +1,123 @@
+//! `feedid._feedid.identify`: one library pipeline run
+//! ([`feedid::pipeline::Pipeline`], as `feedid identify` makes it: the
+//! nominal rig simulated beside the predictions, the method's global model
+//! fitted for the summary) with the GIL released, its arrays handed to NumPy
+//! without copies.
+
+use feedid::ident::{OrderSearch, RESIDUAL_LAGS};
+use feedid::pipeline::Pipeline;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::IntoPy;
+use crate::method::{MethodOptions, OrderOption};
+use crate::recording::PyRecording;
+
+/// Identify a recording; returns the parts of an `Identification` as a dict
+/// (`predicted`, `lower`, `upper` with NaN where nothing was predicted,
+/// `coefficients` windows × names, `coefficient_names`, `window_start`,
+/// `window_end`, `window_outcome`, `simulated`, `summary_json`,
+/// `model_json`, `warnings`).
+#[pyfunction]
+#[pyo3(signature = (recording, *, method = "auto", window = None, horizon = 10, hop = None,
+    order = None, solver = None, time_origin = None, prediction = None, simplex_start = None, lambda_ = None,
+    ridge = None, interval = 95.0, params_path = None, params_json = None, allow_unstable = false,
+    nominal = true, global_model = true, residuals = true))]
+#[allow(clippy::too_many_arguments)]
+pub fn identify<'py>(
+    py: Python<'py>,
+    recording: &Bound<'py, PyRecording>,
+    method: &str,
+    window: Option<usize>,
+    horizon: usize,
+    hop: Option<usize>,
+    order: Option<String>,
+    solver: Option<String>,
+    time_origin: Option<String>,
+    prediction: Option<String>,
+    simplex_start: Option<String>,
+    lambda_: Option<f64>,
+    ridge: Option<f64>,
+    interval: f64,
+    params_path: Option<String>,
+    params_json: Option<String>,
+    allow_unstable: bool,
+    nominal: bool,
+    global_model: bool,
+    residuals: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let options = MethodOptions {
+        order,
+        solver,
+        time_origin,
+        prediction,
+        simplex_start,
+        lambda: lambda_,
+        ridge,
+    };
+    let method = options.method(method)?;
+    let interval = crate::method::interval(interval)?;
+    let select = matches!(options.order_option()?, Some(OrderOption::Select));
+    let params = crate::params::load(
+        params_path.as_deref(),
+        params_json.as_deref(),
+        allow_unstable,
+    )?;
+    let rec = &recording.get().inner;
+    let run = py
+        .detach(move || {
+            let mut pipeline = Pipeline::new(method)
+                .window_or_default(window)
+                .horizon(horizon)
+                .hop(hop)
+                .interval(interval)
+                .method_global_model(global_model)
+                .residuals(if residuals { Some(RESIDUAL_LAGS) } else { None });
+            if nominal {
+                pipeline = pipeline.nominal(params);
+            }
+            if select {
+                pipeline = pipeline.select_orders(OrderSearch::default());
+            }
+            pipeline.run(rec)
+        })
+        .py_err()?;
+    let summary = run.summary();
+    let summary_json = serde_json::to_string(&summary)
+        .map_err(|e| crate::errors::input(format!("summary: {e}")))?;
+    let s = run.sliding;
+    let (mut predicted, mut lower, mut upper) = (s.predicted, s.lower, s.upper);
+    for (k, &has) in s.has_prediction.iter().enumerate() {
+        if !has {
+            for v in [&mut predicted, &mut lower, &mut upper] {
+                if let Some(x) = v.get_mut(k) {
+                    *x = f64::NAN;
+                }
+            }
+        }
+    }
+    let nc = s.coefficient_names.len();
+    let nw = s.windows.len();
+    let coefficients = PyArray1::from_vec(py, s.coefficients).reshape([nw, nc])?;
+    let d = PyDict::new(py);
+    d.set_item("predicted", PyArray1::from_vec(py, predicted))?;
+    d.set_item("lower", PyArray1::from_vec(py, lower))?;
+    d.set_item("upper", PyArray1::from_vec(py, upper))?;
+    d.set_item("coefficients", coefficients)?;
+    d.set_item("coefficient_names", s.coefficient_names)?;
+    let starts: Vec<i64> = s.windows.iter().map(|w| w.window.start as i64).collect();
+    let ends: Vec<i64> = s.windows.iter().map(|w| w.window.end as i64).collect();
+    let outcomes: Vec<&str> = s.windows.iter().map(|w| w.outcome.label()).collect();
+    d.set_item("window_start", PyArray1::from_vec(py, starts))?;
+    d.set_item("window_end", PyArray1::from_vec(py, ends))?;
+    d.set_item("window_outcome", outcomes)?;
+    d.set_item(
+        "simulated",
+        run.simulated.map(|v| PyArray1::from_vec(py, v)),
+    )?;
+    d.set_item("summary_json", summary_json)?;
+    d.set_item("model_json", run.global.map(|g| g.to_json()))?;
+    d.set_item("warnings", summary.warnings)?;
+    Ok(d)
+}

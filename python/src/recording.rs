@@ -189,6 +189,8 @@ pub fn read(
         scale,
         time_unit: time_unit.parse().py_err()?,
         jitter_tolerance: jitter_tol,
+        // the Python recording exposes the extra channels
+        signals_only: false,
     };
     opts.validate().py_err()?;
     let path = std::path::PathBuf::from(path);

@@ -386,6 +386,20 @@ fn emps_benchmark_reads_with_plausible_ranges() {
     assert!((r.rate_hz() - 1000.0).abs() < 0.05, "{}", r.rate_hz());
     assert!((r.duration() - 24.84).abs() < 1e-9);
     assert_eq!(r.extra().len(), 1); // vir
+                                    // the columnar read of `feedid identify`: the same signals, no `vir`
+    let only = read_recording(
+        &path,
+        &ReadOptions {
+            signals_only: true,
+            ..mat_opts()
+        },
+    )
+    .unwrap();
+    assert!(only.extra().is_empty());
+    assert_eq!(
+        (only.time(), only.command(), only.position()),
+        (r.time(), r.command(), r.position())
+    );
     let info = recording_info(&r);
     let (c, p) = (&info.channels[0], &info.channels[1]);
     // A prismatic axis of a few tens of cm; measured close to the reference.

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
-use feedid::io::{read_recording, ChannelRef, ReadOptions};
+use feedid::io::{read_recording, read_recording_with_progress, ChannelRef, ReadOptions};
 use feedid::plausibility::check_recording;
 use feedid::Recording;
 
@@ -43,15 +43,26 @@ pub fn read_options(a: &RecordingArgs) -> Result<ReadOptions> {
         scale: a.scale,
         time_unit: a.time_unit.parse()?,
         jitter_tolerance: a.jitter_tol,
+        signals_only: false,
     };
     opts.validate()?;
     Ok(opts)
 }
 
-/// Read and check a recording, without printing its plausibility warnings
-/// (for commands whose library call reports them, as the pipeline does).
-pub fn read(path: &Path, a: &RecordingArgs) -> Result<Recording> {
-    Ok(read_recording(path, &read_options(a)?)?)
+/// Read and check the time, command and position only (no extra channels:
+/// three `f64` per sample in memory), reporting `progress(bytes read, file size)`,
+/// without printing its plausibility warnings (for commands whose library
+/// call reports them, as the pipeline does).
+pub fn read_signals(
+    path: &Path,
+    a: &RecordingArgs,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<Recording> {
+    let opts = ReadOptions {
+        signals_only: true,
+        ..read_options(a)?
+    };
+    Ok(read_recording_with_progress(path, &opts, Some(progress))?)
 }
 
 /// Read and check a recording; its plausibility warnings go to standard error.

@@ -225,7 +225,7 @@ pub fn read_mat_from_bytes(bytes: &[u8], source: &Path, opts: &ReadOptions) -> R
     })?;
 
     // Other real vectors of the same length become extra channels (unscaled).
-    for v in &vars {
+    for v in vars.iter().filter(|_| !opts.signals_only) {
         let name = v.info.name.as_str();
         let used = Some(name) == time_name.as_deref() || name == cmd_name || name == pos_name;
         if used || !v.info.supported || !v.info.is_vector() {

@@ -31,7 +31,10 @@ pub use self::output::{
     abandon_pending_outputs, destination, pending_output_count, write_atomic, write_string_atomic,
     Destination, OutputSet,
 };
-pub use self::read::{read_recording, read_recording_from_bytes};
+pub use self::read::{
+    read_recording, read_recording_from_bytes, read_recording_with_progress, ReadProgress,
+    READ_PROGRESS_BYTES,
+};
 pub use self::source::{read_small_text, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES};
 pub use self::stream::{
     PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,

@@ -226,6 +226,12 @@ pub struct ReadOptions {
     pub time_unit: TimeUnit,
     /// Allowed relative deviation of a sampling interval from the mean one. Default: 0.01.
     pub jitter_tolerance: f64,
+    /// Read only the time, command and position columns (variables), the
+    /// columnar read of `feedid identify`: no extra channels
+    /// ([`crate::Recording::extra`] stays empty), so a recording holds three
+    /// `f64` per sample whatever the file's width. Default: false (every
+    /// other all-numeric column or vector is kept as an extra channel).
+    pub signals_only: bool,
 }
 
 impl Default for ReadOptions {
@@ -241,6 +247,7 @@ impl Default for ReadOptions {
             scale: None,
             time_unit: TimeUnit::S,
             jitter_tolerance: DEFAULT_JITTER_TOLERANCE,
+            signals_only: false,
         }
     }
 }

@@ -45,22 +45,39 @@ pub fn write_predictions_csv(
         "time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m"
     )?;
     let at = |v: &[f64], k: usize| v.get(k).copied();
+    // one row formatted into a reused buffer, then written whole (no
+    // allocation per cell: 18 M rows for an hour at 5 kHz)
+    let mut row = String::with_capacity(128);
     for (k, t) in time.iter().enumerate() {
         let has = predictions.has_prediction.get(k) == Some(&true);
         let pick = |v: &[f64]| if has { at(v, k) } else { None };
-        writeln!(
-            w,
-            "{},{},{},{},{},{},{}",
-            cell(Some(*t)),
-            cell(at(command, k)),
-            cell(at(measured, k)),
-            cell(pick(predictions.predicted)),
-            cell(pick(predictions.lower)),
-            cell(pick(predictions.upper)),
-            cell(simulated.and_then(|s| at(s, k))),
-        )?;
+        row.clear();
+        push_cell(&mut row, Some(*t));
+        row.push(',');
+        push_cell(&mut row, at(command, k));
+        row.push(',');
+        push_cell(&mut row, at(measured, k));
+        row.push(',');
+        push_cell(&mut row, pick(predictions.predicted));
+        row.push(',');
+        push_cell(&mut row, pick(predictions.lower));
+        row.push(',');
+        push_cell(&mut row, pick(predictions.upper));
+        row.push(',');
+        push_cell(&mut row, simulated.and_then(|s| at(s, k)));
+        row.push('\n');
+        w.write_all(row.as_bytes())?;
     }
     Ok(())
+}
+
+/// Append [`cell`]`(v)` to `out` without allocating.
+fn push_cell(out: &mut String, v: Option<f64>) {
+    use std::fmt::Write as _;
+    if let Some(x) = v.filter(|x| x.is_finite()) {
+        // writing to a String cannot fail
+        let _ = write!(out, "{x}");
+    }
 }
 
 /// One window's row of the coefficients table.
@@ -151,6 +168,41 @@ mod tests {
             "time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m\n\
              0,1,1,,,,1\n0.5,2,2,2.5,2.25,2.75,\n1,3,3,,1,2,3\n"
         );
+    }
+
+    #[test]
+    fn predictions_rows_are_the_cells_of_the_row_by_row_format() {
+        // the buffered writer gives exactly `cell` joined by commas
+        let vals = [0.1, -2.5e-7, 1e300, 3.0, f64::NAN, 1.0 / 3.0, -0.0, 5e-324];
+        let n = vals.len();
+        let rot = |s: usize| -> Vec<f64> { (0..n).map(|k| vals[(k + s) % n]).collect() };
+        let (t, u, y, p, sim) = (rot(0), rot(1), rot(2), rot(3), rot(4));
+        let (lo, hi) = (rot(5), rot(6));
+        let has: Vec<bool> = (0..n).map(|k| k % 3 != 0).collect();
+        let mut out = Vec::new();
+        let cols = PredictionColumns {
+            predicted: &p,
+            lower: &lo,
+            upper: &hi,
+            has_prediction: &has,
+        };
+        write_predictions_csv(&mut out, &t, &u, &y, cols, Some(&sim)).unwrap();
+        let mut expect =
+            String::from("time_s,command_m,measured_m,predicted_m,lower_m,upper_m,simulated_m\n");
+        for k in 0..n {
+            let pick = |v: &[f64]| if has[k] { Some(v[k]) } else { None };
+            expect.push_str(&format!(
+                "{},{},{},{},{},{},{}\n",
+                cell(Some(t[k])),
+                cell(Some(u[k])),
+                cell(Some(y[k])),
+                cell(pick(&p)),
+                cell(pick(&lo)),
+                cell(pick(&hi)),
+                cell(Some(sim[k]))
+            ));
+        }
+        assert_eq!(String::from_utf8(out).unwrap(), expect);
     }
 
     #[test]

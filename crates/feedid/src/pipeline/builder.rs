@@ -122,9 +122,11 @@ impl<'a> Pipeline<'a> {
         self
     }
 
-    /// Fit the method's global model ([`Method::global_model`]) for the
-    /// summary's free-run fit; default true. A model that cannot be fitted
-    /// is a note in the summary, not an error.
+    /// Fit the method's global model ([`Method::global_model`], with `auto`
+    /// its least-squares candidate arx 8,8,1: [`GlobalModelKind::for_summary`])
+    /// on the first [`crate::ident::GLOBAL_FIT_SAMPLES`] samples at most, for
+    /// the summary's free-run fit; default true. A model that cannot be
+    /// fitted is a note in the summary, not an error.
     pub fn method_global_model(mut self, fit: bool) -> Self {
         self.method_global_model = fit;
         self
@@ -320,7 +322,10 @@ impl<'a> Pipeline<'a> {
             )
         });
 
-        let method_kind = method.global_model().filter(|_| self.method_global_model);
+        let method_kind = method
+            .global_model()
+            .map(GlobalModelKind::for_summary)
+            .filter(|_| self.method_global_model);
         let (global, global_note) = match &method_kind {
             None => (None, None),
             Some(kind) => match fit_global_model(recording, kind) {
@@ -446,6 +451,43 @@ mod tests {
         assert!(s
             .to_string()
             .contains("global model of the method (arx 3,3,0)"));
+    }
+
+    #[test]
+    fn the_summary_of_auto_fits_arx_on_a_stated_share_and_extra_auto_compares_all() {
+        let rec = ramp();
+        let run = Pipeline::new(Method::default())
+            .extra_model(GlobalModelKind::Auto)
+            .run(&rec)
+            .unwrap();
+        let s = run.summary();
+        assert_eq!(s.global_model.as_deref(), Some("arx 8,8,1"));
+        assert_eq!(s.global_model_samples, Some(rec.len()));
+        let text = s.to_string();
+        assert!(
+            text.contains(&format!(
+                "global model of the method (arx 8,8,1): free-run fit {:.3} % on all {} samples",
+                s.global_fit_percent.unwrap(),
+                rec.len()
+            )),
+            "{text}"
+        );
+        let json = serde_json::to_value(&s).unwrap();
+        assert_eq!(json["global_model_samples"], rec.len());
+        // the summary's model is the one fit_global_model gives for arx 8,8,1
+        let arx = fit_global_model(&rec, &GlobalModelKind::Auto.for_summary()).unwrap();
+        assert_eq!(run.global.as_ref(), Some(&arx));
+        // --model-out auto still compares the three candidates
+        let prov = run.model.as_ref().unwrap().identified_by.as_ref().unwrap();
+        assert_eq!(prov.candidates.len(), 3, "{:?}", prov.candidates);
+        // a share below 100 % is printed as such
+        let mut part = s.clone();
+        (part.samples, part.global_model_samples) = (1000, Some(250));
+        assert!(
+            part.to_string()
+                .contains("on the first 250 samples (25.0 %)"),
+            "{part}"
+        );
     }
 
     #[test]

@@ -96,6 +96,11 @@ impl Identification {
                 .as_ref()
                 .and_then(|g| g.identified_by.as_ref())
                 .map(|p| format!("{} {}", p.method, p.orders)),
+            global_model_samples: self
+                .global
+                .as_ref()
+                .and_then(|g| g.identified_by.as_ref())
+                .map(|p| p.samples),
             sim_rms_error_m: self
                 .simulation_stats
                 .map(|x| x.rms)

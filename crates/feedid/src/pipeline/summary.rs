@@ -67,6 +67,11 @@ pub struct IdentifySummary {
     /// Structure of the global model (e.g. `"arx 8,8,1"`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub global_model: Option<String>,
+    /// Samples the global model was fitted and simulated on: the first
+    /// ones of the recording, at most [`crate::ident::GLOBAL_FIT_SAMPLES`]
+    /// (`sim_fit_percent` covers these only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub global_model_samples: Option<usize>,
     /// RMS error of the nominal simulation model over the predicted samples \[m\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sim_rms_error_m: Option<f64>,
@@ -172,9 +177,17 @@ impl fmt::Display for IdentifySummary {
             )?;
         }
         if let (Some(m), Some(fit)) = (&self.global_model, self.global_fit_percent) {
+            let share = match self.global_model_samples {
+                Some(n) if n < self.samples => format!(
+                    " on the first {n} samples ({:.1} %)",
+                    100.0 * n as f64 / self.samples as f64
+                ),
+                Some(n) => format!(" on all {n} samples"),
+                None => String::new(),
+            };
             writeln!(
                 f,
-                "  global model of the method ({m}): free-run fit {fit:.3} %"
+                "  global model of the method ({m}): free-run fit {fit:.3} %{share}"
             )?;
         }
         if let Some(n) = &self.global_note {

@@ -195,6 +195,9 @@ class Identification:
         The coefficients' names (the columns of coefficients.csv).
     window_start, window_end : numpy.ndarray
         Sample range ``[start, end)`` of each window (int64).
+    recording : Recording
+        The recording identified (with arrays given to :func:`identify`, a
+        checked copy made on first use).
     window_outcome : list of str
         What became of each window (``converged``, ``fallback``, ``failed``, ...).
     simulated : numpy.ndarray
@@ -210,11 +213,20 @@ class Identification:
         What the user should know about this run (also in the summary).
     """
 
-    def __init__(self, recording: Recording, parts: Dict[str, Any]):
-        self.recording = recording
-        self.time: np.ndarray = recording.time
-        self.command: np.ndarray = recording.command
-        self.position: np.ndarray = recording.position
+    def __init__(
+        self,
+        recording: Optional[Recording],
+        parts: Dict[str, Any],
+        data: Optional[Dict[str, Any]] = None,
+        jitter_tol: float = 0.01,
+    ):
+        self._recording = recording
+        self._jitter_tol = jitter_tol
+        src: Any = recording if recording is not None else data
+        get = (lambda k: getattr(src, k)) if recording is not None else (lambda k: src[k])
+        self.time: np.ndarray = get("time")
+        self.command: np.ndarray = get("command")
+        self.position: np.ndarray = get("position")
         self.predicted: np.ndarray = parts["predicted"]
         self.lower: np.ndarray = parts["lower"]
         self.upper: np.ndarray = parts["upper"]
@@ -231,12 +243,23 @@ class Identification:
         )
         self.warnings: List[str] = list(parts["warnings"])
 
+    @property
+    def recording(self) -> Recording:
+        """The recording identified (built on first use from the arrays
+        ``identify`` was given, a checked copy of them)."""
+        if self._recording is None:
+            self._recording = Recording(
+                self.time, self.command, self.position, jitter_tol=self._jitter_tol
+            )
+        return self._recording
+
     def __repr__(self) -> str:
         s = self.summary
+        rms = s.get("rms_error_m")
         return (
             f"Identification(method={s['method']!r}, samples={s['samples']}, "
             f"windows={s['windows']}, coverage={s['coverage_percent']:.1f} %, "
-            f"rms_error_m={s['rms_error_m']:.3e})"
+            f"rms_error_m={'none' if rms is None else format(rms, '.3e')})"
         )
 
     def to_pandas(self) -> "Any":
@@ -304,8 +327,9 @@ def identify(
         uniformly sampled within ``jitter_tol``).
     command, position : array_like
         Position command [m] and measured position [m] (with ``time`` as
-        arrays). Contiguous float64 arrays are read in place; the library
-        keeps one checked copy of the three.
+        arrays). Contiguous float64 arrays are checked and read in place,
+        not copied (others are converted first); do not change them while
+        ``identify`` runs.
     method : str
         ``auto`` (default), ``arx``, ``rls``, ``oe``, ``paper``.
     window : int, optional
@@ -354,18 +378,20 @@ def identify(
     if isinstance(time, Recording):
         if command is not None or position is not None:
             raise TypeError("identify(recording, ...) takes no command or position arrays")
-        rec = time
+        rec: Optional[Recording] = time
+        data: Dict[str, Any] = {"recording": time}
     else:
         if command is None or position is None:
             raise TypeError("identify(time, command, position, ...) needs all three arrays")
-        rec = Recording(
-            _array(time, "time"),
-            _array(command, "command"),
-            _array(position, "position"),
-            jitter_tol=jitter_tol,
-        )
+        rec = None
+        data = {
+            "time": _array(time, "time"),
+            "command": _array(command, "command"),
+            "position": _array(position, "position"),
+            "jitter_tol": jitter_tol,
+        }
     parts = _feedid.identify(
-        rec,
+        **data,
         method=method,
         window=window,
         horizon=horizon,
@@ -378,7 +404,7 @@ def identify(
         **_params(params),
         **_method_options(order, options),
     )
-    return Identification(rec, parts)
+    return Identification(rec, parts, data, jitter_tol)
 
 
 class Streamer:

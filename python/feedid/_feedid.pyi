@@ -95,8 +95,12 @@ def read(
     jitter_tol: float = 0.01,
 ) -> Recording: ...
 def identify(
-    recording: Recording,
+    recording: Optional[Recording] = None,
     *,
+    time: Optional[npt.NDArray[np.float64]] = None,
+    command: Optional[npt.NDArray[np.float64]] = None,
+    position: Optional[npt.NDArray[np.float64]] = None,
+    jitter_tol: float = 0.01,
     method: str = "auto",
     window: Optional[int] = None,
     horizon: int = 10,

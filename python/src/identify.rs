@@ -1,33 +1,43 @@
 //! `feedid._feedid.identify`: one library pipeline run
 //! ([`feedid::pipeline::Pipeline`], as `feedid identify` makes it: the
 //! nominal rig simulated beside the predictions, the method's global model
-//! fitted for the summary) with the GIL released, its arrays handed to NumPy
-//! without copies.
+//! fitted for the summary) with the GIL released, reading NumPy arrays in
+//! place (a borrowed, checked [`feedid::RecordingRef`]) and handing its
+//! arrays to NumPy without copies.
 
 use feedid::ident::{OrderSearch, RESIDUAL_LAGS};
 use feedid::pipeline::Pipeline;
-use numpy::{PyArray1, PyArrayMethods};
+use feedid::RecordingRef;
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::IntoPy;
 use crate::method::{MethodOptions, OrderOption};
-use crate::recording::PyRecording;
+use crate::recording::{slice, PyRecording};
 
-/// Identify a recording; returns the parts of an `Identification` as a dict
+/// Identify a `recording`, or `time` [s], `command` [m] and `position` [m]
+/// given as contiguous float64 arrays (checked with `jitter_tol`, read in
+/// place: not copied); returns the parts of an `Identification` as a dict
 /// (`predicted`, `lower`, `upper` with NaN where nothing was predicted,
 /// `coefficients` windows × names, `coefficient_names`, `window_start`,
 /// `window_end`, `window_outcome`, `simulated`, `summary_json`,
 /// `model_json`, `warnings`).
 #[pyfunction]
-#[pyo3(signature = (recording, *, method = "auto", window = None, horizon = 10, hop = None,
+#[pyo3(signature = (recording = None, *, time = None, command = None, position = None,
+    jitter_tol = 0.01, method = "auto", window = None, horizon = 10, hop = None,
     order = None, solver = None, time_origin = None, prediction = None, simplex_start = None, lambda_ = None,
     ridge = None, interval = 95.0, params_path = None, params_json = None, allow_unstable = false,
     nominal = true, global_model = true, residuals = true))]
 #[allow(clippy::too_many_arguments)]
 pub fn identify<'py>(
     py: Python<'py>,
-    recording: &Bound<'py, PyRecording>,
+    recording: Option<&Bound<'py, PyRecording>>,
+    time: Option<PyReadonlyArray1<'py, f64>>,
+    command: Option<PyReadonlyArray1<'py, f64>>,
+    position: Option<PyReadonlyArray1<'py, f64>>,
+    jitter_tol: f64,
     method: &str,
     window: Option<usize>,
     horizon: usize,
@@ -64,25 +74,42 @@ pub fn identify<'py>(
         params_json.as_deref(),
         allow_unstable,
     )?;
-    let rec = &recording.get().inner;
-    let run = py
-        .detach(move || {
-            let mut pipeline = Pipeline::new(method)
-                .window_or_default(window)
-                .horizon(horizon)
-                .hop(hop)
-                .interval(interval)
-                .method_global_model(global_model)
-                .residuals(if residuals { Some(RESIDUAL_LAGS) } else { None });
-            if nominal {
-                pipeline = pipeline.nominal(params);
-            }
-            if select {
-                pipeline = pipeline.select_orders(OrderSearch::default());
-            }
-            pipeline.run(rec)
-        })
-        .py_err()?;
+    let mut pipeline = Pipeline::new(method)
+        .window_or_default(window)
+        .horizon(horizon)
+        .hop(hop)
+        .interval(interval)
+        .method_global_model(global_model)
+        .residuals(if residuals { Some(RESIDUAL_LAGS) } else { None });
+    if nominal {
+        pipeline = pipeline.nominal(params);
+    }
+    if select {
+        pipeline = pipeline.select_orders(OrderSearch::default());
+    }
+    let run = match (recording, time, command, position) {
+        (Some(rec), None, None, None) => {
+            let rec = &rec.get().inner;
+            py.detach(|| pipeline.run(rec))
+        }
+        (None, Some(t), Some(u), Some(y)) => {
+            let (t, u, y) = (
+                slice(&t, "time")?,
+                slice(&u, "command")?,
+                slice(&y, "position")?,
+            );
+            py.detach(|| {
+                let rec = RecordingRef::borrowed(t, u, y, jitter_tol)?;
+                pipeline.run(&rec)
+            })
+        }
+        _ => {
+            return Err(PyTypeError::new_err(
+                "identify takes a recording or time, command and position arrays",
+            ))
+        }
+    }
+    .py_err()?;
     let summary = run.summary();
     let summary_json = serde_json::to_string(&summary)
         .map_err(|e| crate::errors::input(format!("summary: {e}")))?;

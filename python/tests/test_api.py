@@ -52,6 +52,19 @@ def test_recording_arrays_are_read_only_views_and_identify_reads_them_in_place()
     # contiguous float64 input is passed on without a NumPy copy
     a = np.ascontiguousarray(rec.time)
     assert feedid._array(a, "time") is a
+    # arrays are identified in place: the result holds the caller's arrays,
+    # and equals the identification of a checked recording of them
+    t, u, y = (np.array(rec.time), np.array(rec.command), np.array(rec.position))
+    run_arrays = feedid.identify(t, u, y, method="arx")
+    assert run_arrays.time is t and run_arrays.position is y
+    np.testing.assert_array_equal(run_arrays.predicted, run.predicted)
+    assert run_arrays.summary["rms_error_m"] == run.summary["rms_error_m"]
+    assert np.array_equal(run_arrays.recording.command, u), "a checked copy on demand"
+    with pytest.raises(TypeError, match="recording or time, command and position"):
+        feedid._feedid.identify(rec, time=t, command=u, position=y)
+    # a run that predicts nothing says so in its repr (no rms)
+    still = feedid.identify(t, np.zeros_like(t), np.zeros_like(t), method="arx")
+    assert still.summary.get("rms_error_m") is None and "rms_error_m=none" in repr(still)
     # strided or integer input is converted, not refused
     t = np.arange(0, 2000, dtype=np.int64)
     run = feedid.identify(t[::2] * 1e-4, np.zeros(1000), np.zeros(1000), method="arx")

@@ -39,4 +39,4 @@ pub mod zoo;
 
 pub use error::{Error, Result};
 pub use pipeline::Pipeline;
-pub use recording::Recording;
+pub use recording::{Recording, RecordingRef};

@@ -102,7 +102,7 @@ impl std::fmt::Display for Warning {
 }
 
 /// The warnings of a recording (see the module doc), in the order of the list above.
-pub fn check_recording(rec: &Recording) -> Vec<Warning> {
+pub fn check_recording<S: AsRef<[f64]>>(rec: &Recording<S>) -> Vec<Warning> {
     let mut out = Vec::new();
     let (t, c, x) = (rec.time(), rec.command(), rec.position());
     let warn = |kind, message| Warning { kind, message };

@@ -14,6 +14,10 @@
 //! let r = Recording::new(t, vec![0.0; 5], vec![0.0; 5]).unwrap();
 //! assert!((r.rate_hz() - 5000.0).abs() < 1e-6);
 //! ```
+//!
+//! A recording owns its signals (`Recording`, storage `Vec<f64>`) or borrows
+//! them ([`RecordingRef`], storage `&[f64]`): the borrowed form runs the same
+//! checks without copying, e.g. over arrays owned by Python or a memory map.
 
 use serde::Serialize;
 
@@ -30,12 +34,13 @@ pub const MAX_MAGNITUDE: f64 = 1e100;
 /// values up to [`MAX_MAGNITUDE`] every finite difference stays finite.
 pub const MIN_INTERVAL: f64 = 1e-12;
 
-/// A checked recording of command and measured position.
+/// A checked recording of command and measured position, owning its signals
+/// (`S = Vec<f64>`, the default) or borrowing them ([`RecordingRef`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Recording {
-    time: Vec<f64>,
-    command: Vec<f64>,
-    position: Vec<f64>,
+pub struct Recording<S = Vec<f64>> {
+    time: S,
+    command: S,
+    position: S,
     extra: Vec<(String, Vec<f64>)>,
     dt: f64,
     max_jitter: f64,
@@ -68,65 +73,7 @@ impl Recording {
         position: Vec<f64>,
         jitter_tolerance: f64,
     ) -> Result<Self> {
-        if command.len() != time.len() {
-            return Err(Error::LengthMismatch {
-                what: "command vs time",
-                expected: time.len(),
-                actual: command.len(),
-            });
-        }
-        if position.len() != time.len() {
-            return Err(Error::LengthMismatch {
-                what: "position vs time",
-                expected: time.len(),
-                actual: position.len(),
-            });
-        }
-        if time.len() < 2 {
-            return Err(Error::TooFewSamples {
-                what: "a recording",
-                needed: 2,
-                actual: time.len(),
-            });
-        }
-        check_finite("time", &time)?;
-        check_finite("command", &command)?;
-        check_finite("position", &position)?;
-        for k in 1..time.len() {
-            if time[k] <= time[k - 1] {
-                return Err(Error::NonMonotoneTime {
-                    index: k,
-                    previous: time[k - 1],
-                    value: time[k],
-                });
-            }
-        }
-        let dt = mean_interval(&time);
-        if dt < MIN_INTERVAL {
-            return Err(Error::SamplingInterval {
-                interval: dt,
-                min: MIN_INTERVAL,
-                max_rate: 1.0 / MIN_INTERVAL,
-            });
-        }
-        let mut max_jitter = 0.0_f64;
-        let mut worst = 0;
-        for k in 1..time.len() {
-            let rel = ((time[k] - time[k - 1]) - dt).abs() / dt;
-            if rel > max_jitter {
-                max_jitter = rel;
-                worst = k;
-            }
-        }
-        if max_jitter > jitter_tolerance {
-            return Err(Error::SamplingJitter {
-                index: worst,
-                interval: time[worst] - time[worst - 1],
-                nominal: dt,
-                relative_percent: 100.0 * max_jitter,
-                tolerance_percent: 100.0 * jitter_tolerance,
-            });
-        }
+        let (dt, max_jitter) = check(&time, &command, &position, jitter_tolerance)?;
         Ok(Self {
             time,
             command,
@@ -137,13 +84,51 @@ impl Recording {
             notes: Vec::new(),
         })
     }
+}
 
+/// A recording that borrows its signals: checked like an owned one, copied never.
+pub type RecordingRef<'a> = Recording<&'a [f64]>;
+
+impl<'a> Recording<&'a [f64]> {
+    /// Check borrowed time \[s\], command \[m\] and position \[m\] with a
+    /// relative jitter tolerance (e.g. [`DEFAULT_JITTER_TOLERANCE`]) and wrap
+    /// them without copying; the checks and errors are those of
+    /// [`Recording::with_tolerance`].
+    ///
+    /// ```
+    /// use feedid::{RecordingRef, recording::DEFAULT_JITTER_TOLERANCE};
+    /// let t: Vec<f64> = (0..5).map(|k| k as f64 * 1e-3).collect();
+    /// let u = [0.0, 1e-6, 2e-6, 3e-6, 4e-6];
+    /// let r = RecordingRef::borrowed(&t, &u, &u, DEFAULT_JITTER_TOLERANCE).unwrap();
+    /// assert_eq!(r.command().as_ptr(), u.as_ptr());
+    /// assert!((r.rate_hz() - 1000.0).abs() < 1e-9);
+    /// ```
+    pub fn borrowed(
+        time: &'a [f64],
+        command: &'a [f64],
+        position: &'a [f64],
+        jitter_tolerance: f64,
+    ) -> Result<Self> {
+        let (dt, max_jitter) = check(time, command, position, jitter_tolerance)?;
+        Ok(Self {
+            time,
+            command,
+            position,
+            extra: Vec::new(),
+            dt,
+            max_jitter,
+            notes: Vec::new(),
+        })
+    }
+}
+
+impl<S: AsRef<[f64]>> Recording<S> {
     /// Attach a further channel (e.g. motor current); checked for length and finiteness.
     pub fn with_channel(mut self, name: &str, values: Vec<f64>) -> Result<Self> {
-        if values.len() != self.time.len() {
+        if values.len() != self.len() {
             return Err(Error::LengthMismatch {
                 what: "extra channel vs time",
-                expected: self.time.len(),
+                expected: self.len(),
                 actual: values.len(),
             });
         }
@@ -168,39 +153,39 @@ impl Recording {
     /// of its own, without the further channels; the sampling was checked
     /// when this recording was built, so no jitter tolerance applies again.
     /// Errors: `n < 2`.
-    pub fn head(&self, n: usize) -> Result<Self> {
+    pub fn head(&self, n: usize) -> Result<Recording> {
         let n = n.min(self.len());
-        Self::with_tolerance(
-            self.time[..n].to_vec(),
-            self.command[..n].to_vec(),
-            self.position[..n].to_vec(),
+        Recording::with_tolerance(
+            self.time()[..n].to_vec(),
+            self.command()[..n].to_vec(),
+            self.position()[..n].to_vec(),
             f64::INFINITY,
         )
     }
 
     /// Number of samples.
     pub fn len(&self) -> usize {
-        self.time.len()
+        self.time().len()
     }
 
     /// Always false: a recording has at least two samples.
     pub fn is_empty(&self) -> bool {
-        self.time.is_empty()
+        self.time().is_empty()
     }
 
     /// Time stamps \[s\].
     pub fn time(&self) -> &[f64] {
-        &self.time
+        self.time.as_ref()
     }
 
     /// Command (set-point) position \[m\].
     pub fn command(&self) -> &[f64] {
-        &self.command
+        self.command.as_ref()
     }
 
     /// Measured position \[m\].
     pub fn position(&self) -> &[f64] {
-        &self.position
+        self.position.as_ref()
     }
 
     /// Further channels, by name.
@@ -225,15 +210,16 @@ impl Recording {
 
     /// Duration from first to last sample \[s\].
     pub fn duration(&self) -> f64 {
-        self.time[self.time.len() - 1] - self.time[0]
+        let t = self.time();
+        t[t.len() - 1] - t[0]
     }
 
     /// Index of the last sample before the command first moves, or `None` if
     /// it never moves by more than `threshold` \[m\] from its first value.
     pub fn motion_start_index(&self, threshold: f64) -> Option<usize> {
-        let c0 = self.command[0];
-        self.command
-            .iter()
+        let c = self.command();
+        let c0 = c[0];
+        c.iter()
             .position(|&c| (c - c0).abs() > threshold)
             .map(|k| k.saturating_sub(1))
     }
@@ -242,7 +228,7 @@ impl Recording {
     /// command moves (by more than 1 nm); the first sample's time if it never moves.
     pub fn motion_start_time(&self) -> f64 {
         self.motion_start_index(MOTION_THRESHOLD)
-            .map_or(self.time[0], |k| self.time[k])
+            .map_or(self.time()[0], |k| self.time()[k])
     }
 
     /// Whether the command moves at all (by more than 1 nm).
@@ -262,7 +248,7 @@ impl Recording {
         step_threshold: f64,
         min_standstill_s: f64,
     ) -> Vec<MotionSegment> {
-        let (t, c) = (&self.time, &self.command);
+        let (t, c) = (self.time(), self.command());
         // Runs of moving steps as (first step, last step).
         let mut runs: Vec<(usize, usize)> = Vec::new();
         for k in 0..c.len().saturating_sub(1) {
@@ -314,6 +300,76 @@ pub struct MotionSegment {
 /// Command change that counts as motion \[m\] (1 nm).
 pub const MOTION_THRESHOLD: f64 = 1e-9;
 
+/// The checks of a recording (see the module docs); returns the mean
+/// interval \[s\] and the largest relative interval deviation.
+fn check(
+    time: &[f64],
+    command: &[f64],
+    position: &[f64],
+    jitter_tolerance: f64,
+) -> Result<(f64, f64)> {
+    if command.len() != time.len() {
+        return Err(Error::LengthMismatch {
+            what: "command vs time",
+            expected: time.len(),
+            actual: command.len(),
+        });
+    }
+    if position.len() != time.len() {
+        return Err(Error::LengthMismatch {
+            what: "position vs time",
+            expected: time.len(),
+            actual: position.len(),
+        });
+    }
+    if time.len() < 2 {
+        return Err(Error::TooFewSamples {
+            what: "a recording",
+            needed: 2,
+            actual: time.len(),
+        });
+    }
+    check_finite("time", time)?;
+    check_finite("command", command)?;
+    check_finite("position", position)?;
+    for k in 1..time.len() {
+        if time[k] <= time[k - 1] {
+            return Err(Error::NonMonotoneTime {
+                index: k,
+                previous: time[k - 1],
+                value: time[k],
+            });
+        }
+    }
+    let dt = mean_interval(time);
+    if dt < MIN_INTERVAL {
+        return Err(Error::SamplingInterval {
+            interval: dt,
+            min: MIN_INTERVAL,
+            max_rate: 1.0 / MIN_INTERVAL,
+        });
+    }
+    let mut max_jitter = 0.0_f64;
+    let mut worst = 0;
+    for k in 1..time.len() {
+        let rel = ((time[k] - time[k - 1]) - dt).abs() / dt;
+        if rel > max_jitter {
+            max_jitter = rel;
+            worst = k;
+        }
+    }
+    if max_jitter > jitter_tolerance {
+        return Err(Error::SamplingJitter {
+            index: worst,
+            interval: time[worst] - time[worst - 1],
+            nominal: dt,
+            relative_percent: 100.0 * max_jitter,
+            tolerance_percent: 100.0 * jitter_tolerance,
+        });
+    }
+    Ok((dt, max_jitter))
+}
+
 fn check_finite(channel: &str, v: &[f64]) -> Result<()> {
     match v.iter().position(|x| !is_usable(*x)) {
         Some(index) if !v[index].is_finite() => Err(Error::NonFinite {
@@ -349,6 +405,45 @@ mod tests {
 
     fn t(n: usize) -> Vec<f64> {
         (0..n).map(|k| k as f64 * 1e-3).collect()
+    }
+
+    #[test]
+    fn borrowed_recording_checks_alike_and_does_not_copy() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        for case in 0..60 {
+            let n = rng.random_range(0..12);
+            let mut time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+            let mut command: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let mut position = command.clone();
+            // spoil one thing (or nothing) at random
+            match (rng.random_range(0..6), n > 2) {
+                (0, true) => time[n / 2] = time[n / 2 - 1],
+                (1, true) => time[n / 2] += 4e-4,
+                (2, true) => position[n - 1] = f64::NAN,
+                (3, true) => command[1] = 1e200,
+                (4, _) => {
+                    position.pop();
+                }
+                _ => {}
+            }
+            let tol = DEFAULT_JITTER_TOLERANCE;
+            let owned =
+                Recording::with_tolerance(time.clone(), command.clone(), position.clone(), tol);
+            let borrowed = RecordingRef::borrowed(&time, &command, &position, tol);
+            match (owned, borrowed) {
+                (Ok(o), Ok(b)) => {
+                    assert_eq!(b.time().as_ptr(), time.as_ptr(), "case {case}");
+                    assert_eq!(b.command().as_ptr(), command.as_ptr());
+                    assert_eq!(b.position().as_ptr(), position.as_ptr());
+                    assert_eq!((o.dt(), o.max_jitter()), (b.dt(), b.max_jitter()));
+                    assert_eq!(o.motion_start_time(), b.motion_start_time());
+                    assert_eq!(o.head(3).unwrap(), b.head(3).unwrap());
+                }
+                (Err(o), Err(b)) => assert_eq!(o.to_string(), b.to_string(), "case {case}"),
+                (o, b) => panic!("case {case}: owned {o:?} but borrowed {b:?}"),
+            }
+        }
     }
 
     #[test]

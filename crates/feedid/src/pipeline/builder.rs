@@ -10,7 +10,7 @@ use crate::ident::{
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
 use crate::plausibility::check_recording;
-use crate::recording::Recording;
+use crate::recording::{Recording, RecordingRef, DEFAULT_JITTER_TOLERANCE};
 use crate::stats::ErrorStats;
 
 /// One identification run's settings: the method, the windows, and what to
@@ -187,15 +187,15 @@ impl<'a> Pipeline<'a> {
         }
     }
 
-    /// Identify time \[s\], command \[m\] and measured position \[m\]
-    /// (copied into a checked [`Recording`]).
+    /// Identify time \[s\], command \[m\] and measured position \[m\],
+    /// checked as a [`Recording`] (1 % jitter tolerance) but not copied.
     pub fn run_slices(
         &self,
         time: &[f64],
         command: &[f64],
         position: &[f64],
     ) -> Result<Identification> {
-        let rec = Recording::new(time.to_vec(), command.to_vec(), position.to_vec())?;
+        let rec = RecordingRef::borrowed(time, command, position, DEFAULT_JITTER_TOLERANCE)?;
         self.run(&rec)
     }
 
@@ -205,7 +205,7 @@ impl<'a> Pipeline<'a> {
     /// ([`Error::NotApplicable`]); a failed order selection, simulation or
     /// extra model ([`Error::Stage`], with the reason); a recording too
     /// short for the windows.
-    pub fn run(&self, recording: &Recording) -> Result<Identification> {
+    pub fn run<S: AsRef<[f64]>>(&self, recording: &Recording<S>) -> Result<Identification> {
         let mut method = self.method.clone();
         method.validate()?;
         self.guard.validate()?;
@@ -373,6 +373,38 @@ mod tests {
             .simulate(&cmd, 5000.0)
             .unwrap();
         Recording::new(out.time, out.command, out.position).unwrap()
+    }
+
+    #[test]
+    fn borrowed_slices_identify_exactly_as_an_owned_recording() {
+        let rec = ramp();
+        for name in ["arx", "auto"] {
+            let pipeline = Pipeline::new(name.parse().unwrap()).nominal(RigParams::default());
+            let owned = pipeline.run(&rec).unwrap();
+            let borrowed = pipeline
+                .run_slices(rec.time(), rec.command(), rec.position())
+                .unwrap();
+            assert_eq!(
+                owned.sliding.predicted, borrowed.sliding.predicted,
+                "{name}"
+            );
+            assert_eq!(owned.sliding.lower, borrowed.sliding.lower, "{name}");
+            assert_eq!(owned.sliding.coefficients, borrowed.sliding.coefficients);
+            assert_eq!(owned.simulated, borrowed.simulated, "{name}");
+            assert_eq!(owned.global, borrowed.global, "{name}");
+            let (mut a, mut b) = (owned.summary(), borrowed.summary());
+            // timing differs from run to run
+            (a.identification_seconds, a.per_window_us) = (0.0, 0.0);
+            (b.identification_seconds, b.per_window_us) = (0.0, 0.0);
+            assert_eq!(a, b, "{name}");
+        }
+        // the checks of a recording apply to the slices too
+        let mut t = rec.time().to_vec();
+        t[7] = t[6];
+        let e = Pipeline::new(Method::default())
+            .run_slices(&t, rec.command(), rec.position())
+            .unwrap_err();
+        assert!(matches!(e, Error::NonMonotoneTime { index: 7, .. }), "{e}");
     }
 
     #[test]

@@ -173,7 +173,7 @@ impl<'a> Signals<'a> {
     }
 }
 
-impl Recording {
+impl<S: AsRef<[f64]>> Recording<S> {
     /// The whole recording as an estimator view (offset 0, its mean sample
     /// interval and its motion start).
     pub fn signals(&self) -> Signals<'_> {

@@ -262,7 +262,10 @@ pub const GLOBAL_FIT_SAMPLES: usize = 200_000;
 /// Errors: those of [`fit_arx`] / [`fit_oe`] (too few samples, no
 /// excitation, no stable model); with `auto`, the last candidate's error
 /// when none succeeds.
-pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
+pub fn fit_global_model<S: AsRef<[f64]>>(
+    rec: &Recording<S>,
+    kind: &GlobalModelKind,
+) -> Result<ModelFile> {
     if rec.len() <= GLOBAL_FIT_SAMPLES {
         return fit_kind(rec, kind);
     }
@@ -270,7 +273,7 @@ pub fn fit_global_model(rec: &Recording, kind: &GlobalModelKind) -> Result<Model
 }
 
 /// [`fit_global_model`] without the cap.
-fn fit_kind(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
+fn fit_kind<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Result<ModelFile> {
     if *kind != GlobalModelKind::Auto {
         return fit_one(rec, kind);
     }
@@ -322,7 +325,7 @@ fn fit_kind(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
     }
 }
 
-fn fit_one(rec: &Recording, kind: &GlobalModelKind) -> Result<ModelFile> {
+fn fit_one<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Result<ModelFile> {
     let (u, y, dt) = (rec.command(), rec.position(), rec.dt());
     let model = match kind {
         GlobalModelKind::Arx(orders) => fit_arx(u, y, dt, *orders, &ArxConfig::default())?.model,

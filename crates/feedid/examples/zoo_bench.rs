@@ -38,6 +38,12 @@
 //!   (the library's default [`feedid::ident::GuardConfig`]); `n/a` for the
 //!   baselines.
 //!
+//! `--offset M` adds `M` metres to every member's command and position
+//! before anything runs (a recording in machine coordinates, far from the
+//! origin): the library methods that are offset-invariant predict the same
+//! motion, while `arx220`, whose equations are in absolute coordinates,
+//! changes (see README, "The zoo benchmark").
+//!
 //! Members with dropped rows are refused by the reader (as by
 //! `feedid identify`): they are listed as `refused` and left out of the summary.
 
@@ -50,6 +56,9 @@ use feedid::zoo::{Zoo, ZooMember};
 use feedid::Recording;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
+
+/// `--offset`: metres added to command and position of every member.
+static OFFSET: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
 
 /// Horizon of the benchmark \[samples\].
 const H: usize = 10;
@@ -300,7 +309,17 @@ fn score(m: &ZooMember) -> Vec<Row> {
                 .collect()
         }
     };
-    let (u, y) = (&m.command, &m.position);
+    let offset = OFFSET.get().copied().unwrap_or(0.0);
+    let shift = |v: &[f64]| v.iter().map(|x| x + offset).collect::<Vec<f64>>();
+    let (u, y) = (&shift(&m.command), &shift(&m.position));
+    let rec = if offset == 0.0 {
+        rec
+    } else {
+        match Recording::new(rec.time().to_vec(), u.clone(), y.clone()) {
+            Ok(r) => r,
+            Err(e) => panic!("member {}: offset recording: {e}", s.index),
+        }
+    };
     let mut all = run_library_methods(&rec);
     all.push(baseline_command(u));
     all.push(baseline_hold(y));
@@ -428,7 +447,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         match a.as_str() {
             "--members" => members = parse_members(&args.next().unwrap_or_default(), &zoo)?,
             "--csv" => csv = args.next().map(PathBuf::from),
-            _ => return Err(format!("unknown argument `{a}` (--members SET, --csv FILE)").into()),
+            "--offset" => {
+                let v: f64 = args.next().unwrap_or_default().parse()?;
+                OFFSET.set(v).map_err(|_| "--offset given twice")?;
+            }
+            _ => {
+                return Err(format!(
+                    "unknown argument `{a}` (--members SET, --csv FILE, --offset METRES)"
+                )
+                .into())
+            }
         }
     }
     let t = Instant::now();

@@ -42,6 +42,9 @@ fn beats(a: Option<f64>, b: Option<f64>) -> bool {
 #[derive(Debug, Clone)]
 struct Member {
     predictor: Predictor,
+    /// A second predictor of the same candidate for the backtest
+    /// (allocated once, reset in place).
+    trial_predictor: Predictor,
     /// The last prediction, not yet scored.
     pending: Vec<f64>,
     pending_start: usize,
@@ -53,12 +56,16 @@ struct Member {
     scored: [usize; REGIMES],
     /// Whether the candidate can predict (fitted).
     ready: bool,
+    /// Mean squared error of the backtest before the first window \[m²\]:
+    /// the score until a horizon is scored.
+    trial: Option<f64>,
 }
 
 impl Member {
     fn new(c: Candidate) -> Self {
         Self {
             predictor: Predictor::new(c),
+            trial_predictor: Predictor::new(c),
             pending: Vec::new(),
             pending_start: 0,
             pending_len: 0,
@@ -66,6 +73,7 @@ impl Member {
             score: [0.0; REGIMES],
             scored: [0; REGIMES],
             ready: false,
+            trial: None,
         }
     }
 
@@ -102,6 +110,11 @@ pub struct AutoEstimator {
     experience: f64,
     /// Samples below this index are in `experience`.
     experienced_to: usize,
+    /// Mean squared error of holding the last position over the backtest.
+    hold_trial: Option<f64>,
+    /// Hold at the first prediction: holding backtested better than the
+    /// first choice.
+    hold_first: bool,
 }
 
 impl AutoEstimator {
@@ -123,6 +136,8 @@ impl AutoEstimator {
             horizon: 10,
             experience: 0.0,
             experienced_to: 0,
+            hold_trial: None,
+            hold_first: false,
         }
     }
 
@@ -199,6 +214,56 @@ impl AutoEstimator {
             }
         }
         self.experienced_to = end.max(self.experienced_to);
+    }
+
+    /// Score every candidate once before the first prediction, out of
+    /// sample: fitted on `start..end − H`, predicting `end − H..end`
+    /// (measured), so that the first choice is not blind. Needs `2·H`
+    /// samples in the first window; without them nothing is scored yet.
+    fn backtest(&mut self, signals: &Signals<'_>, start: usize, end: usize) {
+        let h = self.horizon;
+        if end < start + 2 * h {
+            return;
+        }
+        let split = end - h;
+        let mse = |p: &[f64], hold: Option<f64>| {
+            let w = signals.window(split..end, 0, "auto backtest").ok()?;
+            let v = w
+                .position
+                .iter()
+                .enumerate()
+                .map(|(i, a)| {
+                    let b = hold.unwrap_or_else(|| p.get(i).copied().unwrap_or(f64::NAN));
+                    (a - b) * (a - b)
+                })
+                .sum::<f64>()
+                / h as f64;
+            Some(v).filter(|v| v.is_finite())
+        };
+        self.hold_trial = last_position(signals, start..split)
+            .ok()
+            .and_then(|last| mse(&[], Some(last)));
+        for m in &mut self.members {
+            m.pending_len = 0;
+            m.trial = None;
+            // a predictor of its own: the candidate proper learns the
+            // first window in one piece (its coordinates' scale is set by
+            // the first rows it sees)
+            m.trial_predictor.reset();
+            if !m.trial_predictor.fit(signals, start, split) {
+                continue;
+            }
+            if m.pending.len() < h {
+                m.pending.resize(h, 0.0);
+            }
+            let buf = &mut m.pending[..h];
+            if m.trial_predictor
+                .predict(signals, split..end, &mut self.past, buf)
+                .is_ok()
+            {
+                m.trial = mse(buf, None);
+            }
+        }
     }
 
     /// The ready candidate with the lowest score in the current regime
@@ -297,12 +362,15 @@ impl Estimator for AutoEstimator {
             m.score = [0.0; REGIMES];
             m.scored = [0; REGIMES];
             m.ready = false;
+            m.trial = None;
         }
         self.selected = None;
         self.start = None;
         self.regime = 2;
         self.experience = 0.0;
         self.experienced_to = 0;
+        self.hold_trial = None;
+        self.hold_first = false;
     }
 
     fn fit(
@@ -321,11 +389,24 @@ impl Estimator for AutoEstimator {
         self.score_pending(signals, window.end);
         self.learn_experience(signals, window.end);
         self.regime = regime(signals, window.start, window.end, self.horizon);
+        let first_fit = self.start.is_none();
         let start = *self.start.get_or_insert(window.start);
+        if first_fit {
+            self.backtest(signals, start, window.end);
+        }
         for m in &mut self.members {
             m.ready = m.predictor.fit(signals, start, window.end);
         }
         self.selected = self.choose();
+        self.hold_first = first_fit
+            && match (
+                self.selected.map(|c| self.members[c].trial),
+                self.hold_trial,
+            ) {
+                (Some(Some(c)), Some(hold)) => hold <= c,
+                (_, Some(_)) => true,
+                _ => false,
+            };
         coef.fill(0.0);
         if let Some(x) = coef.get_mut(0) {
             *x = self.selected.map_or(-1.0, |c| c as f64);
@@ -382,6 +463,7 @@ impl Estimator for AutoEstimator {
         }
         let usable = |m: &Member| m.pending_len == h;
         let chosen = match self.selected {
+            _ if self.hold_first => None,
             Some(c) if usable(&self.members[c]) => Some(c),
             _ => {
                 let r = self.regime;
@@ -405,6 +487,68 @@ impl Estimator for AutoEstimator {
                 out.fill(last);
                 Ok(PredictStatus::Predicted)
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ident::engine::{run, EngineConfig};
+
+    /// 1 kHz, a slow 1 µm sine of the position; the command `offset` away.
+    fn signals_data(offset: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let n = 200;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let y: Vec<f64> = (0..n).map(|k| 1e-6 * (0.05 * k as f64).sin()).collect();
+        let u: Vec<f64> = y.iter().map(|v| v + offset).collect();
+        (t, u, y)
+    }
+
+    /// `auto` with the command as its only candidate, so that the first
+    /// prediction is either the command or the held position.
+    fn run_command_only(offset: f64) -> (Vec<f64>, Vec<f64>, crate::ident::SlidingResult) {
+        let (t, u, y) = signals_data(offset);
+        let config = AutoConfig {
+            candidates: vec![Candidate::Command],
+            plausibility: 100.0,
+            ..AutoConfig::default()
+        };
+        let mut est = config.build().unwrap();
+        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
+        let cfg = EngineConfig {
+            window: 50,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        };
+        let r = run(&mut est, &s, &cfg).unwrap();
+        (u, y, r)
+    }
+
+    #[test]
+    fn the_first_prediction_holds_when_holding_backtests_better_than_every_candidate() {
+        // the command is 1.5 µm beside the position: over the first window's
+        // last horizon holding (error < 0.5 µm) beats it
+        let (u, y, r) = run_command_only(1.5e-6);
+        let first = r.windows[0].horizon.clone();
+        let second = r.windows[1].horizon.clone();
+        let last = y[first.start - 1];
+        for k in first {
+            assert_eq!(r.predicted[k], last, "sample {k}: the last position, held");
+        }
+        // from the second window on, the scored candidate predicts
+        for k in second {
+            assert_eq!(r.predicted[k], u[k], "sample {k}");
+        }
+    }
+
+    #[test]
+    fn the_first_prediction_is_the_candidates_when_it_backtests_better_than_holding() {
+        // the position follows the command exactly: the command backtests with error 0
+        let (u, _, r) = run_command_only(0.0);
+        for k in r.windows[0].horizon.clone() {
+            assert_eq!(r.predicted[k], u[k], "sample {k}");
         }
     }
 }

@@ -49,6 +49,14 @@
 //! first scored one). Scores are compared with one another only, so they
 //! carry no threshold and no unit.
 //!
+//! The first window is not chosen blind: before its prediction every
+//! candidate is backtested once, out of sample — a second instance of it
+//! learns the window without its last `H` samples and predicts them — and
+//! so is holding the last position. If holding backtests at least as well
+//! as the first choice (the settings' first ready candidate), the first
+//! horizon holds the last position; the backtest scores decide nothing
+//! after it (a single horizon on a partly learnt model is a poor score).
+//!
 //! A candidate's prediction is *implausible* when it leaves the last
 //! measured position by more than [`AutoConfig::plausibility`] times the
 //! largest motion of the position over `H + 1` samples so far: the

@@ -581,6 +581,11 @@ def compensate(
     max_acceleration: float = 30.0,
     keep_dc_gain: bool = False,
     allow_unstable: bool = False,
+    start: str = "rest",
+    min_benefit: float = 1.25,
+    min_fit: float = 90.0,
+    fallback: bool = True,
+    check: Union[None, Recording, "Identification", PathLike, Sequence[Any]] = None,
 ) -> Dict[str, Any]:
     """The command that makes a model follow the desired trajectory
     (``feedid compensate``).
@@ -604,6 +609,26 @@ def compensate(
         Command limits [m/s], [m/s²]; defaults 1.0 and 30.0.
     keep_dc_gain : bool
         Keep the model's DC gain (default False: scaled to 1).
+    allow_unstable : bool
+        Use an unstable physical model anyway (default False: refused).
+    start : str
+        The axis before the first desired sample: ``rest`` (default, at the
+        first value) or ``moving`` (a segment cut from a longer program, at
+        the first sample's velocity); ``--start``.
+    min_benefit : float
+        Send the plain command (the desired trajectory) when the model
+        expects the rms error to fall less than this many times; default
+        1.25 (``--min-benefit``).
+    min_fit : float
+        Send the plain command when the model's free-run position fit is
+        below this [%]; default 90 (``--min-fit``).
+    fallback : bool
+        Allow that fall-back to the plain command (default True; False is
+        ``--no-fallback``: always the compensated command).
+    check : Recording, Identification, path or (time, command, position), optional
+        A recording of the axis on which the identified model's fits are
+        measured for the fall-back (``--check``); default the model's own
+        fit. Identified models only.
 
     Returns
     -------
@@ -631,6 +656,15 @@ def compensate(
         if smooth.strip() != "auto":
             raise InputError(f"invalid smooth `{smooth}`: expected a time in seconds or auto")
         smooth = None
+    if check is None or isinstance(check, Recording):
+        check_rec = check
+    elif isinstance(check, Identification):
+        check_rec = check.recording
+    elif isinstance(check, (str, bytes, os.PathLike)):
+        check_rec = read(check)
+    else:
+        t, u, y = check
+        check_rec = Recording(_array(t, "time"), _array(u, "command"), _array(y, "position"))
     command, predicted, summary = _feedid.compensate(
         _array(time, "time"),
         _array(desired, "desired"),
@@ -641,6 +675,11 @@ def compensate(
         max_acceleration=max_acceleration,
         keep_dc_gain=keep_dc_gain,
         allow_unstable=allow_unstable,
+        start=start,
+        min_benefit=min_benefit,
+        min_fit=min_fit,
+        fallback=fallback,
+        check=check_rec,
         **kw,
     )
     out: Dict[str, Any] = json.loads(summary)

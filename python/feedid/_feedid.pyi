@@ -150,4 +150,9 @@ def compensate(
     max_acceleration: float = 30.0,
     keep_dc_gain: bool = False,
     allow_unstable: bool = False,
+    start: str = "rest",
+    min_benefit: float = 1.25,
+    min_fit: float = 90.0,
+    fallback: bool = True,
+    check: Optional[Recording] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], str]: ...

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use feedid::compensate::{
-    compensate_model, compensate_params, CompensateConfig, ModelQuality, Smoothing,
+    compensate_model, compensate_params, CompensateConfig, ModelQuality, Smoothing, StartMode,
 };
 use feedid::drive::{D1Variant, ModelSummary, RigEffects, VirtualRig};
 use feedid::greybox::LoopModel;
@@ -109,12 +109,29 @@ fn quality(file: &ModelFile) -> ModelQuality {
     }
 }
 
+/// The model's fits measured on a check recording (`feedid compensate
+/// --check`): its sample time must be the model's.
+fn checked_quality(file: &ModelFile, check: &Recording) -> PyResult<ModelQuality> {
+    if let feedid::ident::LinearModel::Discrete { dt, .. } = &file.model {
+        if (check.dt() - dt).abs() > 1e-6 * dt {
+            return Err(input(format!(
+                "check: sample time {} s differs from the model's {} s",
+                check.dt(),
+                dt
+            )));
+        }
+    }
+    ModelQuality::from_run(&file.model, check.command(), check.position(), check.dt())
+        .map_err(|e| input(format!("check: {e}")))
+}
+
 /// The command that makes a model follow `desired` (`feedid compensate`):
 /// returns `(command, predicted, summary_json)`.
 #[pyfunction]
 #[pyo3(signature = (time, desired, *, model_json = None, model_path = None, params_path = None,
     params_json = None, position_loop = "sampled", smooth = None, max_smoothing = 0.02,
-    max_velocity = 1.0, max_acceleration = 30.0, keep_dc_gain = false, allow_unstable = false))]
+    max_velocity = 1.0, max_acceleration = 30.0, keep_dc_gain = false, allow_unstable = false,
+    start = "rest", min_benefit = 1.25, min_fit = 90.0, fallback = true, check = None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn compensate<'py>(
     py: Python<'py>,
@@ -131,6 +148,11 @@ pub fn compensate<'py>(
     max_acceleration: f64,
     keep_dc_gain: bool,
     allow_unstable: bool,
+    start: &str,
+    min_benefit: f64,
+    min_fit: f64,
+    fallback: bool,
+    check: Option<&Bound<'py, PyRecording>>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, String)> {
     let (t, x) = (slice(&time, "time")?, slice(&desired, "desired")?);
     // the desired trajectory is checked as a recording (time increasing, finite)
@@ -141,6 +163,10 @@ pub fn compensate<'py>(
         max_acceleration,
         max_smoothing,
         unit_dc_gain: !keep_dc_gain,
+        start: start.parse::<StartMode>().py_err()?,
+        min_benefit,
+        min_fit_percent: min_fit,
+        fallback,
         ..CompensateConfig::default()
     };
     cfg.validate().py_err()?;
@@ -148,18 +174,31 @@ pub fn compensate<'py>(
     let comp = match (model_json, model_path) {
         (Some(text), _) => {
             let file = ModelFile::from_json(&text).py_err()?;
-            cfg.quality = quality(&file);
+            cfg.quality = match check {
+                Some(c) => checked_quality(&file, &c.get().inner)?,
+                None => quality(&file),
+            };
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))
                 .py_err()?
         }
         (None, Some(path)) => {
             let text = feedid::io::read_small_text(Path::new(&path)).py_err()?;
             let file = ModelFile::from_json_file(&text, Path::new(&path)).py_err()?;
-            cfg.quality = quality(&file);
+            cfg.quality = match check {
+                Some(c) => checked_quality(&file, &c.get().inner)?,
+                None => quality(&file),
+            };
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))
                 .map_err(|e| input(format!("{path}: {e}")))?
         }
         (None, None) => {
+            if check.is_some() {
+                return Err(input(
+                    "check applies to an identified model (a model dict, model.json or \
+                     Identification), not to a physical one"
+                        .to_string(),
+                ));
+            }
             let params = crate::params::load(
                 params_path.as_deref(),
                 params_json.as_deref(),

@@ -2,6 +2,8 @@
 scenarios and on EMPS: predictions within 1e-12 of the position range, the
 same samples predicted, the same coefficients, the same summary."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -96,3 +98,55 @@ def test_identify_equals_the_cli_on_emps(cli, tmp_path, emps):
         pred, coef, summ = cli_identify(cli, tmp_path, emps, *args, "--method", method)
         rec = feedid.read(emps, time="t", command="qg", position="qm")
         check(feedid.identify(rec, method=method), pred, coef, summ)
+
+
+@pytest.mark.parametrize(
+    "py_options, cli_options, fallback",
+    [
+        ({}, [], None),
+        ({"start": "rest"}, ["--start", "rest"], "limits"),
+        (
+            {"start": "rest", "fallback": False, "max_acceleration": float("inf")},
+            ["--start", "rest", "--no-fallback", "--max-acceleration", "inf"],
+            None,
+        ),
+        ({"min_benefit": 1e12}, ["--min-benefit", 1e12], "small_benefit"),
+        ({"min_fit": 99.999}, ["--min-fit", 99.999], "poor_fit"),
+        ({"check": "CHECK"}, ["--check", "CHECK"], None),
+        ({"check": "CHECK", "min_fit": 99.99}, ["--check", "CHECK", "--min-fit", 99.99], "poor_fit"),
+    ],
+)
+def test_compensate_equals_the_cli_with_its_options(cli, tmp_path, py_options, cli_options, fallback):
+    rec_path, model_path = tmp_path / "prbs.csv", tmp_path / "model.json"
+    cli("simulate", "--scenario", "prbs", "--seed", 2, "-o", rec_path)
+    cli("identify", rec_path, "--method", "arx", "-o", tmp_path / "p.csv", "--model-out", model_path)
+    check_path = tmp_path / "check.csv"
+    cli("simulate", "--scenario", "chirp", "--seed", 3, "-o", check_path)
+    # a desired trajectory cut from a move: it starts at a small speed
+    # (from rest, the compensated command would exceed 30 m/s²)
+    t = np.arange(3000) * 2e-4
+    desired = 0.5e-3 * (1 - np.cos(2 * np.pi * t)) + 1e-4 * t
+    desired_path = tmp_path / "desired.csv"
+    np.savetxt(desired_path, np.column_stack([t, desired]), delimiter=",",
+               header="time_s,position_m", comments="", fmt="%.17g")
+    py_options = {"start": "moving", **py_options}
+    if "--start" not in cli_options:
+        cli_options = ["--start", "moving", *cli_options]
+    py_options = {k: (feedid.read(check_path) if v == "CHECK" else v) for k, v in py_options.items()}
+    cli_options = [check_path if v == "CHECK" else v for v in cli_options]
+    out_path, summary_path = tmp_path / "c.csv", tmp_path / "c.json"
+    cli("compensate", "--desired", desired_path, "--model", model_path, "-o", out_path,
+        "--summary", summary_path, *cli_options)
+    c, summary = read_csv(out_path), read_json(summary_path)
+    out = feedid.compensate(t, desired, model_path, **py_options)
+    scale = float(np.ptp(desired))
+    assert np.max(np.abs(out["command"] - c["command_m"])) <= 1e-12 * scale
+    assert np.max(np.abs(out["predicted"] - c["predicted_m"])) <= 1e-12 * scale
+    # the summary's keys (the CLI's also names its files and limits)
+    keys = set(out) - {"command", "predicted"}
+    assert keys and keys <= set(summary), keys - set(summary)
+    for key in keys:
+        assert json.dumps(out[key], sort_keys=True) == json.dumps(summary[key], sort_keys=True), key
+    # the option did what it says: the plain command is sent on a fall-back only
+    assert (out["fallback"] or {}).get("reason") == fallback, out["fallback"]
+    assert np.array_equal(out["command"], desired) == (fallback is not None)

@@ -73,16 +73,7 @@ impl Recording {
         position: Vec<f64>,
         jitter_tolerance: f64,
     ) -> Result<Self> {
-        let (dt, max_jitter) = check(&time, &command, &position, jitter_tolerance)?;
-        Ok(Self {
-            time,
-            command,
-            position,
-            extra: Vec::new(),
-            dt,
-            max_jitter,
-            notes: Vec::new(),
-        })
+        Self::checked(time, command, position, jitter_tolerance)
     }
 }
 
@@ -109,7 +100,19 @@ impl<'a> Recording<&'a [f64]> {
         position: &'a [f64],
         jitter_tolerance: f64,
     ) -> Result<Self> {
-        let (dt, max_jitter) = check(time, command, position, jitter_tolerance)?;
+        Self::checked(time, command, position, jitter_tolerance)
+    }
+}
+
+impl<S: AsRef<[f64]>> Recording<S> {
+    /// Check the signals (see the module docs) and wrap them, owned or borrowed.
+    fn checked(time: S, command: S, position: S, jitter_tolerance: f64) -> Result<Self> {
+        let (dt, max_jitter) = check(
+            time.as_ref(),
+            command.as_ref(),
+            position.as_ref(),
+            jitter_tolerance,
+        )?;
         Ok(Self {
             time,
             command,
@@ -120,9 +123,7 @@ impl<'a> Recording<&'a [f64]> {
             notes: Vec::new(),
         })
     }
-}
 
-impl<S: AsRef<[f64]>> Recording<S> {
     /// Attach a further channel (e.g. motor current); checked for length and finiteness.
     pub fn with_channel(mut self, name: &str, values: Vec<f64>) -> Result<Self> {
         if values.len() != self.len() {

@@ -56,8 +56,8 @@ struct Member {
     scored: [usize; REGIMES],
     /// Whether the candidate can predict (fitted).
     ready: bool,
-    /// Mean squared error of the backtest before the first window \[m²\]:
-    /// the score until a horizon is scored.
+    /// Mean squared error of its backtest on the first window \[m²\]
+    /// (decides only whether the first prediction holds instead).
     trial: Option<f64>,
 }
 
@@ -226,23 +226,13 @@ impl AutoEstimator {
             return;
         }
         let split = end - h;
-        let mse = |p: &[f64], hold: Option<f64>| {
-            let w = signals.window(split..end, 0, "auto backtest").ok()?;
-            let v = w
-                .position
-                .iter()
-                .enumerate()
-                .map(|(i, a)| {
-                    let b = hold.unwrap_or_else(|| p.get(i).copied().unwrap_or(f64::NAN));
-                    (a - b) * (a - b)
-                })
-                .sum::<f64>()
-                / h as f64;
-            Some(v).filter(|v| v.is_finite())
+        let Ok(measured) = signals.window(split..end, 0, "auto backtest") else {
+            return;
         };
+        let measured = measured.position;
         self.hold_trial = last_position(signals, start..split)
             .ok()
-            .and_then(|last| mse(&[], Some(last)));
+            .and_then(|last| mean_square_error(measured, std::iter::repeat(last)));
         for m in &mut self.members {
             m.pending_len = 0;
             m.trial = None;
@@ -261,7 +251,7 @@ impl AutoEstimator {
                 .predict(signals, split..end, &mut self.past, buf)
                 .is_ok()
             {
-                m.trial = mse(buf, None);
+                m.trial = mean_square_error(measured, buf.iter().copied());
             }
         }
     }
@@ -314,6 +304,17 @@ fn regime(signals: &Signals<'_>, from: usize, end: usize, h: usize) -> usize {
     } else {
         2
     }
+}
+
+/// Mean squared difference of `measured` and `predicted` (as many as
+/// `measured`), if finite.
+fn mean_square_error(measured: &[f64], predicted: impl Iterator<Item = f64>) -> Option<f64> {
+    let sse: f64 = measured
+        .iter()
+        .zip(predicted)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum();
+    Some(sse / measured.len().max(1) as f64).filter(|v| v.is_finite())
 }
 
 /// The last measured position of the window.
@@ -398,6 +399,7 @@ impl Estimator for AutoEstimator {
             m.ready = m.predictor.fit(signals, start, window.end);
         }
         self.selected = self.choose();
+        // hold first unless the first choice backtested better than holding
         self.hold_first = first_fit
             && match (
                 self.selected.map(|c| self.members[c].trial),

@@ -68,7 +68,8 @@ def identify_one(path: str, method: str, read_options: Dict[str, Any]) -> Dict[s
         max_m=s["max_abs_error_m"],
         coverage_percent=s["coverage_percent"],
         global_model=s.get("global_model") or "",
-        global_fit_percent=s.get("global_fit_percent", ""),
+        # summary.json's key for the global model's free-run fit
+        global_fit_percent=s.get("sim_fit_percent", ""),
         identification_seconds=s["identification_seconds"],
     )
     return row

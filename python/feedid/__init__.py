@@ -351,9 +351,10 @@ def identify(
     nominal, global_model, residuals : bool
         What ``feedid identify`` computes beside the sliding predictions
         (default True, all three): the nominal model's simulation (the
-        summary's ``sim_*`` and ``nominal_fit_percent``, ``simulated``), the
-        method's global model and its free-run fit (``global_model``,
-        ``global_fit_percent``, ``model``), the residual analysis
+        summary's ``sim_rms_error_m``, ``sim_max_abs_error_m`` and
+        ``nominal_fit_percent``, ``simulated``), the method's global model
+        and its free-run fit (``global_model``, ``global_model_samples``,
+        ``sim_fit_percent``, ``model``), the residual analysis
         (``residuals``). On long recordings they cost several times the
         sliding identification (README, "Python"): False leaves them out
         and their keys out of the summary.

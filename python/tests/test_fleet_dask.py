@@ -54,7 +54,7 @@ def test_fleet_rows_equal_the_cli_summaries(cli, tmp_path):
         assert int(row["samples"]) == s["samples"]
         for col, key in [("rms_m", "rms_error_m"), ("max_m", "max_abs_error_m"),
                          ("coverage_percent", "coverage_percent"),
-                         ("global_fit_percent", "global_fit_percent")]:
+                         ("global_fit_percent", "sim_fit_percent")]:
             b = s.get(key)
             if b is None:  # not in the summary (no global model fitted)
                 assert row[col] == "", (p.name, col)
@@ -65,3 +65,4 @@ def test_fleet_rows_equal_the_cli_summaries(cli, tmp_path):
         assert float(row["identification_seconds"]) > 0
     # the fleet is not trivial: most recordings have a global model and a score
     assert sum(1 for r in by_name.values() if r["global_model"]) >= 10
+    assert sum(1 for r in by_name.values() if r["global_fit_percent"]) >= 10

@@ -49,6 +49,11 @@ impl AutoConfig {
                 ridge: 1e-6,
                 bias: false,
             },
+            Candidate::Recursive {
+                orders: ArxOrders::new(3, 3, 0),
+                lambda: 0.99,
+                bias: true,
+            },
             rls(3, 3, 0.995),
             rls(4, 4, 0.999),
             rls(6, 6, 0.999),

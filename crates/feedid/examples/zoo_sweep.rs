@@ -10,7 +10,8 @@
 //! one, check on the other) or `emps` (the EMPS recording, printed). Each
 //! line of `configs.txt` is a method and its settings, e.g.
 //! `arx o=3,3,0 w=100 ridge=1e-10 dc=1`, `rls o=8,8,0 lambda=0.999`,
-//! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995 mem=0.1`, or `arx220 100`
+//! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995 mem=0.1` (`lsb:…`,
+//! `rlsb:…`: the same with a constant term), or `arx220 100`
 //! (the benchmark's plain ARX(2,2,0) baseline); `#` starts a comment. The
 //! CSV has per member and configuration the rms over the predicted samples,
 //! the coverage, and the rms of the configuration and of `arx220` on the
@@ -30,14 +31,16 @@ fn cand(s: &str) -> Candidate {
     match f[0] {
         "hold" => Candidate::Hold,
         "command" => Candidate::Command,
-        "ls" => Candidate::Windowed {
+        "ls" | "lsb" => Candidate::Windowed {
             orders: orders(f[1]),
             window: f[2].parse().unwrap(),
             ridge: f.get(3).map_or(0.0, |v| v.parse().unwrap()),
+            bias: f[0] == "lsb",
         },
-        "rls" => Candidate::Recursive {
+        "rls" | "rlsb" => Candidate::Recursive {
             orders: orders(f[1]),
             lambda: f[2].parse().unwrap(),
+            bias: f[0] == "rlsb",
         },
         _ => panic!("candidate {s}"),
     }

@@ -1,6 +1,13 @@
 //! `auto`'s candidate predictors: hold, the command, and unit-gain ARX
 //! models ([`super::model`]) fitted recursively (exponential forgetting) or
-//! over a sliding window of samples.
+//! over a sliding window of samples, optionally with a constant term (bias).
+//!
+//! The column of the constant term is not 1 (that would give it a unit of
+//! its own and make the relative ridge, or the recursive prior, depend on
+//! the unit): it is the largest regressor or target of the candidate's
+//! first informative window (`scale`), a length of the recording like every
+//! other column, so the estimate of `c = θ_c·scale` scales with the unit
+//! and the fit and prediction are unit-equivariant and offset-invariant.
 
 // Negated comparisons are deliberate (they reject NaN).
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -36,6 +43,9 @@ pub enum Candidate {
         orders: ArxOrders,
         /// Forgetting factor λ ∈ (0, 1].
         lambda: f64,
+        /// Whether the model has a constant term `c` added to every
+        /// increment ([`super::model`]).
+        bias: bool,
     },
     /// Unit-gain ARX by least squares over the last `window` samples,
     /// refitted at every window, with a ridge `ridge·‖Ψ‖²_F/n` relative to
@@ -47,25 +57,36 @@ pub enum Candidate {
         window: usize,
         /// Relative ridge ≥ 0.
         ridge: f64,
+        /// Whether the model has a constant term `c` added to every
+        /// increment ([`super::model`]).
+        bias: bool,
     },
 }
 
 impl fmt::Display for Candidate {
     /// A short name: `hold`, `command`, `rls 2,2,0 λ=0.99`, `ls 2,2,0 W=100`
-    /// (with the ridge if any: `ls 2,2,0 W=100 ρ=1e-6`).
+    /// (with the ridge if any: `ls 2,2,0 W=100 ρ=1e-6`; with a constant
+    /// term: `rls 2,2,0+c λ=0.99`, `ls 2,2,0+c W=100`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Candidate::Hold => f.write_str("hold"),
             Candidate::Command => f.write_str("command"),
-            Candidate::Recursive { orders: o, lambda } => {
-                write!(f, "rls {},{},{} λ={lambda}", o.na, o.nb, o.nk)
+            Candidate::Recursive {
+                orders: o,
+                lambda,
+                bias,
+            } => {
+                let c = if *bias { "+c" } else { "" };
+                write!(f, "rls {},{},{}{c} λ={lambda}", o.na, o.nb, o.nk)
             }
             Candidate::Windowed {
                 orders: o,
                 window,
                 ridge,
+                bias,
             } => {
-                write!(f, "ls {},{},{} W={window}", o.na, o.nb, o.nk)?;
+                let c = if *bias { "+c" } else { "" };
+                write!(f, "ls {},{},{}{c} W={window}", o.na, o.nb, o.nk)?;
                 if *ridge > 0.0 {
                     write!(f, " ρ={ridge:e}")?;
                 }
@@ -84,6 +105,21 @@ impl Candidate {
                 Some(*orders)
             }
         }
+    }
+
+    /// Whether the model has a constant term (bias).
+    pub fn has_bias(&self) -> bool {
+        matches!(
+            self,
+            Candidate::Recursive { bias: true, .. } | Candidate::Windowed { bias: true, .. }
+        )
+    }
+
+    /// Number of estimated parameters (`na − 1 + nb`, plus one with a
+    /// constant term; 0 for hold and command).
+    pub(crate) fn n_params(&self) -> usize {
+        self.orders()
+            .map_or(0, |o| model::n_free(&o) + usize::from(self.has_bias()))
     }
 
     /// Samples needed before the first regression row.
@@ -132,8 +168,11 @@ impl Candidate {
 #[derive(Debug, Clone)]
 pub(crate) struct Predictor {
     spec: Candidate,
-    /// Free parameters of the unit-gain model.
+    /// Free parameters of the unit-gain model, then (with a bias) the
+    /// coefficient of the constant column.
     theta: Vec<f64>,
+    /// Number of free parameters of the unit-gain model (without the bias).
+    n_model: usize,
     /// Whether the model has been fitted (hold and command: always).
     fitted: bool,
     state: State,
@@ -158,6 +197,12 @@ struct Recursive {
     avx: bool,
 }
 
+/// With a bias, the value of the constant column (`scale`) and its
+/// coefficient `θ_c` give `c = θ_c·scale`; 0 without a bias.
+fn constant_of(theta: &[f64], n_model: usize, scale: f64) -> f64 {
+    theta.get(n_model).map_or(0.0, |t| t * scale)
+}
+
 /// Least squares over the last `W/2 … W` samples without downdating: two
 /// triangular factors of `[Ψ t]` grown by Givens rotations, the older one
 /// (which started `W/2` rows earlier) fitted, replaced by the newer one
@@ -174,12 +219,16 @@ struct Windowed {
     small: Vec<f64>,
     rhs: Vec<f64>,
     tail: Vec<f64>,
+    /// Value of the constant column (bias only): the largest regressor or
+    /// target of the first informative window (0 until it arrived).
+    scale: f64,
 }
 
 impl Predictor {
     /// A fresh predictor (the settings are validated by the caller).
     pub(crate) fn new(spec: Candidate) -> Self {
-        let n = spec.orders().map_or(0, |o| model::n_free(&o));
+        let n = spec.n_params();
+        let n_model = spec.orders().map_or(0, |o| model::n_free(&o));
         let state = match spec {
             Candidate::Hold | Candidate::Command => State::Plain,
             Candidate::Recursive { .. } => State::Recursive(Box::new(Recursive {
@@ -199,11 +248,13 @@ impl Predictor {
                 small: vec![0.0; n * n],
                 rhs: vec![0.0; n],
                 tail: vec![0.0; n],
+                scale: 0.0,
             })),
         };
         let mut p = Self {
             spec,
             theta: vec![0.0; n],
+            n_model,
             fitted: false,
             state,
         };
@@ -216,9 +267,20 @@ impl Predictor {
         &self.spec
     }
 
-    /// Free parameters of the unit-gain model (empty for hold and command).
+    /// Free parameters of the unit-gain model (empty for hold and command;
+    /// without the constant term).
     pub(crate) fn theta(&self) -> &[f64] {
-        &self.theta
+        &self.theta[..self.n_model]
+    }
+
+    /// The constant `c` added to every increment, in the unit of the
+    /// recording per sample (0 without a bias).
+    pub(crate) fn constant(&self) -> f64 {
+        match &self.state {
+            State::Recursive(r) => constant_of(&self.theta, self.n_model, r.scale),
+            State::Windowed(l) => constant_of(&self.theta, self.n_model, l.scale),
+            State::Plain => 0.0,
+        }
     }
 
     /// Forget the model but keep the position in the data (a model that
@@ -249,6 +311,7 @@ impl Predictor {
             }
             State::Windowed(l) => {
                 l.cursor = None;
+                l.scale = 0.0;
                 for f in &mut l.factors {
                     f.fill(0.0);
                 }
@@ -267,6 +330,8 @@ impl Predictor {
         };
         let lag = model::lag(&o);
         let first = signals.offset() + lag;
+        let bias = self.spec.has_bias();
+        let nm = self.n_model;
         match (&mut self.state, self.spec) {
             (State::Recursive(r), Candidate::Recursive { lambda, .. }) => {
                 let mut cursor = r.cursor.unwrap_or(start.max(first));
@@ -285,18 +350,22 @@ impl Predictor {
                 let n = self.theta.len();
                 let rows = lag..lag + (end - cursor);
                 if r.scale == 0.0 {
-                    r.scale = largest_row_entry(&o, y, u, rows.clone(), &mut r.psi);
+                    r.scale = largest_row_entry(&o, y, u, rows.clone(), &mut r.psi[..nm]);
                 }
                 if r.scale > 0.0 {
                     let inv = 1.0 / r.scale;
                     let max_trace = n as f64 * P0;
                     for k in rows {
-                        let t = model::row(&o, y, u, k, &mut r.psi);
-                        if t == 0.0 && r.psi.iter().all(|&v| v == 0.0) {
+                        let t = model::row(&o, y, u, k, &mut r.psi[..nm]);
+                        if t == 0.0 && r.psi[..nm].iter().all(|&v| v == 0.0) {
                             continue;
                         }
-                        for v in r.psi.iter_mut() {
+                        for v in r.psi[..nm].iter_mut() {
                             *v *= inv;
+                        }
+                        if bias {
+                            // the column `scale`, in scaled coordinates
+                            r.psi[nm] = 1.0;
                         }
                         let _ = rls_update(
                             r.avx,
@@ -328,6 +397,7 @@ impl Predictor {
                         f.fill(0.0);
                     }
                     l.rows = [0, 0];
+                    l.scale = 0.0;
                     cursor = start.max(first).min(end);
                 }
                 let Ok(w) = signals.window(cursor..end, lag, "auto candidate") else {
@@ -336,10 +406,21 @@ impl Predictor {
                 let (y, u) = (w.position, w.command);
                 let n = self.theta.len();
                 let half = (window / 2).max(1);
-                for k in lag..lag + (end - cursor) {
-                    let t = model::row(&o, y, u, k, &mut l.psi);
-                    if t == 0.0 && l.psi.iter().all(|&v| v == 0.0) {
+                let rows = lag..lag + (end - cursor);
+                if bias && l.scale == 0.0 {
+                    l.scale = largest_row_entry(&o, y, u, rows.clone(), &mut l.psi[..nm]);
+                }
+                for k in rows {
+                    let t = model::row(&o, y, u, k, &mut l.psi[..nm]);
+                    if t == 0.0 && l.psi[..nm].iter().all(|&v| v == 0.0) {
                         continue;
+                    }
+                    if bias {
+                        // the column `scale` (no row before it is known)
+                        if l.scale == 0.0 {
+                            continue;
+                        }
+                        l.psi[nm] = l.scale;
                     }
                     for f in &mut l.factors {
                         l.row[..n].copy_from_slice(&l.psi);
@@ -395,6 +476,7 @@ impl Predictor {
                 out.copy_from_slice(w.command);
             }
             Candidate::Recursive { orders, .. } | Candidate::Windowed { orders, .. } => {
+                let c = self.constant();
                 if !self.fitted {
                     return Err(Error::Singular {
                         context: "auto candidate (not fitted yet)",
@@ -406,7 +488,16 @@ impl Predictor {
                 if past.len() < need {
                     past.resize(need, 0.0);
                 }
-                model::predict(&orders, &self.theta, w.position, w.command, lag, past, out);
+                model::predict(
+                    &orders,
+                    &self.theta[..self.n_model],
+                    c,
+                    w.position,
+                    w.command,
+                    lag,
+                    past,
+                    out,
+                );
             }
         }
         if out.iter().all(|v| v.is_finite()) {
@@ -542,5 +633,133 @@ fn largest_row_entry(
         m
     } else {
         0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `y[k] = 1.5 y[k−1] − 0.6 y[k−2] + 0.05 u[k] + 0.05 u[k−1] + d` (unit DC
+    /// gain, a constant disturbance `d` per sample), in `unit`s, `offset` away.
+    fn system(n: usize, d: f64, offset: f64, unit: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let u0: Vec<f64> = (0..n)
+            .map(|k| {
+                let k = k as f64;
+                1e-3 * ((k * 0.07).sin() + (k * 0.011).cos() + 0.3 * (k * 1.3).sin())
+            })
+            .collect();
+        let mut y0 = vec![0.0; n];
+        for k in 2..n {
+            y0[k] = 1.5 * y0[k - 1] - 0.6 * y0[k - 2] + 0.05 * u0[k] + 0.05 * u0[k - 1] + d;
+        }
+        let map = |v: &f64| (v + offset) * unit;
+        (
+            t,
+            u0.iter().map(map).collect(),
+            y0.iter().map(map).collect(),
+        )
+    }
+
+    fn windowed(bias: bool) -> Candidate {
+        Candidate::Windowed {
+            orders: ArxOrders::new(2, 2, 0),
+            window: 100,
+            ridge: 0.0,
+            bias,
+        }
+    }
+
+    /// Fit on samples `10..end`, predict `end..end + 10`.
+    fn fit_predict(
+        c: Candidate,
+        data: &(Vec<f64>, Vec<f64>, Vec<f64>),
+        end: usize,
+    ) -> (Predictor, [f64; 10]) {
+        let (t, u, y) = data;
+        let s = Signals::new(t, u, y, 1e-3, 0.0);
+        let mut p = Predictor::new(c);
+        assert!(p.fit(&s, 10, end));
+        let mut out = [0.0; 10];
+        p.predict(&s, end..end + 10, &mut Vec::new(), &mut out)
+            .unwrap();
+        (p, out)
+    }
+
+    #[test]
+    fn a_constant_disturbance_is_fitted_and_predicted_exactly() {
+        let d = 2e-6;
+        let data = system(400, d, 0.0, 1.0);
+        let (p, out) = fit_predict(windowed(true), &data, 300);
+        let theta = p.theta();
+        for (a, b) in theta.iter().zip([0.6, 0.05, 0.05]) {
+            assert!((a - b).abs() < 1e-8, "θ {theta:?}");
+        }
+        assert!((p.constant() - d).abs() < 1e-12, "c {}", p.constant());
+        for (h, v) in out.iter().enumerate() {
+            assert!((v - data.2[300 + h]).abs() < 1e-12, "step {h}");
+        }
+        // without the constant the same model is not exact
+        let (_, plain) = fit_predict(windowed(false), &data, 300);
+        let worst = plain
+            .iter()
+            .enumerate()
+            .map(|(h, v)| (v - data.2[300 + h]).abs())
+            .fold(0.0, f64::max);
+        assert!(worst > 1e-8, "{worst}");
+    }
+
+    #[test]
+    fn the_recursive_candidate_with_a_constant_learns_the_disturbance() {
+        let d = 2e-6;
+        let data = system(2000, d, 0.0, 1.0);
+        let c = Candidate::Recursive {
+            orders: ArxOrders::new(2, 2, 0),
+            lambda: 1.0,
+            bias: true,
+        };
+        let (p, out) = fit_predict(c, &data, 1900);
+        assert!((p.constant() - d).abs() < 1e-3 * d, "c {}", p.constant());
+        for (h, v) in out.iter().enumerate() {
+            assert!((v - data.2[1900 + h]).abs() < 1e-9, "step {h}");
+        }
+    }
+
+    #[test]
+    fn an_offset_changes_nothing_and_a_unit_scales_the_constant() {
+        let d = 2e-6;
+        for c in [
+            windowed(true),
+            Candidate::Windowed {
+                orders: ArxOrders::new(3, 3, 0),
+                window: 60,
+                ridge: 1e-3,
+                bias: true,
+            },
+            Candidate::Recursive {
+                orders: ArxOrders::new(3, 3, 0),
+                lambda: 0.99,
+                bias: true,
+            },
+        ] {
+            let base = system(400, d, 0.0, 1.0);
+            let (p0, out0) = fit_predict(c, &base, 300);
+            let shift = 1.0;
+            let (p1, out1) = fit_predict(c, &system(400, d, shift, 1.0), 300);
+            assert!((p0.constant() - p1.constant()).abs() < 1e-4 * d, "{c}");
+            for (a, b) in out0.iter().zip(&out1) {
+                assert!((a + shift - b).abs() < 1e-9, "{c}: {a} {b}");
+            }
+            let unit = 1e6; // µm
+            let (p2, out2) = fit_predict(c, &system(400, d, 0.0, unit), 300);
+            assert!(
+                (p0.constant() * unit - p2.constant()).abs() < 1e-9 * unit,
+                "{c}"
+            );
+            for (a, b) in out0.iter().zip(&out2) {
+                assert!((a * unit - b).abs() < 1e-9 * unit, "{c}: {a} {b}");
+            }
+        }
     }
 }

@@ -40,12 +40,19 @@ impl AutoConfig {
         let rls = |na, nb, lambda| Candidate::Recursive {
             orders: ArxOrders::new(na, nb, 0),
             lambda,
+            bias: false,
         };
         vec![
             Candidate::Windowed {
                 orders: ArxOrders::new(2, 2, 0),
                 window: 100,
                 ridge: 1e-6,
+                bias: false,
+            },
+            Candidate::Recursive {
+                orders: ArxOrders::new(3, 3, 0),
+                lambda: 0.99,
+                bias: true,
             },
             rls(3, 3, 0.995),
             rls(4, 4, 0.999),

@@ -23,6 +23,10 @@
 //!
 //! - `ls 2,2,0 W=100 ρ=1e-6`: least squares over the last 100 samples,
 //!   refitted at every window (short memory, quick after a change);
+//! - `rls 3,3,0+c λ=0.99`: recursive least squares (memory ≈ 100 samples)
+//!   of the model plus a constant increment `c` (a constant disturbance:
+//!   friction during a one-directional move, gravity, a following-error
+//!   bias; see module `model`);
 //! - `rls 3,3,0 λ=0.995`, `rls 4,4,0 λ=0.999`, `rls 6,6,0 λ=0.999`,
 //!   `rls 8,8,0 λ=0.9995`: exponentially weighted recursive least squares
 //!   (memories of 200 to 2000 samples, low to high orders).

@@ -22,6 +22,20 @@
 //! leaves `θ` unchanged. `θ = 0` is the hold predictor. The k-step
 //! prediction runs the same equation forward from the last measured
 //! position, on the known command, feeding back its own predictions.
+//!
+//! A candidate may add a constant `c` to every increment (a *bias*: a
+//! constant disturbance such as friction during a one-directional move,
+//! gravity, or a following-error bias),
+//!
+//! ```text
+//! y[k] − y[k−1] = ψ[k]ᵀθ + c.
+//! ```
+//!
+//! The target is a difference of positions, so `c` is a speed (a length per
+//! sample): it cancels no offset, an offset still changes nothing, and a
+//! change of unit scales it like the target. The candidates append its
+//! column to `ψ` with a value fixed from the data (see `candidate`); the
+//! prediction adds `c` at every step.
 
 // Index loops mirror the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -55,11 +69,14 @@ pub(crate) fn row(o: &ArxOrders, y: &[f64], u: &[f64], k: usize, psi: &mut [f64]
 }
 
 /// k-step prediction of `out.len()` samples from the local index `e`: `y`
-/// measured below `e`, `u` known up to `e + out.len()`; `past` a scratch of
-/// length `≥ na + out.len()`.
+/// measured below `e`, `u` known up to `e + out.len()`; `c` the constant
+/// added to every increment (0 without a bias); `past` a scratch of length
+/// `≥ na + out.len()`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn predict(
     o: &ArxOrders,
     theta: &[f64],
+    c: f64,
     y: &[f64],
     u: &[f64],
     e: usize,
@@ -83,7 +100,7 @@ pub(crate) fn predict(
             v += theta[p] * (u[t - o.nk - j] - rho);
             p += 1;
         }
-        let yh = rho + v;
+        let yh = rho + v + c;
         past[na + h] = yh;
         out[h] = yh;
     }
@@ -142,7 +159,7 @@ mod tests {
         let (u, y) = system(200, 0.0);
         let mut out = [0.0; 10];
         let mut past = [0.0; 12];
-        predict(&o, &theta, &y, &u, 150, &mut past, &mut out);
+        predict(&o, &theta, 0.0, &y, &u, 150, &mut past, &mut out);
         let mut reference = [0.0; 10];
         let mut past2 = [0.0; 12];
         predict_k_step(
@@ -183,8 +200,8 @@ mod tests {
             }
         }
         let (mut a, mut b) = ([0.0; 10], [0.0; 10]);
-        predict(&o, &theta, &y0, &u0, 80, &mut [0.0; 13], &mut a);
-        predict(&o, &theta, &y1, &u1, 80, &mut [0.0; 13], &mut b);
+        predict(&o, &theta, 0.0, &y0, &u0, 80, &mut [0.0; 13], &mut a);
+        predict(&o, &theta, 0.0, &y1, &u1, 80, &mut [0.0; 13], &mut b);
         for (a, b) in a.iter().zip(&b) {
             assert!((a + shift - b).abs() < 1e-12);
         }
@@ -195,7 +212,7 @@ mod tests {
         let o = ArxOrders::new(2, 3, 0);
         let (u, y) = system(50, 0.0);
         let mut out = [0.0; 5];
-        predict(&o, &[0.0; 4], &y, &u, 40, &mut [0.0; 7], &mut out);
+        predict(&o, &[0.0; 4], 0.0, &y, &u, 40, &mut [0.0; 7], &mut out);
         assert!(out.iter().all(|&v| v == y[39]));
     }
 }

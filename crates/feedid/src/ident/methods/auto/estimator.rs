@@ -110,8 +110,6 @@ pub struct AutoEstimator {
     experience: f64,
     /// Samples below this index are in `experience`.
     experienced_to: usize,
-    /// Mean squared error of holding the last position over the backtest.
-    hold_trial: Option<f64>,
     /// Hold at the first prediction: holding backtested better than the
     /// first choice.
     hold_first: bool,
@@ -136,7 +134,6 @@ impl AutoEstimator {
             horizon: 10,
             experience: 0.0,
             experienced_to: 0,
-            hold_trial: None,
             hold_first: false,
         }
     }
@@ -175,15 +172,8 @@ impl AutoEstimator {
             let to = (m.pending_start + m.pending_len).min(end);
             if let (true, Ok(w)) = (to > from, signals.window(from..to, 0, "auto scoring")) {
                 let p = &m.pending[from - m.pending_start..to - m.pending_start];
-                let mse = w
-                    .position
-                    .iter()
-                    .zip(p)
-                    .map(|(a, b)| (a - b) * (a - b))
-                    .sum::<f64>()
-                    / (to - from) as f64;
                 let r = m.pending_regime;
-                if mse.is_finite() {
+                if let Some(mse) = mean_square_error(w.position, p.iter().copied()) {
                     m.score[r] = if m.scored[r] == 0 {
                         mse
                     } else {
@@ -220,17 +210,18 @@ impl AutoEstimator {
     /// sample: fitted on `start..end − H`, predicting `end − H..end`
     /// (measured), so that the first choice is not blind. Needs `2·H`
     /// samples in the first window; without them nothing is scored yet.
-    fn backtest(&mut self, signals: &Signals<'_>, start: usize, end: usize) {
+    /// Returns the mean squared error of holding the last position there.
+    fn backtest(&mut self, signals: &Signals<'_>, start: usize, end: usize) -> Option<f64> {
         let h = self.horizon;
         if end < start + 2 * h {
-            return;
+            return None;
         }
         let split = end - h;
-        let Ok(measured) = signals.window(split..end, 0, "auto backtest") else {
-            return;
-        };
-        let measured = measured.position;
-        self.hold_trial = last_position(signals, start..split)
+        let measured = signals
+            .window(split..end, 0, "auto backtest")
+            .ok()?
+            .position;
+        let hold = last_position(signals, start..split)
             .ok()
             .and_then(|last| mean_square_error(measured, std::iter::repeat(last)));
         for m in &mut self.members {
@@ -254,6 +245,7 @@ impl AutoEstimator {
                 m.trial = mean_square_error(measured, buf.iter().copied());
             }
         }
+        hold
     }
 
     /// The ready candidate with the lowest score in the current regime
@@ -370,7 +362,6 @@ impl Estimator for AutoEstimator {
         self.regime = 2;
         self.experience = 0.0;
         self.experienced_to = 0;
-        self.hold_trial = None;
         self.hold_first = false;
     }
 
@@ -392,19 +383,18 @@ impl Estimator for AutoEstimator {
         self.regime = regime(signals, window.start, window.end, self.horizon);
         let first_fit = self.start.is_none();
         let start = *self.start.get_or_insert(window.start);
-        if first_fit {
-            self.backtest(signals, start, window.end);
-        }
+        let hold_trial = if first_fit {
+            self.backtest(signals, start, window.end)
+        } else {
+            None
+        };
         for m in &mut self.members {
             m.ready = m.predictor.fit(signals, start, window.end);
         }
         self.selected = self.choose();
         // hold first unless the first choice backtested better than holding
         self.hold_first = first_fit
-            && match (
-                self.selected.map(|c| self.members[c].trial),
-                self.hold_trial,
-            ) {
+            && match (self.selected.map(|c| self.members[c].trial), hold_trial) {
                 (Some(Some(c)), Some(hold)) => hold <= c,
                 (_, Some(_)) => true,
                 _ => false,

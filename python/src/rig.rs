@@ -109,22 +109,6 @@ fn quality(file: &ModelFile) -> ModelQuality {
     }
 }
 
-/// The model's fits measured on a check recording (`feedid compensate
-/// --check`): its sample time must be the model's.
-fn checked_quality(file: &ModelFile, check: &Recording) -> PyResult<ModelQuality> {
-    if let feedid::ident::LinearModel::Discrete { dt, .. } = &file.model {
-        if (check.dt() - dt).abs() > 1e-6 * dt {
-            return Err(input(format!(
-                "check: sample time {} s differs from the model's {} s",
-                check.dt(),
-                dt
-            )));
-        }
-    }
-    ModelQuality::from_run(&file.model, check.command(), check.position(), check.dt())
-        .map_err(|e| input(format!("check: {e}")))
-}
-
 /// The command that makes a model follow `desired` (`feedid compensate`):
 /// returns `(command, predicted, summary_json)`.
 #[pyfunction]
@@ -175,7 +159,8 @@ pub fn compensate<'py>(
         (Some(text), _) => {
             let file = ModelFile::from_json(&text).py_err()?;
             cfg.quality = match check {
-                Some(c) => checked_quality(&file, &c.get().inner)?,
+                Some(c) => ModelQuality::from_recording(&file.model, &c.get().inner)
+                    .map_err(|e| input(format!("check: {e}")))?,
                 None => quality(&file),
             };
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))
@@ -185,7 +170,8 @@ pub fn compensate<'py>(
             let text = feedid::io::read_small_text(Path::new(&path)).py_err()?;
             let file = ModelFile::from_json_file(&text, Path::new(&path)).py_err()?;
             cfg.quality = match check {
-                Some(c) => checked_quality(&file, &c.get().inner)?,
+                Some(c) => ModelQuality::from_recording(&file.model, &c.get().inner)
+                    .map_err(|e| input(format!("check: {e}")))?,
                 None => quality(&file),
             };
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))

@@ -25,6 +25,15 @@ pub enum Error {
         actual: usize,
     },
 
+    /// A recording's sample time differs from a discrete model's.
+    #[error("sample time {actual} s differs from the model's {model} s")]
+    SampleTimeMismatch {
+        /// The model's sample time \[s\].
+        model: f64,
+        /// The recording's mean sample interval \[s\].
+        actual: f64,
+    },
+
     /// Not enough samples for the requested operation.
     #[error("too few samples for {what}: need at least {needed}, got {actual}")]
     TooFewSamples {

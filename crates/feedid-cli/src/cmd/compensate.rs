@@ -82,19 +82,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             cfg.quality = match &a.check {
                 Some(check) => {
                     let r = read_recording(check, &ReadOptions::default())?;
-                    let model_dt = match &file.model {
-                        feedid::ident::LinearModel::Discrete { dt, .. } => *dt,
-                        feedid::ident::LinearModel::Continuous { .. } => r.dt(),
-                    };
-                    if (r.dt() - model_dt).abs() > 1e-6 * model_dt {
-                        anyhow::bail!(
-                            "{}: sample time {} s differs from the model's {} s",
-                            check.display(),
-                            r.dt(),
-                            model_dt
-                        );
-                    }
-                    ModelQuality::from_run(&file.model, r.command(), r.position(), r.dt())
+                    ModelQuality::from_recording(&file.model, &r)
                         .map_err(|e| anyhow::anyhow!("{}: {e}", check.display()))?
                 }
                 None => ModelQuality {

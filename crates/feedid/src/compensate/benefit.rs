@@ -37,6 +37,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::ident::LinearModel;
+use crate::recording::Recording;
 
 /// How well a model reproduces the axis (free run over a recording).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -48,6 +49,24 @@ pub struct ModelQuality {
 }
 
 impl ModelQuality {
+    /// [`ModelQuality::from_run`] on a check recording of the axis, whose
+    /// sampling must be a discrete model's (else
+    /// [`Error::SampleTimeMismatch`]).
+    pub fn from_recording<S: AsRef<[f64]>>(
+        model: &LinearModel,
+        check: &Recording<S>,
+    ) -> Result<Self> {
+        if let LinearModel::Discrete { dt, .. } = model {
+            if (check.dt() - dt).abs() > 1e-6 * dt {
+                return Err(Error::SampleTimeMismatch {
+                    model: *dt,
+                    actual: check.dt(),
+                });
+            }
+        }
+        Self::from_run(model, check.command(), check.position(), check.dt())
+    }
+
     /// Both fits of `model` run free (deviations from the first sample,
     /// the model rescaled to unit DC gain as the compensation uses it) on
     /// the `command` of a recording of the axis at interval `dt` \[s\],
@@ -217,6 +236,25 @@ impl std::fmt::Display for Fallback {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_check_recording_must_have_the_discrete_models_sample_time() {
+        let m = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+        let u: Vec<f64> = (0..500).map(|k| ((k / 50) % 2) as f64).collect();
+        let y = m.simulate(&u).unwrap();
+        let t = |dt: f64| (0..500).map(|k| k as f64 * dt).collect::<Vec<f64>>();
+        let ok = Recording::new(t(1e-3), u.clone(), y.clone()).unwrap();
+        assert_eq!(
+            ModelQuality::from_recording(&m, &ok).unwrap(),
+            ModelQuality::from_run(&m, &u, &y, 1e-3).unwrap()
+        );
+        let slow = Recording::new(t(2e-3), u, y).unwrap();
+        let e = ModelQuality::from_recording(&m, &slow).unwrap_err();
+        assert!(
+            matches!(e, Error::SampleTimeMismatch { model, actual } if model == 1e-3 && (actual - 2e-3).abs() < 1e-15),
+            "{e}"
+        );
+    }
 
     #[test]
     fn error_fit_measures_the_explained_share_of_the_following_error() {

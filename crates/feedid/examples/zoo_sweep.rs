@@ -247,6 +247,7 @@ fn main() {
             let mut rows = Vec::new();
             for c in &configs {
                 let t = Instant::now();
+                let mut cand = vec![f64::NAN; n];
                 let (p, has) = if c == "arx220frame" {
                     arx220f(&m.command, y, true)
                 } else if let Some(w) = c.strip_prefix("arx220unit") {
@@ -261,11 +262,31 @@ fn main() {
                         warm_up: 0,
                     };
                     match engine::run(&mut est, &s, &cfg) {
-                        Ok(r) => (r.predicted, r.has_prediction),
+                        Ok(r) => {
+                            let nc = r.coefficient_names.len();
+                            for (wi, w) in r.windows.iter().enumerate() {
+                                for k in w.horizon.clone() {
+                                    if nc > 0 && k < n {
+                                        cand[k] = r.coefficients[wi * nc];
+                                    }
+                                }
+                            }
+                            (r.predicted, r.has_prediction)
+                        }
                         Err(_) => (vec![0.0; n], vec![false; n]),
                     }
                 };
                 let secs = t.elapsed().as_secs_f64();
+                if let Ok(d) = std::env::var("ZOO_SWEEP_DUMP") {
+                    let mut text = String::from("k,u,y,p,has,arx220,cand\n");
+                    for k in 0..n {
+                        text += &format!(
+                            "{k},{},{},{},{},{},{}\n",
+                            m.command[k], y[k], p[k], has[k] as u8, bv[k], cand[k]
+                        );
+                    }
+                    std::fs::write(format!("{d}-{i}.csv"), text).unwrap();
+                }
                 let (mut se, mut cnt, mut seb, mut cb) = (0.0, 0usize, 0.0, 0usize);
                 for k in 0..n {
                     if has[k] && scored[k] {
@@ -285,8 +306,30 @@ fn main() {
                     }
                 }
                 let _ = cb;
+                // worst ratio to a baseline (command, hold, arx220) on the shared samples
+                let hold_has = |k: usize| k >= H;
+                let hold_at = |k: usize| y[k - 1 - (k - H) % H];
+                let mut worst = 0.0f64;
+                for b in 0..3 {
+                    let (mut sa, mut sb, mut nn) = (0.0, 0.0, 0usize);
+                    for k in 0..n {
+                        let (bh_k, bv_k) = match b {
+                            0 => (true, m.command[k]),
+                            1 => (hold_has(k), if hold_has(k) { hold_at(k) } else { 0.0 }),
+                            _ => (bh[k], bv[k]),
+                        };
+                        if has[k] && scored[k] && bh_k {
+                            sa += (y[k] - p[k]).powi(2);
+                            sb += (y[k] - bv_k).powi(2);
+                            nn += 1;
+                        }
+                    }
+                    if nn >= 50 {
+                        worst = worst.max((sa / sb).sqrt());
+                    }
+                }
                 rows.push(format!(
-                    "{i},\"{c}\",{},{},{},{},{},{secs:.4},{}",
+                    "{i},\"{c}\",{},{},{},{},{},{secs:.4},{},{worst}",
                     if cnt > 0 {
                         (se / cnt as f64).sqrt()
                     } else {
@@ -311,7 +354,7 @@ fn main() {
         })
         .collect();
     let mut text =
-        String::from("member,config,rms,coverage,rms_shared_arx220,arx220_rms,n,secs,plant\n");
+        String::from("member,config,rms,coverage,rms_shared_arx220,arx220_rms,n,secs,plant,worst_baseline_ratio\n");
     for r in rows {
         text += &r;
         text += "\n";

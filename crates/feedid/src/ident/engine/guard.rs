@@ -41,7 +41,12 @@
 //! motion and are kept. The last sample before a fit has no successor yet:
 //! it is an outlier only if its error also exceeds the factor times the
 //! largest change of the position over `H` samples seen so far (a jump no
-//! motion of the recording could make). An outlier is replaced, in what
+//! motion of the recording could make). The measurement itself must also
+//! stand out from its neighbours — depart from the mean of the samples on
+//! both sides (for the last sample: from the sample before it) by at least
+//! half its error — so that a wild *prediction* of a smooth motion (a model
+//! oscillating from one step ahead to the next) never makes the measured
+//! sample an outlier. An outlier is replaced, in what
 //! the estimators see, by its prediction: it is neither fitted nor used as
 //! the start of a prediction, and its error does not join the history. The
 //! measured value is kept for the scores: the statistics of a run are over
@@ -326,8 +331,22 @@ impl Guard {
             } else {
                 self.batch[i - 1].exceeds
             };
+            // the measurement itself must stand out from its neighbours by
+            // half its error: a wild prediction of a smooth motion (an
+            // oscillating model) does not make the measurement an outlier
+            let previous = if i == 0 {
+                self.last
+            } else {
+                Some(self.batch[i - 1].y)
+            };
+            let spike = match (previous, self.batch.get(i + 1)) {
+                (Some(a), Some(b)) => (c.y - 0.5 * (a + b.y)).abs(),
+                (Some(a), None) => (c.y - a).abs(),
+                (None, _) => 0.0,
+            };
             let outlier = c.exceeds
                 && !before
+                && spike > 0.5 * c.excess
                 && if i + 1 < n {
                     !self.batch[i + 1].exceeds
                 } else {
@@ -517,6 +536,31 @@ mod tests {
         // second one is kept (a second wild sample in a row is a change)
         assert!(!replaced.contains(&301), "{replaced:?}");
         assert_eq!(clean[301], y[301]);
+    }
+
+    #[test]
+    fn a_wild_prediction_of_a_smooth_motion_does_not_make_the_measurement_an_outlier() {
+        // a smooth ramp predicted well, then by a model oscillating from
+        // sample to sample (every other step ahead far off): the
+        // measurement is kept, so the estimators never see the wild values
+        let h = 10;
+        let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
+        let y: Vec<f64> = (0..600).map(|k| 1e-3 * k as f64).collect();
+        let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
+        let mut replaced = Vec::new();
+        let mut start = 10;
+        while start + h <= y.len() {
+            g.observe(start, |k| y[k], |k, _| replaced.push(k));
+            let pred: Vec<f64> = (start..start + h)
+                .map(|k| {
+                    let wild = start >= 300 && (k - start) % 2 == 1;
+                    y[k] + if wild { 1.0 } else { 1e-6 * ((k % 3) as f64) }
+                })
+                .collect();
+            g.predicted(start, &pred, y[start - 1], 1e-2, &mut lo, &mut hi);
+            start += h;
+        }
+        assert!(replaced.is_empty(), "{replaced:?}");
     }
 
     #[test]

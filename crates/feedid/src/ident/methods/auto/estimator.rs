@@ -59,6 +59,9 @@ struct Member {
     /// Mean squared error of its backtest on the first window \[m²\]
     /// (decides only whether the first prediction holds instead).
     trial: Option<f64>,
+    /// Its pending prediction departs from the candidates' consensus
+    /// ([`AutoConfig::consensus`]): it does not predict this horizon.
+    dissents: bool,
 }
 
 impl Member {
@@ -74,6 +77,7 @@ impl Member {
             scored: [0; REGIMES],
             ready: false,
             trial: None,
+            dissents: false,
         }
     }
 
@@ -113,11 +117,16 @@ pub struct AutoEstimator {
     /// Hold at the first prediction: holding backtested better than the
     /// first choice.
     hold_first: bool,
+    /// Scratch of the consensus: the candidates' predictions at one step,
+    /// and the median prediction over the horizon.
+    column: Vec<f64>,
+    median: Vec<f64>,
 }
 
 impl AutoEstimator {
     pub(super) fn new(config: AutoConfig) -> Self {
-        let members = config.candidates.iter().map(|&c| Member::new(c)).collect();
+        let members: Vec<Member> = config.candidates.iter().map(|&c| Member::new(c)).collect();
+        let n_members = members.len();
         let reported = config.reported();
         let n_arx = reported
             .and_then(|r| config.candidates[r].orders())
@@ -135,6 +144,8 @@ impl AutoEstimator {
             experience: 0.0,
             experienced_to: 0,
             hold_first: false,
+            column: Vec::with_capacity(n_members),
+            median: Vec::new(),
         }
     }
 
@@ -248,6 +259,55 @@ impl AutoEstimator {
         hold
     }
 
+    /// Mark the candidates whose pending prediction (of `h` samples)
+    /// departs from the median of all pending predictions, at some step, by
+    /// more than [`AutoConfig::consensus`] times their own recent rms error
+    /// (at least `1e-9` of the experienced motion, so that exact models of
+    /// noise-free data agree). With fewer than three predictions there is
+    /// no consensus to depart from.
+    fn mark_dissent(&mut self, h: usize) {
+        let r = self.regime;
+        let k = self.config.consensus;
+        for m in &mut self.members {
+            m.dissents = false;
+        }
+        let pending = self.members.iter().filter(|m| m.pending_len == h).count();
+        if pending < 3 || !k.is_finite() {
+            return;
+        }
+        if self.median.len() < h {
+            self.median.resize(h, 0.0);
+        }
+        for j in 0..h {
+            self.column.clear();
+            self.column.extend(
+                self.members
+                    .iter()
+                    .filter(|m| m.pending_len == h)
+                    .map(|m| m.pending[j]),
+            );
+            self.column.sort_unstable_by(f64::total_cmp);
+            let c = self.column.len();
+            self.median[j] = if c % 2 == 1 {
+                self.column[c / 2]
+            } else {
+                0.5 * (self.column[c / 2 - 1] + self.column[c / 2])
+            };
+        }
+        let floor = 1e-9 * self.experience;
+        let median = &self.median[..h];
+        for m in self.members.iter_mut().filter(|m| m.pending_len == h) {
+            let Some(score) = m.score_in(r) else {
+                continue;
+            };
+            let limit = k * score.sqrt().max(floor);
+            m.dissents = m.pending[..h]
+                .iter()
+                .zip(median)
+                .any(|(p, q)| (p - q).abs() > limit || (p - q).is_nan());
+        }
+    }
+
     /// The ready candidate with the lowest score in the current regime
     /// (unscored candidates last); ties ([`TIE`]) keep the previous choice,
     /// else the first in the order of the settings.
@@ -356,6 +416,7 @@ impl Estimator for AutoEstimator {
             m.scored = [0; REGIMES];
             m.ready = false;
             m.trial = None;
+            m.dissents = false;
         }
         self.selected = None;
         self.start = None;
@@ -418,7 +479,8 @@ impl Estimator for AutoEstimator {
     }
 
     /// The chosen candidate's prediction; if it cannot predict (or its
-    /// prediction is implausible), the best-scored candidate that can.
+    /// prediction is implausible or departs from the candidates'
+    /// consensus), the best-scored candidate that can.
     fn predict(
         &mut self,
         signals: &Signals<'_>,
@@ -453,7 +515,8 @@ impl Estimator for AutoEstimator {
                 m.ready = false;
             }
         }
-        let usable = |m: &Member| m.pending_len == h;
+        self.mark_dissent(h);
+        let usable = |m: &Member| m.pending_len == h && !m.dissents;
         let chosen = match self.selected {
             _ if self.hold_first => None,
             Some(c) if usable(&self.members[c]) => Some(c),
@@ -541,6 +604,91 @@ mod tests {
         let (u, _, r) = run_command_only(0.0);
         for k in r.windows[0].horizon.clone() {
             assert_eq!(r.predicted[k], u[k], "sample {k}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod consensus_tests {
+    use super::*;
+
+    /// An `auto` with `n` plain candidates whose pending predictions over a
+    /// horizon of 10 are the constants `values`, scored with rms errors `rms`
+    /// (`None`: unscored).
+    fn with_pending(values: &[f64], rms: &[Option<f64>], consensus: f64) -> AutoEstimator {
+        let config = AutoConfig {
+            candidates: vec![Candidate::Hold; values.len()],
+            consensus,
+            ..AutoConfig::default()
+        };
+        let mut est = config.build().unwrap();
+        est.experience = 1.0;
+        est.regime = 1;
+        for ((m, &v), &e) in est.members.iter_mut().zip(values).zip(rms) {
+            m.pending = vec![v; 10];
+            m.pending_len = 10;
+            if let Some(e) = e {
+                m.score[1] = e * e;
+                m.scored[1] = 1;
+            }
+        }
+        est
+    }
+
+    fn dissenters(est: &AutoEstimator) -> Vec<usize> {
+        (0..est.members.len())
+            .filter(|&i| est.members[i].dissents)
+            .collect()
+    }
+
+    #[test]
+    fn a_prediction_far_from_the_median_beyond_its_own_error_dissents() {
+        // median 1.015; limit 20 × 0.01 = 0.2: only the 5.0 dissents
+        let rms = [Some(0.01); 4];
+        let mut est = with_pending(&[1.0, 1.01, 1.02, 5.0], &rms, 20.0);
+        est.mark_dissent(10);
+        assert_eq!(dissenters(&est), vec![3]);
+        // the same prediction by a candidate whose errors are that large agrees
+        let mut est = with_pending(
+            &[1.0, 1.01, 1.02, 5.0],
+            &[Some(0.01), Some(0.01), Some(0.01), Some(0.5)],
+            20.0,
+        );
+        est.mark_dissent(10);
+        assert!(dissenters(&est).is_empty());
+        // an unscored candidate is never held against the consensus
+        let mut est = with_pending(
+            &[1.0, 1.01, 1.02, 5.0],
+            &[Some(0.01), Some(0.01), Some(0.01), None],
+            20.0,
+        );
+        est.mark_dissent(10);
+        assert!(dissenters(&est).is_empty());
+    }
+
+    #[test]
+    fn no_consensus_with_fewer_than_three_predictions_or_when_disabled() {
+        let mut est = with_pending(&[1.0, 5.0], &[Some(0.01); 2], 20.0);
+        est.mark_dissent(10);
+        assert!(dissenters(&est).is_empty());
+        let mut est = with_pending(&[1.0, 1.01, 1.02, 5.0], &[Some(0.01); 4], f64::INFINITY);
+        est.mark_dissent(10);
+        assert!(dissenters(&est).is_empty());
+        // one candidate that is not pending leaves two: no consensus
+        let mut est = with_pending(&[1.0, 1.01, 5.0], &[Some(0.01); 3], 20.0);
+        est.members[0].pending_len = 0;
+        est.mark_dissent(10);
+        assert!(dissenters(&est).is_empty());
+    }
+
+    #[test]
+    fn a_non_positive_consensus_factor_is_refused() {
+        for c in [0.0, -1.0, f64::NAN] {
+            let config = AutoConfig {
+                consensus: c,
+                ..AutoConfig::default()
+            };
+            assert!(config.validate().is_err(), "{c}");
         }
     }
 }

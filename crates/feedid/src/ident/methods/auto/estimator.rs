@@ -59,9 +59,6 @@ struct Member {
     /// Mean squared error of its backtest on the first window \[m²\]
     /// (decides only whether the first prediction holds instead).
     trial: Option<f64>,
-    /// Its pending prediction departs from the candidates' consensus
-    /// ([`AutoConfig::consensus`]): it does not predict this horizon.
-    dissents: bool,
 }
 
 impl Member {
@@ -77,7 +74,6 @@ impl Member {
             scored: [0; REGIMES],
             ready: false,
             trial: None,
-            dissents: false,
         }
     }
 
@@ -117,16 +113,11 @@ pub struct AutoEstimator {
     /// Hold at the first prediction: holding backtested better than the
     /// first choice.
     hold_first: bool,
-    /// Scratch of the consensus: the candidates' predictions at one step,
-    /// and the median prediction over the horizon.
-    column: Vec<f64>,
-    median: Vec<f64>,
 }
 
 impl AutoEstimator {
     pub(super) fn new(config: AutoConfig) -> Self {
-        let members: Vec<Member> = config.candidates.iter().map(|&c| Member::new(c)).collect();
-        let n_members = members.len();
+        let members = config.candidates.iter().map(|&c| Member::new(c)).collect();
         let reported = config.reported();
         let n_arx = reported
             .and_then(|r| config.candidates[r].orders())
@@ -144,8 +135,6 @@ impl AutoEstimator {
             experience: 0.0,
             experienced_to: 0,
             hold_first: false,
-            column: Vec::with_capacity(n_members),
-            median: Vec::new(),
         }
     }
 
@@ -259,53 +248,41 @@ impl AutoEstimator {
         hold
     }
 
-    /// Mark the candidates whose pending prediction (of `h` samples)
-    /// departs from the median of all pending predictions, at some step, by
-    /// more than [`AutoConfig::consensus`] times their own recent rms error
-    /// (at least `1e-9` of the experienced motion, so that exact models of
-    /// noise-free data agree). With fewer than three predictions there is
-    /// no consensus to depart from.
-    fn mark_dissent(&mut self, h: usize) {
-        let r = self.regime;
+    /// Whether candidate `i`'s pending prediction (of `h` samples)
+    /// departs from the candidates' consensus: at some step, more than half
+    /// of the pending predictions (its own included) lie on one side of it
+    /// by more than [`AutoConfig::consensus`] times its recent rms error (at
+    /// least `1e-9` of the experienced motion, so that exact models of
+    /// noise-free data agree) — with an odd count, its distance from their
+    /// median exceeds that. Never with fewer than three pending predictions,
+    /// nor for an unscored candidate.
+    fn dissents(&self, i: usize, h: usize) -> bool {
         let k = self.config.consensus;
-        for m in &mut self.members {
-            m.dissents = false;
+        let me = &self.members[i];
+        let Some(score) = me.score_in(self.regime) else {
+            return false;
+        };
+        let pending = self.members.iter().filter(|m| m.pending_len == h);
+        let count = pending.clone().count();
+        if count < 3 || !k.is_finite() || me.pending_len != h {
+            return false;
         }
-        let pending = self.members.iter().filter(|m| m.pending_len == h).count();
-        if pending < 3 || !k.is_finite() {
-            return;
-        }
-        if self.median.len() < h {
-            self.median.resize(h, 0.0);
-        }
-        for j in 0..h {
-            self.column.clear();
-            self.column.extend(
-                self.members
-                    .iter()
-                    .filter(|m| m.pending_len == h)
-                    .map(|m| m.pending[j]),
-            );
-            self.column.sort_unstable_by(f64::total_cmp);
-            let c = self.column.len();
-            self.median[j] = if c % 2 == 1 {
-                self.column[c / 2]
-            } else {
-                0.5 * (self.column[c / 2 - 1] + self.column[c / 2])
-            };
-        }
-        let floor = 1e-9 * self.experience;
-        let median = &self.median[..h];
-        for m in self.members.iter_mut().filter(|m| m.pending_len == h) {
-            let Some(score) = m.score_in(r) else {
-                continue;
-            };
-            let limit = k * score.sqrt().max(floor);
-            m.dissents = m.pending[..h]
-                .iter()
-                .zip(median)
-                .any(|(p, q)| (p - q).abs() > limit || (p - q).is_nan());
-        }
+        let limit = k * score.sqrt().max(1e-9 * self.experience);
+        me.pending[..h].iter().enumerate().any(|(j, &p)| {
+            if !p.is_finite() {
+                return true;
+            }
+            let (mut above, mut below) = (0, 0);
+            for m in pending.clone() {
+                let q = m.pending[j];
+                if q > p + limit {
+                    above += 1;
+                } else if q < p - limit {
+                    below += 1;
+                }
+            }
+            2 * above > count || 2 * below > count
+        })
     }
 
     /// The ready candidate with the lowest score in the current regime
@@ -416,7 +393,6 @@ impl Estimator for AutoEstimator {
             m.scored = [0; REGIMES];
             m.ready = false;
             m.trial = None;
-            m.dissents = false;
         }
         self.selected = None;
         self.start = None;
@@ -515,15 +491,14 @@ impl Estimator for AutoEstimator {
                 m.ready = false;
             }
         }
-        self.mark_dissent(h);
-        let usable = |m: &Member| m.pending_len == h && !m.dissents;
+        let usable = |i: usize| self.members[i].pending_len == h && !self.dissents(i, h);
         let chosen = match self.selected {
             _ if self.hold_first => None,
-            Some(c) if usable(&self.members[c]) => Some(c),
+            Some(c) if usable(c) => Some(c),
             _ => {
                 let r = self.regime;
                 let mut best: Option<(usize, Option<f64>)> = None;
-                for (i, m) in self.members.iter().enumerate().filter(|(_, m)| usable(m)) {
+                for (i, m) in self.members.iter().enumerate().filter(|&(i, _)| usable(i)) {
                     let s = m.score_in(r);
                     if best.map_or(true, |(_, b)| beats(s, b)) {
                         best = Some((i, s));
@@ -637,47 +612,42 @@ mod consensus_tests {
 
     fn dissenters(est: &AutoEstimator) -> Vec<usize> {
         (0..est.members.len())
-            .filter(|&i| est.members[i].dissents)
+            .filter(|&i| est.dissents(i, 10))
             .collect()
     }
 
     #[test]
-    fn a_prediction_far_from_the_median_beyond_its_own_error_dissents() {
-        // median 1.015; limit 20 × 0.01 = 0.2: only the 5.0 dissents
+    fn a_prediction_beyond_most_others_by_more_than_its_own_error_dissents() {
+        // limit 20 × 0.01 = 0.2: three of four predictions lie below 5.0 − 0.2,
+        // at most one beyond any other: only the 5.0 dissents
         let rms = [Some(0.01); 4];
-        let mut est = with_pending(&[1.0, 1.01, 1.02, 5.0], &rms, 20.0);
-        est.mark_dissent(10);
+        let est = with_pending(&[1.0, 1.01, 1.02, 5.0], &rms, 20.0);
         assert_eq!(dissenters(&est), vec![3]);
         // the same prediction by a candidate whose errors are that large agrees
-        let mut est = with_pending(
+        let est = with_pending(
             &[1.0, 1.01, 1.02, 5.0],
             &[Some(0.01), Some(0.01), Some(0.01), Some(0.5)],
             20.0,
         );
-        est.mark_dissent(10);
         assert!(dissenters(&est).is_empty());
         // an unscored candidate is never held against the consensus
-        let mut est = with_pending(
+        let est = with_pending(
             &[1.0, 1.01, 1.02, 5.0],
             &[Some(0.01), Some(0.01), Some(0.01), None],
             20.0,
         );
-        est.mark_dissent(10);
         assert!(dissenters(&est).is_empty());
     }
 
     #[test]
     fn no_consensus_with_fewer_than_three_predictions_or_when_disabled() {
-        let mut est = with_pending(&[1.0, 5.0], &[Some(0.01); 2], 20.0);
-        est.mark_dissent(10);
+        let est = with_pending(&[1.0, 5.0], &[Some(0.01); 2], 20.0);
         assert!(dissenters(&est).is_empty());
-        let mut est = with_pending(&[1.0, 1.01, 1.02, 5.0], &[Some(0.01); 4], f64::INFINITY);
-        est.mark_dissent(10);
+        let est = with_pending(&[1.0, 1.01, 1.02, 5.0], &[Some(0.01); 4], f64::INFINITY);
         assert!(dissenters(&est).is_empty());
         // one candidate that is not pending leaves two: no consensus
         let mut est = with_pending(&[1.0, 1.01, 5.0], &[Some(0.01); 3], 20.0);
         est.members[0].pending_len = 0;
-        est.mark_dissent(10);
         assert!(dissenters(&est).is_empty());
     }
 

@@ -515,12 +515,11 @@ fn add_kernel(
     let mut f = 1.0;
     if max < f64::INFINITY {
         // trace of the updated P, from its diagonal computed as below
-        let tr: f64 = p
-            .iter()
-            .step_by(n + 1)
-            .zip(h)
-            .map(|(&d, &hi)| (d - hi * hi) * il)
-            .sum();
+        // (an index loop: the strided iterator is not inlined here)
+        let mut tr = 0.0;
+        for (i, &hi) in h.iter().enumerate() {
+            tr += (p[i * (n + 1)] - hi * hi) * il;
+        }
         if tr > max {
             f = max / tr;
         }

@@ -122,6 +122,29 @@ impl Candidate {
             .map_or(0, |o| model::n_free(&o) + usize::from(self.has_bias()))
     }
 
+    /// Whether this candidate (windowed, with a constant term) can be solved
+    /// from the factors of `leader` (the same windowed candidate without
+    /// it, carrying the constant column: [`Predictor::carry_constant`]).
+    pub(crate) fn follows(&self, leader: &Candidate) -> bool {
+        match (*self, *leader) {
+            (
+                Candidate::Windowed {
+                    orders: a,
+                    window: wa,
+                    bias: true,
+                    ..
+                },
+                Candidate::Windowed {
+                    orders: b,
+                    window: wb,
+                    bias: false,
+                    ..
+                },
+            ) => a == b && wa == wb,
+            _ => false,
+        }
+    }
+
     /// Samples needed before the first regression row.
     pub fn warm_up(&self) -> usize {
         self.orders().map_or(1, |o| model::lag(&o))
@@ -224,6 +247,11 @@ struct Windowed {
     /// Value of the constant column (bias only): the largest regressor or
     /// target of the first informative window (0 until it arrived).
     scale: f64,
+    /// A candidate without a constant term whose factors also carry the
+    /// constant column, after the target (`[Ψ t c]`), so that the same
+    /// candidate with a constant term can be solved from them
+    /// ([`Predictor::fit_follower`]) instead of keeping factors of its own.
+    carries: bool,
 }
 
 impl Predictor {
@@ -252,6 +280,7 @@ impl Predictor {
                 rhs: vec![0.0; n],
                 tail: vec![0.0; n],
                 scale: 0.0,
+                carries: false,
             })),
         };
         let mut p = Self {
@@ -284,6 +313,84 @@ impl Predictor {
             State::Windowed(l) => constant_of(&self.theta, self.n_model, l.scale),
             State::Plain => 0.0,
         }
+    }
+
+    /// Let the factors of this windowed candidate without a constant term
+    /// also carry the constant column, so that the same candidate with it
+    /// can follow ([`Predictor::fit_follower`]); forgets all state. No
+    /// effect on other candidates.
+    pub(crate) fn carry_constant(&mut self) {
+        let n = self.theta.len();
+        if let (State::Windowed(l), Candidate::Windowed { bias: false, .. }) =
+            (&mut self.state, self.spec)
+        {
+            let m = n + 2;
+            l.carries = true;
+            l.factors = [vec![0.0; m * m], vec![0.0; m * m]];
+            l.row = vec![0.0; m];
+            l.row2 = vec![0.0; m];
+        }
+        self.reset();
+    }
+
+    /// Fit this windowed candidate with a constant term from the factors of
+    /// `leader` (see [`Candidate::follows`]; its fit done up to the same
+    /// sample) instead of from factors of its own: the leader's factor of
+    /// `[Ψ t c]` with its last two columns swapped and one Givens rotation
+    /// is the factor of `[Ψ c t]` over the same rows — the same least
+    /// squares as its own factors would give, for half the work. Returns
+    /// whether the model can predict. A follower that is restarted refits
+    /// from the leader's rows at the next fit.
+    pub(crate) fn fit_follower(&mut self, leader: &Predictor) -> bool {
+        let n = self.theta.len();
+        let (State::Windowed(l), State::Windowed(lead)) = (&mut self.state, &leader.state) else {
+            return self.fitted;
+        };
+        let Candidate::Windowed { ridge, .. } = self.spec else {
+            return self.fitted;
+        };
+        let m = n + 1;
+        if !lead.carries || lead.row.len() != m || l.factors[0].len() != m * m {
+            return self.fitted;
+        }
+        l.scale = lead.scale;
+        l.cursor = lead.cursor;
+        l.rows = lead.rows;
+        if lead.rows[0] < n || l.scale == 0.0 {
+            return self.fitted;
+        }
+        // [Ψ t c] → [Ψ c t]: swap the last two columns …
+        let (src, dst) = (&lead.factors[0], &mut l.factors[0]);
+        let (nm, t, c) = (n - 1, n - 1, n);
+        for i in 0..m {
+            let row = &src[i * m..(i + 1) * m];
+            let out = &mut dst[i * m..(i + 1) * m];
+            out[..nm].copy_from_slice(&row[..nm]);
+            out[t] = row[c];
+            out[c] = row[t];
+        }
+        // … and rotate rows nm and nm + 1 to zero the entry below the diagonal
+        if let Some((rho, cs, sn)) = rotation(dst[nm * m + nm], dst[(nm + 1) * m + nm]) {
+            dst[nm * m + nm] = rho;
+            dst[(nm + 1) * m + nm] = 0.0;
+            let (a, b) = (dst[nm * m + c], dst[(nm + 1) * m + c]);
+            dst[nm * m + c] = cs * a + sn * b;
+            dst[(nm + 1) * m + c] = cs * b - sn * a;
+        }
+        if solve_ridge(
+            &l.factors[0],
+            m,
+            n,
+            ridge,
+            &mut l.small,
+            &mut l.tail,
+            &mut l.rhs,
+        ) && l.rhs.iter().all(|v| v.is_finite())
+        {
+            self.theta.copy_from_slice(&l.rhs);
+            self.fitted = true;
+        }
+        self.fitted
     }
 
     /// Forget the model but keep the position in the data (a model that
@@ -410,7 +517,8 @@ impl Predictor {
                 let n = self.theta.len();
                 let half = (window / 2).max(1);
                 let rows = lag..lag + (end - cursor);
-                if bias && l.scale == 0.0 {
+                let constant = bias || l.carries;
+                if constant && l.scale == 0.0 {
                     l.scale = largest_row_entry(&o, y, u, rows.clone(), &mut l.psi[..nm]);
                 }
                 for k in rows {
@@ -418,15 +526,19 @@ impl Predictor {
                     if t == 0.0 && l.psi[..nm].iter().all(|&v| v == 0.0) {
                         continue;
                     }
-                    if bias {
-                        // the column `scale` (no row before it is known)
-                        if l.scale == 0.0 {
-                            continue;
-                        }
-                        l.psi[nm] = l.scale;
+                    // the column `scale` (no row before it is known): before
+                    // the target with a bias, after it when carried
+                    if constant && l.scale == 0.0 {
+                        continue;
                     }
-                    l.row[..n].copy_from_slice(&l.psi);
+                    l.row[..nm].copy_from_slice(&l.psi[..nm]);
+                    if bias {
+                        l.row[nm] = l.scale;
+                    }
                     l.row[n] = t;
+                    if l.carries {
+                        l.row[n + 1] = l.scale;
+                    }
                     l.row2.copy_from_slice(&l.row);
                     let [a, b] = &mut l.factors;
                     givens_add_pair(a, &mut l.row, b, &mut l.row2);
@@ -440,9 +552,11 @@ impl Predictor {
                     }
                 }
                 l.cursor = Some(end);
+                let stride = l.row.len();
                 if l.rows[0] >= n
                     && solve_ridge(
                         &l.factors[0],
+                        stride,
                         n,
                         ridge,
                         &mut l.small,
@@ -597,19 +711,20 @@ fn givens_add(r: &mut [f64], row: &mut [f64]) {
     }
 }
 
-/// Solve `min ‖R·θ − z‖² + λ‖θ‖²` from the `(n+1)×(n+1)` factor of `[Ψ t]`
-/// (`R` its leading `n×n` block, `z` its last column above the diagonal),
-/// `λ = max(ridge, 1e-12)·‖R‖²_F/n` (the relative ridge; 1e-12 keeps a
-/// rank-deficient window defined); the solution goes to `theta`.
+/// Solve `min ‖R·θ − z‖² + λ‖θ‖²` from the upper-triangular factor of
+/// `[Ψ t …]` (row-major, rows of `stride ≥ n + 1` entries; `R` its leading
+/// `n×n` block, `z` its column `n` above the diagonal; columns after it are
+/// ignored), `λ = max(ridge, 1e-12)·‖R‖²_F/n` (the relative ridge; 1e-12
+/// keeps a rank-deficient window defined); the solution goes to `theta`.
 fn solve_ridge(
     f: &[f64],
+    m: usize,
     n: usize,
     ridge: f64,
     small: &mut [f64],
     row_tail: &mut [f64],
     theta: &mut [f64],
 ) -> bool {
-    let m = n + 1;
     let mut frob = 0.0;
     for i in 0..n {
         for j in i..n {
@@ -744,6 +859,51 @@ mod tests {
         p.predict(&s, end..end + 10, &mut Vec::new(), &mut out)
             .unwrap();
         (p, out)
+    }
+
+    #[test]
+    fn a_follower_solved_from_its_leaders_factor_equals_the_candidate_fitted_alone() {
+        // noise added so that the fit is not exact; fitted in pieces of 10
+        // samples (as auto does), past several swaps of the two factors
+        let (t, u, mut y) = system(700, 2e-6, 0.3, 1.0);
+        for (k, v) in y.iter_mut().enumerate() {
+            *v += 1e-7 * ((k * 7919 % 13) as f64 - 6.0);
+        }
+        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
+        let mut plain = Predictor::new(windowed(false));
+        let mut leader = Predictor::new(windowed(false));
+        leader.carry_constant();
+        let mut alone = Predictor::new(windowed(true));
+        let mut follower = Predictor::new(windowed(true));
+        assert!(windowed(true).follows(&windowed(false)));
+        assert!(!windowed(false).follows(&windowed(true)));
+        let (mut past, mut a, mut b) = (Vec::new(), [0.0; 10], [0.0; 10]);
+        let mut end = 40;
+        while end + 10 <= 700 {
+            let fitted = plain.fit(&s, 10, end);
+            assert_eq!(leader.fit(&s, 10, end), fitted);
+            assert_eq!(alone.fit(&s, 10, end), follower.fit_follower(&leader));
+            // carrying the constant column changes nothing of the leader's own fit
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(plain.theta()), bits(leader.theta()), "end {end}");
+            if alone.fitted {
+                for (x, z) in alone.theta.iter().zip(&follower.theta) {
+                    assert!(
+                        (x - z).abs() <= 1e-8 * x.abs().max(1e-3),
+                        "end {end}: {x} vs {z}"
+                    );
+                }
+                alone.predict(&s, end..end + 10, &mut past, &mut a).unwrap();
+                follower
+                    .predict(&s, end..end + 10, &mut past, &mut b)
+                    .unwrap();
+                for (x, z) in a.iter().zip(&b) {
+                    assert!((x - z).abs() <= 1e-12, "end {end}: {x} vs {z}");
+                }
+            }
+            end += 10;
+        }
+        assert!(follower.fitted && (follower.constant() - 2e-6).abs() < 1e-7);
     }
 
     #[test]

@@ -59,6 +59,11 @@ struct Member {
     /// Mean squared error of its backtest on the first window \[m²\]
     /// (decides only whether the first prediction holds instead).
     trial: Option<f64>,
+    /// The candidate whose factors this one is solved from
+    /// ([`Predictor::fit_follower`]), if any.
+    leader: Option<usize>,
+    /// Whether the backtest's predictor could be fitted.
+    trial_fitted: bool,
 }
 
 impl Member {
@@ -74,6 +79,8 @@ impl Member {
             scored: [0; REGIMES],
             ready: false,
             trial: None,
+            leader: None,
+            trial_fitted: false,
         }
     }
 
@@ -117,7 +124,19 @@ pub struct AutoEstimator {
 
 impl AutoEstimator {
     pub(super) fn new(config: AutoConfig) -> Self {
-        let members = config.candidates.iter().map(|&c| Member::new(c)).collect();
+        let mut members: Vec<Member> = config.candidates.iter().map(|&c| Member::new(c)).collect();
+        // a windowed candidate with a constant term is solved from the
+        // factors of the same candidate without it, if there is one
+        let n = members.len();
+        for (m, c) in members.iter_mut().zip(&config.candidates) {
+            m.leader = config.candidates.iter().position(|l| c.follows(l));
+        }
+        for j in 0..n {
+            if members.iter().any(|m| m.leader == Some(j)) {
+                members[j].predictor.carry_constant();
+                members[j].trial_predictor.carry_constant();
+            }
+        }
         let reported = config.reported();
         let n_arx = reported
             .and_then(|r| config.candidates[r].orders())
@@ -224,14 +243,23 @@ impl AutoEstimator {
         let hold = last_position(signals, start..split)
             .ok()
             .and_then(|last| mean_square_error(measured, std::iter::repeat(last)));
+        // a predictor of its own: the candidate proper learns the first
+        // window in one piece (its coordinates' scale is set by the first
+        // rows it sees); followers after their leaders
+        for m in self.members.iter_mut().filter(|m| m.leader.is_none()) {
+            m.trial_predictor.reset();
+            m.trial_fitted = m.trial_predictor.fit(signals, start, split);
+        }
+        for i in 0..self.members.len() {
+            if let Some((m, leader)) = follower_and_leader(&mut self.members, i) {
+                m.trial_predictor.reset();
+                m.trial_fitted = m.trial_predictor.fit_follower(&leader.trial_predictor);
+            }
+        }
         for m in &mut self.members {
             m.pending_len = 0;
             m.trial = None;
-            // a predictor of its own: the candidate proper learns the
-            // first window in one piece (its coordinates' scale is set by
-            // the first rows it sees)
-            m.trial_predictor.reset();
-            if !m.trial_predictor.fit(signals, start, split) {
+            if !m.trial_fitted {
                 continue;
             }
             if m.pending.len() < h {
@@ -335,6 +363,18 @@ fn regime(signals: &Signals<'_>, from: usize, end: usize, h: usize) -> usize {
     }
 }
 
+/// Member `i` (mutable) and its leader, if it follows one.
+fn follower_and_leader(members: &mut [Member], i: usize) -> Option<(&mut Member, &Member)> {
+    let j = members[i].leader.filter(|&j| j != i)?;
+    if i < j {
+        let (a, b) = members.split_at_mut(j);
+        Some((&mut a[i], &b[0]))
+    } else {
+        let (a, b) = members.split_at_mut(i);
+        Some((&mut b[0], &a[j]))
+    }
+}
+
 /// Mean squared difference of `measured` and `predicted` (as many as
 /// `measured`), if finite.
 fn mean_square_error(measured: &[f64], predicted: impl Iterator<Item = f64>) -> Option<f64> {
@@ -393,6 +433,7 @@ impl Estimator for AutoEstimator {
             m.scored = [0; REGIMES];
             m.ready = false;
             m.trial = None;
+            m.trial_fitted = false;
         }
         self.selected = None;
         self.start = None;
@@ -425,8 +466,13 @@ impl Estimator for AutoEstimator {
         } else {
             None
         };
-        for m in &mut self.members {
+        for m in self.members.iter_mut().filter(|m| m.leader.is_none()) {
             m.ready = m.predictor.fit(signals, start, window.end);
+        }
+        for i in 0..self.members.len() {
+            if let Some((m, leader)) = follower_and_leader(&mut self.members, i) {
+                m.ready = m.predictor.fit_follower(&leader.predictor);
+            }
         }
         self.selected = self.choose();
         // hold first unless the first choice backtested better than holding

@@ -180,7 +180,7 @@ pub struct MethodOptions {
     pub lambda: Option<f64>,
     /// arx, auto (its windowed candidates): ridge of the least squares,
     /// relative to the regressors' scale (arx: on the column-normalised
-    /// coefficients), ≥ 0, 0 = none [default: arx 1e-10; auto 1e-6].
+    /// coefficients), ≥ 0, 0 = none [default: arx 1e-10; auto 0].
     #[arg(long, value_name = "R")]
     pub ridge: Option<f64>,
 }

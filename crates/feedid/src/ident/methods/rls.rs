@@ -324,14 +324,14 @@ impl RlsEstimator {
         #[cfg(target_arch = "x86_64")]
         let r = if self.avx {
             // SAFETY: `avx` is set only when the CPU reports AVX2 (`new`).
-            unsafe { add_avx2(self.n, p, psi, theta, g, target, lambda, max) }
+            unsafe { add_avx2(self.n, self.n, p, psi, theta, g, target, lambda, max) }
         } else {
-            add_sized(self.n, p, psi, theta, g, target, lambda, max)
+            add_sized(self.n, self.n, p, psi, theta, g, target, lambda, max)
         };
         #[cfg(not(target_arch = "x86_64"))]
         let r = {
             let _ = self.avx;
-            add_sized(self.n, p, psi, theta, g, target, lambda, max)
+            add_sized(self.n, self.n, p, psi, theta, g, target, lambda, max)
         };
         match r {
             Ok(e) => e,
@@ -407,10 +407,14 @@ pub(crate) fn has_avx2() -> bool {
 }
 
 /// One exponentially weighted RLS update (the update of [`RlsEstimator`],
-/// shared with `auto`'s recursive candidates): `p` row-major `n×n` and
-/// exactly symmetric, `g` a scratch of length `n`, trace bound `max`
-/// (∞ = none), `avx` from [`has_avx2`]. Returns the a-priori error, or
-/// `Err(e)` if `λ + ψᵀPψ` is not positive (nothing updated).
+/// shared with `auto`'s recursive candidates) of the `n = θ.len()`
+/// parameters: `p` row-major `n×s` with the stride `s = ψ.len() ≥ n` (the
+/// rows padded to `s` columns, for whole vectors: the pads of `p` and `ψ`
+/// must be zero, and they stay zero) and exactly symmetric in its `n×n`
+/// part, `g` a scratch of length `s`, trace bound `max` (∞ = none), `avx`
+/// from [`has_avx2`]. Returns the a-priori error, or `Err(e)` if
+/// `λ + ψᵀPψ` is not positive (nothing updated). The padding changes no
+/// result (bit-identical to `s = n`).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn rls_update(
     avx: bool,
@@ -422,20 +426,21 @@ pub(crate) fn rls_update(
     lambda: f64,
     max: f64,
 ) -> std::result::Result<f64, f64> {
-    let n = psi.len();
+    let (s, n) = (psi.len(), theta.len().min(psi.len()));
     #[cfg(target_arch = "x86_64")]
     if avx {
         // SAFETY: callers pass `avx` from `has_avx2`.
-        return unsafe { add_avx2(n, p, psi, theta, g, target, lambda, max) };
+        return unsafe { add_avx2(s, n, p, psi, theta, g, target, lambda, max) };
     }
     let _ = avx;
-    add_sized(n, p, psi, theta, g, target, lambda, max)
+    add_sized(s, n, p, psi, theta, g, target, lambda, max)
 }
 
-/// [`add_kernel`] with the sizes up to 16 as constants (unrolled, vectorised).
+/// [`add_kernel`] with the strides up to 16 as constants (unrolled, vectorised).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn add_sized(
+    s: usize,
     n: usize,
     p: &mut [f64],
     psi: &[f64],
@@ -448,9 +453,9 @@ fn add_sized(
     // each arm inlines the kernel with a constant size (unrolled loops)
     macro_rules! sized {
         ($($k:literal)*) => {
-            match n {
-                $($k => add_kernel($k, p, psi, theta, g, target, lambda, max),)*
-                _ => add_kernel(n, p, psi, theta, g, target, lambda, max),
+            match s {
+                $($k => add_kernel($k, n, p, psi, theta, g, target, lambda, max),)*
+                _ => add_kernel(s, n, p, psi, theta, g, target, lambda, max),
             }
         };
     }
@@ -463,6 +468,7 @@ fn add_sized(
 #[target_feature(enable = "avx2")]
 #[allow(clippy::too_many_arguments)]
 fn add_avx2(
+    s: usize,
     n: usize,
     p: &mut [f64],
     psi: &[f64],
@@ -472,15 +478,17 @@ fn add_avx2(
     lambda: f64,
     max: f64,
 ) -> std::result::Result<f64, f64> {
-    add_sized(n, p, psi, theta, g, target, lambda, max)
+    add_sized(s, n, p, psi, theta, g, target, lambda, max)
 }
 
-/// The update of [`RlsEstimator::add`] on `n` parameters with the trace
-/// bound `max` (∞ = none); `Err(e)` if `λ + ψᵀg` is not positive (nothing
-/// updated, the trace bound not applied).
+/// The update of [`RlsEstimator::add`] on `n` parameters stored with the
+/// stride `s ≥ n` (see [`rls_update`]) with the trace bound `max` (∞ =
+/// none); `Err(e)` if `λ + ψᵀg` is not positive (nothing updated, the
+/// trace bound not applied).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn add_kernel(
+    s: usize,
     n: usize,
     p: &mut [f64],
     psi: &[f64],
@@ -490,7 +498,7 @@ fn add_kernel(
     lambda: f64,
     max: f64,
 ) -> std::result::Result<f64, f64> {
-    let (p, psi, theta, g) = (&mut p[..n * n], &psi[..n], &mut theta[..n], &mut g[..n]);
+    let (p, psi, theta, g) = (&mut p[..n * s], &psi[..s], &mut theta[..n], &mut g[..s]);
     sym_mul(p, psi, g);
     let mut den = lambda;
     let mut pred = 0.0;
@@ -517,21 +525,21 @@ fn add_kernel(
         // trace of the updated P, from its diagonal computed as below
         // (an index loop: the strided iterator is not inlined here)
         let mut tr = 0.0;
-        for (i, &hi) in h.iter().enumerate() {
-            tr += (p[i * (n + 1)] - hi * hi) * il;
+        for (i, &hi) in h[..n].iter().enumerate() {
+            tr += (p[i * (s + 1)] - hi * hi) * il;
         }
         if tr > max {
             f = max / tr;
         }
     }
     if f == 1.0 {
-        for (row, &hi) in p.chunks_exact_mut(n).zip(h) {
+        for (row, &hi) in p.chunks_exact_mut(s).zip(h) {
             for (v, &hj) in row.iter_mut().zip(h) {
                 *v = (*v - hi * hj) * il;
             }
         }
     } else {
-        for (row, &hi) in p.chunks_exact_mut(n).zip(h) {
+        for (row, &hi) in p.chunks_exact_mut(s).zip(h) {
             for (v, &hj) in row.iter_mut().zip(h) {
                 *v = (*v - hi * hj) * il * f;
             }
@@ -540,8 +548,9 @@ fn add_kernel(
     Ok(e)
 }
 
-/// `g = P·ψ` for an exactly symmetric row-major `P`, accumulated as the
-/// ψ-weighted sum of its rows (contiguous, vectorisable).
+/// `g = P·ψ` for an exactly symmetric row-major `P` (rows of `g.len()`
+/// entries, as many rows as it holds), accumulated as the ψ-weighted sum of
+/// its rows (contiguous, vectorisable).
 #[inline(always)]
 fn sym_mul(p: &[f64], psi: &[f64], g: &mut [f64]) {
     if let Ok(g) = <&mut [f64; 16]>::try_from(&mut *g) {
@@ -951,6 +960,59 @@ mod tests {
             };
             let fast = run();
             assert_eq!(fast, crate::solve::rows::portable(run));
+        }
+    }
+
+    #[test]
+    fn padded_rows_give_the_unpadded_updates_bit_for_bit() {
+        // rls_update on P stored with rows padded to whole 4-wide vectors
+        // (auto's candidates) against the unpadded storage, for every size
+        // the default candidates use and more, with and without the trace
+        // bound, on seeded regressors (some exactly zero)
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let avx = has_avx2();
+        for n in 2..=15usize {
+            let s = n.div_ceil(4usize) * 4;
+            for max in [f64::INFINITY, 50.0 * n as f64] {
+                let (mut p1, mut p2) = (vec![0.0; n * n], vec![0.0; n * s]);
+                for i in 0..n {
+                    p1[i * n + i] = 100.0;
+                    p2[i * s + i] = 100.0;
+                }
+                let (mut th1, mut th2) = (vec![0.0; n], vec![0.0; n]);
+                let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; s]);
+                let mut psi2 = vec![0.0; s];
+                for k in 0..300 {
+                    let psi1: Vec<f64> = (0..n)
+                        .map(|j| if (k + j) % 9 == 0 { 0.0 } else { next() })
+                        .collect();
+                    psi2[..n].copy_from_slice(&psi1);
+                    let target = next();
+                    let a = rls_update(avx, &mut p1, &psi1, &mut th1, &mut g1, target, 0.99, max);
+                    let b = rls_update(avx, &mut p2, &psi2, &mut th2, &mut g2, target, 0.99, max);
+                    assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "n {n} k {k}");
+                }
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&th1), bits(&th2), "n {n}");
+                for i in 0..n {
+                    assert_eq!(
+                        bits(&p1[i * n..(i + 1) * n]),
+                        bits(&p2[i * s..i * s + n]),
+                        "n {n}"
+                    );
+                    assert!(
+                        p2[i * s + n..(i + 1) * s].iter().all(|&v| v == 0.0),
+                        "pads stay zero"
+                    );
+                }
+                assert!(th1.iter().any(|&v| v != 0.0));
+            }
         }
     }
 

@@ -262,9 +262,9 @@ impl Predictor {
         let state = match spec {
             Candidate::Hold | Candidate::Command => State::Plain,
             Candidate::Recursive { .. } => State::Recursive(Box::new(Recursive {
-                p: vec![0.0; n * n],
-                psi: vec![0.0; n],
-                g: vec![0.0; n],
+                p: vec![0.0; n * stride(n)],
+                psi: vec![0.0; stride(n)],
+                g: vec![0.0; stride(n)],
                 cursor: None,
                 scale: 0.0,
                 avx: has_avx2(),
@@ -783,10 +783,23 @@ fn solve_ridge(
     true
 }
 
+/// Row stride of a recursive candidate's covariance for `n` parameters:
+/// one more when that makes whole 4-wide vectors (7 → 8, 11 → 12, 15 → 16;
+/// the pad stays zero, the results are bit-identical, see [`rls_update`];
+/// padding further cost more than it saved).
+fn stride(n: usize) -> usize {
+    if n % 4 == 3 {
+        n + 1
+    } else {
+        n
+    }
+}
+
 fn reset_covariance(p: &mut [f64], n: usize) {
     p.fill(0.0);
+    let s = stride(n);
     for i in 0..n {
-        p[i * n + i] = P0;
+        p[i * s + i] = P0;
     }
 }
 

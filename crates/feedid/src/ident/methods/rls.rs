@@ -969,13 +969,8 @@ mod tests {
         // (auto's candidates) against the unpadded storage, for every size
         // the default candidates use and more, with and without the trace
         // bound, on seeded regressors (some exactly zero)
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut next = || rng.random_range(-0.5..0.5);
         let avx = has_avx2();
         for n in 2..=15usize {
             let s = n.div_ceil(4usize) * 4;

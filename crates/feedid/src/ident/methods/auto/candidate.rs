@@ -921,15 +921,12 @@ mod tests {
 
     #[test]
     fn interleaved_givens_updates_equal_two_single_updates_bit_for_bit() {
+        use rand::{Rng, SeedableRng};
+        use rand_chacha::ChaCha8Rng;
         // seeded rows, some with zeros (skipped rotations), into two factors
         let m = 5;
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        let mut next = || rng.random_range(-0.5..0.5);
         let (mut a, mut b) = (vec![0.0; m * m], vec![0.0; m * m]);
         let (mut a1, mut b1) = (a.clone(), b.clone());
         for k in 0..200 {

@@ -22,10 +22,11 @@ pub struct AutoConfig {
     /// consecutive samples so far), ≥ 1; default 4. Until the axis has
     /// moved, only predictions that stay where it is pass.
     pub plausibility: f64,
-    /// A candidate whose prediction departs from the median of the usable
-    /// candidates' predictions (at some step of the horizon) by more than
-    /// this factor times its own recent rms error does not predict that
-    /// horizon (a model thrown off by a motion it has not seen, such as a
+    /// A candidate whose prediction departs from the candidates' consensus
+    /// — at some step of the horizon more than half of their predictions
+    /// lie on one side of it by more than this factor times its own recent
+    /// rms error (odd count: its distance from their median exceeds that) —
+    /// does not predict that horizon (a model thrown off by a motion it has not seen, such as a
     /// jerk of the command); > 0, `∞` disables; default 20 (chosen on the
     /// drive zoo: 15 … 30 give the same losses).
     pub consensus: f64,

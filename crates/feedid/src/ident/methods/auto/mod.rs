@@ -64,11 +64,13 @@
 //! horizon holds the last position; the backtest scores decide nothing
 //! after it (a single horizon on a partly learnt model is a poor score).
 //!
-//! A candidate whose prediction departs from the *consensus* — the median
-//! of all candidates' predictions at some step of the horizon — by more
-//! than [`AutoConfig::consensus`] (default 20) times its own recent rms
-//! error does not predict that horizon; the best-scored candidate that
-//! agrees does. A model well scored on a smooth motion can be thrown off by
+//! A candidate whose prediction departs from the *consensus* does not
+//! predict that horizon; the best-scored candidate that agrees does. It
+//! departs when, at some step of the horizon, more than half of the
+//! candidates' predictions lie on one side of it by more than
+//! [`AutoConfig::consensus`] (default 20) times its own recent rms error —
+//! with an odd count of predictions: its distance from their median exceeds
+//! that (fewer than three predictions make no consensus). A model well scored on a smooth motion can be thrown off by
 //! a motion it has not seen (a jerk of the command excites directions its
 //! nearly collinear regressors never determined): its prediction then
 //! leaves the others by far more than it ever erred. The factor is relative

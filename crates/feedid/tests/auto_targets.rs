@@ -14,12 +14,12 @@
 mod common;
 
 use feedid::drive::{RigParams, VirtualRig};
-use feedid::ident::{engine, AutoConfig, EngineConfig, Signals};
+use feedid::ident::{engine, AutoConfig, EngineConfig, Signals, SlidingResult};
 use feedid::signal::Scenario;
 use feedid::stats::ErrorStats;
 
-/// Error over the predicted samples from `from` on, and the coverage after the first window.
-fn run_auto_from(s: &Signals<'_>, from: usize) -> (ErrorStats, f64) {
+/// The default `auto` over the recording (window 50, H = hop = 10).
+fn run_auto(s: &Signals<'_>) -> SlidingResult {
     let mut est = AutoConfig::default().build().unwrap();
     let cfg = EngineConfig {
         window: 50,
@@ -27,7 +27,12 @@ fn run_auto_from(s: &Signals<'_>, from: usize) -> (ErrorStats, f64) {
         hop: None,
         warm_up: 0,
     };
-    let r = engine::run(&mut est, s, &cfg).unwrap();
+    engine::run(&mut est, s, &cfg).unwrap()
+}
+
+/// Error over the predicted samples from `from` on, and the coverage after the first window.
+fn run_auto_from(s: &Signals<'_>, from: usize) -> (ErrorStats, f64) {
+    let r = run_auto(s);
     assert!(r.predicted.iter().all(|v| v.is_finite()));
     let first = r.windows[0].horizon.start;
     let rest = &r.has_prediction[first..];
@@ -117,14 +122,7 @@ fn a_candidate_thrown_off_by_an_unseen_jerk_does_not_predict() {
         let rec = m.recording().unwrap();
         let s = rec.signals();
         let (y, u) = (&m.position, &m.command);
-        let mut est = AutoConfig::default().build().unwrap();
-        let cfg = EngineConfig {
-            window: 50,
-            horizon: 10,
-            hop: None,
-            warm_up: 0,
-        };
-        let r = engine::run(&mut est, &s, &cfg).unwrap();
+        let r = run_auto(&s);
         let glitch: Vec<usize> = m.spec.glitches.iter().map(|g| g.index).collect();
         // the baseline: ARX(2,2,0) by least squares on the 100 samples
         // before each block of 10, run 10 samples ahead on the command

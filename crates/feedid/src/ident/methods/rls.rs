@@ -12,9 +12,11 @@
 //! g = P·ψ,   K = g/(λ + ψᵀg),   θ ← θ + K·(ỹ − ψᵀθ),   P ← (P − K·gᵀ)/λ
 //! ```
 //!
-//! `P` is kept exactly symmetric by writing the downdate as
-//! `P ← (P − h·hᵀ)/λ`, `h = g/√(λ + ψᵀg)` (so `Pψ` can be accumulated from
-//! contiguous rows). Memory
+//! `P` is kept exactly symmetric by writing the downdate entry by entry as
+//! `Pᵢⱼ ← (Pᵢⱼ − (gᵢ·gⱼ)/(λ + ψᵀg))/λ` (the product `gᵢ·gⱼ` is the same
+//! for `Pⱼᵢ`, so `Pψ` can be accumulated from contiguous rows; no square
+//! root on the critical path). The dot products are summed in four lanes
+//! (short dependency chains). Memory
 //! `≈ 1/(1 − λ)` samples. Two safeguards against covariance wind-up:
 //! * **Excitation gate:** a sample updates `θ` and `P` (and is forgotten) only
 //!   when the command moved over the regressor span, i.e. the range of
@@ -317,7 +319,7 @@ impl RlsEstimator {
     ///
     /// With `bound`, the trace bound is applied to the updated `P` in the
     /// same pass (as [`Self::bound_trace`] would after it). `P` stays exactly
-    /// symmetric: the downdate is `P ← (P − h·hᵀ)/λ` with `h = g/√(λ + ψᵀg)`.
+    /// symmetric: the downdate is `Pᵢⱼ ← (Pᵢⱼ − (gᵢ·gⱼ)/(λ + ψᵀg))/λ`.
     fn add(&mut self, target: f64, lambda: f64, bound: bool) -> f64 {
         let max = if bound { self.max_trace } else { f64::INFINITY };
         let (p, psi, theta, g) = (&mut self.p, &self.psi, &mut self.theta, &mut self.g);
@@ -499,13 +501,16 @@ fn add_kernel(
     max: f64,
 ) -> std::result::Result<f64, f64> {
     let (p, psi, theta, g) = (&mut p[..n * s], &psi[..s], &mut theta[..n], &mut g[..s]);
-    sym_mul(p, psi, g);
-    let mut den = lambda;
-    let mut pred = 0.0;
-    for ((&s, &gi), &t) in psi.iter().zip(g.iter()).zip(theta.iter()) {
-        den += s * gi;
-        pred += s * t;
+    // the trace of P before the update (off the critical path)
+    let mut diag = 0.0;
+    if max < f64::INFINITY {
+        for i in 0..n {
+            diag += p[i * (s + 1)];
+        }
     }
+    let pred = dot4(&psi[..n], theta);
+    sym_mul(p, psi, g);
+    let den = lambda + dot4(psi, g);
     let e = target - pred;
     if !(den > 0.0) || !den.is_finite() {
         return Err(e);
@@ -514,38 +519,57 @@ fn add_kernel(
     for (t, &gi) in theta.iter_mut().zip(g.iter()) {
         *t += gi * inv * e;
     }
-    let root = inv.sqrt();
-    for gi in g.iter_mut() {
-        *gi *= root;
-    }
     let il = 1.0 / lambda;
-    let h = &*g;
+    let g = &*g;
     let mut f = 1.0;
     if max < f64::INFINITY {
-        // trace of the updated P, from its diagonal computed as below
-        // (an index loop: the strided iterator is not inlined here)
-        let mut tr = 0.0;
-        for (i, &hi) in h[..n].iter().enumerate() {
-            tr += (p[i * (s + 1)] - hi * hi) * il;
-        }
+        // trace of the updated P: tr(P − g·gᵀ/den)/λ
+        let tr = (diag - dot4(&g[..n], &g[..n]) * inv) * il;
         if tr > max {
             f = max / tr;
         }
     }
+    // (gᵢ·gⱼ)·inv keeps P exactly symmetric without a square root
     if f == 1.0 {
-        for (row, &hi) in p.chunks_exact_mut(s).zip(h) {
-            for (v, &hj) in row.iter_mut().zip(h) {
-                *v = (*v - hi * hj) * il;
+        for (row, &gi) in p.chunks_exact_mut(s).zip(g) {
+            for (v, &gj) in row.iter_mut().zip(g) {
+                *v = (*v - gi * gj * inv) * il;
             }
         }
     } else {
-        for (row, &hi) in p.chunks_exact_mut(s).zip(h) {
-            for (v, &hj) in row.iter_mut().zip(h) {
-                *v = (*v - hi * hj) * il * f;
+        for (row, &gi) in p.chunks_exact_mut(s).zip(g) {
+            for (v, &gj) in row.iter_mut().zip(g) {
+                *v = (*v - gi * gj * inv) * il * f;
             }
         }
     }
     Ok(e)
+}
+
+/// `Σ aᵢbᵢ` (equal lengths) in four lanes (entry `i` into lane `i mod 4`,
+/// then `(l₀ + l₁) + (l₂ + l₃)`): short dependency chains, and trailing
+/// zeros (padding) change no bit.
+#[inline(always)]
+fn dot4(a: &[f64], b: &[f64]) -> f64 {
+    // index loops: iterator adapters are not inlined into the large kernel
+    let n = a.len();
+    let b = &b[..n];
+    let mut d = [0.0f64; 4];
+    let mut i = 0;
+    while i + 4 <= n {
+        d[0] += a[i] * b[i];
+        d[1] += a[i + 1] * b[i + 1];
+        d[2] += a[i + 2] * b[i + 2];
+        d[3] += a[i + 3] * b[i + 3];
+        i += 4;
+    }
+    let mut l = 0;
+    while i < n {
+        d[l] += a[i] * b[i];
+        i += 1;
+        l += 1;
+    }
+    (d[0] + d[1]) + (d[2] + d[3])
 }
 
 /// `g = P·ψ` for an exactly symmetric row-major `P` (rows of `g.len()`

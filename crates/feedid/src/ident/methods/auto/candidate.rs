@@ -226,24 +226,31 @@ fn constant_of(theta: &[f64], n_model: usize, scale: f64) -> f64 {
     theta.get(n_model).map_or(0.0, |t| t * scale)
 }
 
-/// Least squares over the last `W/2 … W` samples without downdating: two
-/// triangular factors of `[Ψ t]` grown by Givens rotations, the older one
-/// (which started `W/2` rows earlier) fitted, replaced by the newer one
-/// when it holds `W` rows.
+/// Least squares over the last `W/2 … W` samples without downdating: the
+/// triangular factor of `[Ψ t]` over a completed block of `W/2` rows and
+/// that of the rows since, grown by Givens rotations; at each fit the two
+/// are merged (the newer one's rows rotated into a copy of the older) and
+/// the merged factor solved. A block that reaches `W/2` rows becomes the
+/// older one.
 #[derive(Debug, Clone)]
 struct Windowed {
     /// Row-major `(n+1)×(n+1)` upper-triangular factors: older, newer.
     factors: [Vec<f64>; 2],
     rows: [usize; 2],
+    /// The factor of both blocks' rows (`rows[0] + rows[1]`), as of the
+    /// last fit.
+    merged: Vec<f64>,
     cursor: Option<usize>,
     psi: Vec<f64>,
-    /// The row `[ψ t]`, one copy per factor (rotated into it).
+    /// Scratch of one row `[ψ t]`.
     row: Vec<f64>,
-    row2: Vec<f64>,
-    /// Scratch of the ridge solve (`(n+1)×n` and `n`).
+    /// Up to [`GROUP`] rows waiting to be rotated into the newer factor.
+    group: Vec<f64>,
+    /// Scratch of the ridge solve: `[R z]` (`(n+1)×(n+1)`), the solution
+    /// (`n`) and the ridge rows (`n×(n+1)`).
     small: Vec<f64>,
     rhs: Vec<f64>,
-    tail: Vec<f64>,
+    ridge_rows: Vec<f64>,
     /// Value of the constant column (bias only): the largest regressor or
     /// target of the first informative window (0 until it arrived).
     scale: f64,
@@ -252,6 +259,25 @@ struct Windowed {
     /// candidate with a constant term can be solved from them
     /// ([`Predictor::fit_follower`]) instead of keeping factors of its own.
     carries: bool,
+}
+
+/// Rows rotated into a windowed candidate's factor together.
+const GROUP: usize = 4;
+
+impl Windowed {
+    /// Rotate the first `count` rows of the group into the newer factor;
+    /// it becomes the older one when it holds `half` rows.
+    fn add_group(&mut self, count: usize, half: usize) {
+        let m = self.row.len();
+        givens_add_rows(&mut self.factors[1], &mut self.group[..count * m], m);
+        self.rows[1] += count;
+        if self.rows[1] >= half {
+            let [a, b] = &mut self.factors;
+            std::mem::swap(a, b);
+            b.fill(0.0);
+            self.rows = [self.rows[1], 0];
+        }
+    }
 }
 
 impl Predictor {
@@ -272,13 +298,14 @@ impl Predictor {
             Candidate::Windowed { .. } => State::Windowed(Box::new(Windowed {
                 factors: [vec![0.0; (n + 1) * (n + 1)], vec![0.0; (n + 1) * (n + 1)]],
                 rows: [0, 0],
+                merged: vec![0.0; (n + 1) * (n + 1)],
                 cursor: None,
                 psi: vec![0.0; n],
                 row: vec![0.0; n + 1],
-                row2: vec![0.0; n + 1],
-                small: vec![0.0; n * n],
+                group: vec![0.0; GROUP * (n + 1)],
+                small: vec![0.0; (n + 1) * (n + 1)],
                 rhs: vec![0.0; n],
-                tail: vec![0.0; n],
+                ridge_rows: vec![0.0; n * (n + 1)],
                 scale: 0.0,
                 carries: false,
             })),
@@ -327,8 +354,9 @@ impl Predictor {
             let m = n + 2;
             l.carries = true;
             l.factors = [vec![0.0; m * m], vec![0.0; m * m]];
+            l.merged = vec![0.0; m * m];
             l.row = vec![0.0; m];
-            l.row2 = vec![0.0; m];
+            l.group = vec![0.0; GROUP * m];
         }
         self.reset();
     }
@@ -356,11 +384,11 @@ impl Predictor {
         l.scale = lead.scale;
         l.cursor = lead.cursor;
         l.rows = lead.rows;
-        if lead.rows[0] < n || l.scale == 0.0 {
+        if lead.rows[0] + lead.rows[1] < n || l.scale == 0.0 {
             return self.fitted;
         }
         // [Ψ t c] → [Ψ c t]: swap the last two columns …
-        let (src, dst) = (&lead.factors[0], &mut l.factors[0]);
+        let (src, dst) = (&lead.merged, &mut l.factors[0]);
         let (nm, t, c) = (n - 1, n - 1, n);
         for i in 0..m {
             let row = &src[i * m..(i + 1) * m];
@@ -383,7 +411,7 @@ impl Predictor {
             n,
             ridge,
             &mut l.small,
-            &mut l.tail,
+            &mut l.ridge_rows,
             &mut l.rhs,
         ) && l.rhs.iter().all(|v| v.is_finite())
         {
@@ -425,6 +453,7 @@ impl Predictor {
                 for f in &mut l.factors {
                     f.fill(0.0);
                 }
+                l.merged.fill(0.0);
                 l.rows = [0, 0];
             }
             State::Plain => {}
@@ -466,12 +495,12 @@ impl Predictor {
                     let inv = 1.0 / r.scale;
                     let max_trace = n as f64 * P0;
                     for k in rows {
-                        let t = model::row(&o, y, u, k, &mut r.psi[..nm]);
-                        if t == 0.0 && r.psi[..nm].iter().all(|&v| v == 0.0) {
+                        // scaled as it is built (a separate pass reloaded
+                        // the fresh scalar stores as vectors: a stall)
+                        let (t, informative) =
+                            model::row_scaled(&o, y, u, k, inv, &mut r.psi[..nm]);
+                        if !informative {
                             continue;
-                        }
-                        for v in r.psi[..nm].iter_mut() {
-                            *v *= inv;
                         }
                         if bias {
                             // the column `scale`, in scaled coordinates
@@ -483,7 +512,7 @@ impl Predictor {
                             &r.psi,
                             &mut self.theta,
                             &mut r.g,
-                            t * inv,
+                            t,
                             lambda,
                             max_trace,
                         );
@@ -506,6 +535,7 @@ impl Predictor {
                     for f in &mut l.factors {
                         f.fill(0.0);
                     }
+                    l.merged.fill(0.0);
                     l.rows = [0, 0];
                     l.scale = 0.0;
                     cursor = start.max(first).min(end);
@@ -521,9 +551,16 @@ impl Predictor {
                 if constant && l.scale == 0.0 {
                     l.scale = largest_row_entry(&o, y, u, rows.clone(), &mut l.psi[..nm]);
                 }
+                // rows gathered in groups of up to GROUP and rotated in
+                // together (the same result as one by one)
+                let m = l.row.len();
+                let mut pending = 0;
                 for k in rows {
-                    let t = model::row(&o, y, u, k, &mut l.psi[..nm]);
-                    if t == 0.0 && l.psi[..nm].iter().all(|&v| v == 0.0) {
+                    // built in place (a copy reloaded the fresh scalar
+                    // stores as vectors: a stall)
+                    let row = &mut l.group[pending * m..(pending + 1) * m];
+                    let t = model::row(&o, y, u, k, &mut row[..nm]);
+                    if t == 0.0 && row[..nm].iter().all(|&v| v == 0.0) {
                         continue;
                     }
                     // the column `scale` (no row before it is known): before
@@ -531,36 +568,33 @@ impl Predictor {
                     if constant && l.scale == 0.0 {
                         continue;
                     }
-                    l.row[..nm].copy_from_slice(&l.psi[..nm]);
                     if bias {
-                        l.row[nm] = l.scale;
+                        row[nm] = l.scale;
                     }
-                    l.row[n] = t;
+                    row[n] = t;
                     if l.carries {
-                        l.row[n + 1] = l.scale;
+                        row[n + 1] = l.scale;
                     }
-                    l.row2.copy_from_slice(&l.row);
-                    let [a, b] = &mut l.factors;
-                    givens_add_pair(a, &mut l.row, b, &mut l.row2);
-                    l.rows[0] += 1;
-                    l.rows[1] += 1;
-                    if l.rows[1] >= half {
-                        let [a, b] = &mut l.factors;
-                        std::mem::swap(a, b);
-                        b.fill(0.0);
-                        l.rows = [l.rows[1], 0];
+                    pending += 1;
+                    if pending == GROUP || l.rows[1] + pending >= half {
+                        l.add_group(pending, half);
+                        pending = 0;
                     }
+                }
+                if pending > 0 {
+                    l.add_group(pending, half);
                 }
                 l.cursor = Some(end);
                 let stride = l.row.len();
-                if l.rows[0] >= n
+                merge(&l.factors, l.rows, &mut l.merged, &mut l.row);
+                if l.rows[0] + l.rows[1] >= n
                     && solve_ridge(
-                        &l.factors[0],
+                        &l.merged,
                         stride,
                         n,
                         ridge,
                         &mut l.small,
-                        &mut l.tail,
+                        &mut l.ridge_rows,
                         &mut l.rhs,
                     )
                     && l.rhs.iter().all(|v| v.is_finite())
@@ -629,33 +663,27 @@ impl Predictor {
     }
 }
 
-/// [`givens_add`] of `row_a` into `a` and of `row_b` into `b` (the same
-/// length), interleaved: the two chains of dependent square roots and
-/// divisions overlap in the processor. Bit-identical to two calls.
-fn givens_add_pair(a: &mut [f64], row_a: &mut [f64], b: &mut [f64], row_b: &mut [f64]) {
-    let m = row_a.len();
-    debug_assert_eq!(row_b.len(), m);
-    for i in 0..m {
-        let rot_a = rotation(a[i * m + i], row_a[i]);
-        let rot_b = rotation(b[i * m + i], row_b[i]);
-        if let Some((rho, c, s)) = rot_a {
-            a[i * m + i] = rho;
-            rotate(
-                &mut a[i * m + i + 1..(i + 1) * m],
-                &mut row_a[i + 1..],
-                c,
-                s,
-            );
-        }
-        if let Some((rho, c, s)) = rot_b {
-            b[i * m + i] = rho;
-            rotate(
-                &mut b[i * m + i + 1..(i + 1) * m],
-                &mut row_b[i + 1..],
-                c,
-                s,
-            );
-        }
+/// The factor of the rows of both `factors` (holding `rows` rows each)
+/// into `merged`: the newer one's rows rotated into a copy of the older
+/// (a copy when either is empty); `row` is scratch of one row.
+fn merge(factors: &[Vec<f64>; 2], rows: [usize; 2], merged: &mut [f64], row: &mut [f64]) {
+    let [old, new] = factors;
+    if rows[0] == 0 {
+        merged.copy_from_slice(new);
+        return;
+    }
+    merged.copy_from_slice(old);
+    if rows[1] == 0 {
+        return;
+    }
+    let m = row.len();
+    // (every row: with fewer rows than columns, a zero regressor can leave
+    // a leading row of the triangle empty and fill a later one)
+    for (i, r) in new.chunks_exact(m).enumerate() {
+        // row i of a triangle is zero before column i
+        row[..i].fill(0.0);
+        row[i..].copy_from_slice(&r[i..]);
+        givens_add(merged, row);
     }
 }
 
@@ -674,19 +702,53 @@ fn rotation(d: f64, x: f64) -> Option<(f64, f64, f64)> {
     Some((rho, d * inv, x * inv))
 }
 
-/// Apply the rotation `(c, s)` to a factor row's tail `r` and the new row's `row`.
+/// [`givens_add`] of the rows of `rows` (each of `m` entries) in turn, as
+/// a wavefront: row `q` is rotated at column `c` in step `c + q`, after the
+/// rows before it have passed that column, so that the rows' chains of
+/// dependent square roots and divisions overlap. Bit-identical to adding
+/// them one by one.
 #[inline(always)]
-fn rotate(r: &mut [f64], row: &mut [f64], c: f64, s: f64) {
-    for (a, b) in r.iter_mut().zip(row.iter_mut()) {
-        let (x, y) = (*a, *b);
-        *a = c * x + s * y;
-        *b = c * y - s * x;
+fn givens_add_rows(r: &mut [f64], rows: &mut [f64], m: usize) {
+    givens_add_rows_upto(r, rows, m, m);
+}
+
+/// [`givens_add_rows`] eliminating the rows' first `cols ≤ m` columns only
+/// (the later ones are rotated along, not eliminated).
+#[inline(always)]
+fn givens_add_rows_upto(r: &mut [f64], rows: &mut [f64], m: usize, cols: usize) {
+    let g = rows.len() / m;
+    for step in 0..cols + g.saturating_sub(1) {
+        for q in 0..g.min(step + 1) {
+            let i = step - q;
+            if i >= cols {
+                continue;
+            }
+            let row = &mut rows[q * m..(q + 1) * m];
+            let x = row[i];
+            if x == 0.0 {
+                continue;
+            }
+            let d = r[i * m + i];
+            let rho = (d * d + x * x).sqrt();
+            if !(rho > 0.0) {
+                continue;
+            }
+            let inv = 1.0 / rho;
+            let (c, s) = (d * inv, x * inv);
+            r[i * m + i] = rho;
+            for j in i + 1..m {
+                let a = r[i * m + j];
+                let b = row[j];
+                r[i * m + j] = c * a + s * b;
+                row[j] = c * b - s * a;
+            }
+        }
     }
 }
 
 /// Rotate the row `row` (length `m`) into the row-major `m×m` upper-triangular
 /// factor `r` (Givens rotations; `row` is destroyed).
-#[cfg(test)]
+#[inline(always)]
 fn givens_add(r: &mut [f64], row: &mut [f64]) {
     let m = row.len();
     for i in 0..m {
@@ -722,59 +784,39 @@ fn solve_ridge(
     n: usize,
     ridge: f64,
     small: &mut [f64],
-    row_tail: &mut [f64],
+    ridge_rows: &mut [f64],
     theta: &mut [f64],
 ) -> bool {
+    // [R z] into `small` ((n+1)×(n+1), the last row unused)
+    let w = n + 1;
     let mut frob = 0.0;
+    small.fill(0.0);
     for i in 0..n {
         for j in i..n {
-            small[i * n + j] = f[i * m + j];
+            small[i * w + j] = f[i * m + j];
             frob += f[i * m + j] * f[i * m + j];
         }
-        for j in 0..i {
-            small[i * n + j] = 0.0;
-        }
-        theta[i] = f[i * m + n];
+        small[i * w + n] = f[i * m + n];
     }
     if !(frob > 0.0 && frob.is_finite()) {
         return false;
     }
     let lambda = ridge.max(1e-12) * frob / n as f64;
+    // fold the rows [√λ·e_k 0] into the triangle (together, as a wavefront:
+    // the same as one after the other)
+    ridge_rows.fill(0.0);
     let root = lambda.sqrt();
-    // fold the rows √λ·e_k (right-hand side 0) into the triangle
     for k in 0..n {
-        let mut extra_rhs = 0.0;
-        // the row √λ·e_k is zero before column k
-        row_tail.fill(0.0);
-        row_tail[k] = root;
-        for i in k..n {
-            let x = row_tail[i];
-            if x == 0.0 {
-                continue;
-            }
-            let d = small[i * n + i];
-            let rho = (d * d + x * x).sqrt();
-            let inv = 1.0 / rho;
-            let (c, s) = (d * inv, x * inv);
-            small[i * n + i] = rho;
-            for j in i + 1..n {
-                let a = small[i * n + j];
-                let b = row_tail[j];
-                small[i * n + j] = c * a + s * b;
-                row_tail[j] = c * b - s * a;
-            }
-            let a = theta[i];
-            theta[i] = c * a + s * extra_rhs;
-            extra_rhs = c * extra_rhs - s * a;
-        }
+        ridge_rows[k * w + k] = root;
     }
+    givens_add_rows_upto(small, &mut ridge_rows[..n * w], w, n);
     // back substitution
     for i in (0..n).rev() {
-        let mut v = theta[i];
+        let mut v = small[i * w + n];
         for j in i + 1..n {
-            v -= small[i * n + j] * theta[j];
+            v -= small[i * w + j] * theta[j];
         }
-        let d = small[i * n + i];
+        let d = small[i * w + i];
         if !(d.abs() > 0.0) {
             return false;
         }
@@ -920,35 +962,105 @@ mod tests {
     }
 
     #[test]
-    fn interleaved_givens_updates_equal_two_single_updates_bit_for_bit() {
+    fn rows_rotated_in_as_a_wavefront_equal_rows_rotated_in_one_by_one_bit_for_bit() {
         use rand::{Rng, SeedableRng};
         use rand_chacha::ChaCha8Rng;
-        // seeded rows, some with zeros (skipped rotations), into two factors
-        let m = 5;
-        let mut rng = ChaCha8Rng::seed_from_u64(12);
-        let mut next = || rng.random_range(-0.5..0.5);
-        let (mut a, mut b) = (vec![0.0; m * m], vec![0.0; m * m]);
-        let (mut a1, mut b1) = (a.clone(), b.clone());
-        for k in 0..200 {
-            let mut ra: Vec<f64> = (0..m)
-                .map(|j| if (k + j) % 7 == 0 { 0.0 } else { next() })
-                .collect();
-            let mut rb: Vec<f64> = (0..m)
-                .map(|j| if (k * j) % 5 == 3 { 0.0 } else { next() })
-                .collect();
-            let (mut ra1, mut rb1) = (ra.clone(), rb.clone());
-            givens_add_pair(&mut a, &mut ra, &mut b, &mut rb);
-            givens_add(&mut a1, &mut ra1);
-            givens_add(&mut b1, &mut rb1);
-            if k == 100 {
-                b.fill(0.0); // a factor started over, as the windowed candidate does
-                b1.fill(0.0);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for (m, g) in [(5, 1), (5, 4), (6, 3), (4, 4), (6, 7)] {
+            let (mut a, mut b) = (vec![0.0; m * m], vec![0.0; m * m]);
+            for round in 0..20 {
+                // some zero entries (skipped rotations), leading ones included
+                let mut rows: Vec<f64> = (0..g * m)
+                    .map(|i| {
+                        if (i + round) % 6 == 0 {
+                            0.0
+                        } else {
+                            rng.random_range(-1.0..1.0)
+                        }
+                    })
+                    .collect();
+                for row in rows.clone().chunks_exact(m) {
+                    givens_add(&mut a, &mut row.to_vec());
+                }
+                givens_add_rows(&mut b, &mut rows, m);
+            }
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&a), bits(&b), "m {m}, group {g}");
+        }
+        // eliminating fewer columns than the rows hold: the ridge rows of
+        // `solve_ridge`, the last column rotated along
+        let w = 4;
+        let mut r: Vec<f64> = (0..w * w)
+            .map(|i| if i / w <= i % w { 1.0 + i as f64 } else { 0.0 })
+            .collect();
+        let mut r1 = r.clone();
+        let mut rows = vec![0.0; 3 * w];
+        for k in 0..3 {
+            rows[k * w + k] = 0.5;
+        }
+        for row in rows.clone().chunks_exact(w) {
+            let mut row = row.to_vec();
+            for i in 0..3 {
+                let x = row[i];
+                if x == 0.0 {
+                    continue;
+                }
+                let d = r1[i * w + i];
+                let rho = (d * d + x * x).sqrt();
+                let (c, s) = (d / rho, x / rho);
+                r1[i * w + i] = rho;
+                for j in i + 1..w {
+                    let (p, q) = (r1[i * w + j], row[j]);
+                    r1[i * w + j] = c * p + s * q;
+                    row[j] = c * q - s * p;
+                }
             }
         }
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&a), bits(&a1));
-        assert_eq!(bits(&b), bits(&b1));
-        assert!(a.iter().any(|&x| x != 0.0) && b.iter().any(|&x| x != 0.0));
+        givens_add_rows_upto(&mut r, &mut rows, w, 3);
+        for (x, y) in r.iter().zip(&r1) {
+            assert!((x - y).abs() <= 1e-15 * y.abs().max(1.0), "{x} vs {y}");
+        }
+        assert_eq!(r[3 * w + 3], 16.0, "the last row is not touched");
+    }
+
+    #[test]
+    fn merging_two_factors_gives_the_factor_of_all_their_rows() {
+        use rand::{Rng, SeedableRng};
+        use rand_chacha::ChaCha8Rng;
+        // seeded rows, some with zeros (skipped rotations); the newer block
+        // with fewer rows than columns, its first row without a lead entry
+        let m = 5;
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        for (n_old, n_new) in [(0, 3), (7, 0), (50, 2), (50, 49), (6, 1)] {
+            let mut row_of = |k: usize| -> Vec<f64> {
+                (0..m)
+                    .map(|j| {
+                        if (k + j) % 7 == 0 {
+                            0.0
+                        } else {
+                            rng.random_range(-0.5..0.5)
+                        }
+                    })
+                    .collect()
+            };
+            let rows: Vec<Vec<f64>> = (0..n_old + n_new).map(&mut row_of).collect();
+            let (mut old, mut new, mut all) =
+                (vec![0.0; m * m], vec![0.0; m * m], vec![0.0; m * m]);
+            for (k, r) in rows.iter().enumerate() {
+                let target = if k < n_old { &mut old } else { &mut new };
+                givens_add(target, &mut r.clone());
+                givens_add(&mut all, &mut r.clone());
+            }
+            let (mut merged, mut scratch) = (vec![0.0; m * m], vec![0.0; m]);
+            merge(&[old, new], [n_old, n_new], &mut merged, &mut scratch);
+            // the factor is unique: positive diagonals (Givens) on both sides
+            for (i, (a, b)) in merged.iter().zip(&all).enumerate() {
+                assert!(
+                    (a - b).abs() <= 1e-12,
+                    "{n_old}+{n_new} rows, entry {i}: {a} vs {b}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -68,10 +68,50 @@ pub(crate) fn row(o: &ArxOrders, y: &[f64], u: &[f64], k: usize, psi: &mut [f64]
     y[k] - rho
 }
 
+/// [`row`] with every entry and the target multiplied by `inv`; also
+/// whether the unscaled row or target has a non-zero entry. Bit-identical
+/// to scaling the result of [`row`].
+#[inline]
+pub(crate) fn row_scaled(
+    o: &ArxOrders,
+    y: &[f64],
+    u: &[f64],
+    k: usize,
+    inv: f64,
+    psi: &mut [f64],
+) -> (f64, bool) {
+    let rho = y[k - 1];
+    let t = y[k] - rho;
+    let mut any = t != 0.0;
+    let mut i = 0;
+    for a in 2..=o.na {
+        let v = -(y[k - a] - rho);
+        any |= v != 0.0;
+        psi[i] = v * inv;
+        i += 1;
+    }
+    for j in 0..o.nb {
+        let v = u[k - o.nk - j] - rho;
+        any |= v != 0.0;
+        psi[i] = v * inv;
+        i += 1;
+    }
+    (t * inv, any)
+}
+
 /// k-step prediction of `out.len()` samples from the local index `e`: `y`
 /// measured below `e`, `u` known up to `e + out.len()`; `c` the constant
 /// added to every increment (0 without a bias); `past` a scratch of length
 /// `≥ na + out.len()`.
+///
+/// Computed relative to the last measured position `r = y[e−1]` (an offset
+/// of the recording cancels before any product): with `d` the positions
+/// and `ū` the commands minus `r`, the increment of the unit-gain model is
+/// `−Σ θ_a·d(h−a) + Σ θ_b·ū + d(h−1)·(Σθ_a − Σθ_b)`. The command's share
+/// does not depend on the predictions and is summed first; the recursion
+/// then only carries one product and two additions from one step to the
+/// next (the step-by-step form chained every term through the previous
+/// prediction).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn predict(
     o: &ArxOrders,
@@ -84,25 +124,37 @@ pub(crate) fn predict(
     out: &mut [f64],
 ) {
     let na = o.na.max(1);
-    for i in 0..na {
-        past[i] = y[e - na + i];
+    let r = y[e - 1];
+    let (ta, tb) = theta.split_at(o.na.saturating_sub(1));
+    let mut sum = 0.0;
+    for &a in ta {
+        sum += a;
     }
+    for &b in tb {
+        sum -= b;
+    }
+    // the command's share of each increment (off the recursion)
+    for (h, v) in out.iter_mut().enumerate() {
+        let t = e + h - o.nk;
+        let mut acc = 0.0;
+        for (j, &b) in tb.iter().enumerate() {
+            acc += b * (u[t - j] - r);
+        }
+        *v = acc + c;
+    }
+    for i in 0..na {
+        past[i] = y[e - na + i] - r;
+    }
+    let keep = 1.0 + sum;
     for h in 0..out.len() {
-        let t = e + h;
-        let rho = past[na + h - 1];
-        let mut v = 0.0;
-        let mut p = 0;
-        for a in 2..=o.na {
-            v -= theta[p] * (past[na + h - a] - rho);
-            p += 1;
+        // the oldest terms first: the newest prediction enters last
+        let mut v = out[h];
+        for a in (2..=o.na).rev() {
+            v -= ta[a - 2] * past[na + h - a];
         }
-        for j in 0..o.nb {
-            v += theta[p] * (u[t - o.nk - j] - rho);
-            p += 1;
-        }
-        let yh = rho + v + c;
-        past[na + h] = yh;
-        out[h] = yh;
+        let d = v + past[na + h - 1] * keep;
+        past[na + h] = d;
+        out[h] = r + d;
     }
 }
 

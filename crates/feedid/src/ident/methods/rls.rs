@@ -326,14 +326,22 @@ impl RlsEstimator {
         #[cfg(target_arch = "x86_64")]
         let r = if self.avx {
             // SAFETY: `avx` is set only when the CPU reports AVX2 (`new`).
-            unsafe { add_avx2(self.n, self.n, p, psi, theta, g, target, lambda, max) }
+            unsafe {
+                add_avx2::<false>(
+                    self.n, self.n, p, psi, theta, g, target, lambda, max, &mut 1.0,
+                )
+            }
         } else {
-            add_sized(self.n, self.n, p, psi, theta, g, target, lambda, max)
+            add_sized::<false>(
+                self.n, self.n, p, psi, theta, g, target, lambda, max, &mut 1.0,
+            )
         };
         #[cfg(not(target_arch = "x86_64"))]
         let r = {
             let _ = self.avx;
-            add_sized(self.n, self.n, p, psi, theta, g, target, lambda, max)
+            add_sized::<false>(
+                self.n, self.n, p, psi, theta, g, target, lambda, max, &mut 1.0,
+            )
         };
         match r {
             Ok(e) => e,
@@ -408,19 +416,31 @@ pub(crate) fn has_avx2() -> bool {
     }
 }
 
-/// One exponentially weighted RLS update (the update of [`RlsEstimator`],
-/// shared with `auto`'s recursive candidates) of the `n = θ.len()`
-/// parameters: `p` row-major `n×s` with the stride `s = ψ.len() ≥ n` (the
-/// rows padded to `s` columns, for whole vectors: the pads of `p` and `ψ`
-/// must be zero, and they stay zero) and exactly symmetric in its `n×n`
-/// part, `g` a scratch of length `s`, trace bound `max` (∞ = none), `avx`
-/// from [`has_avx2`]. Returns the a-priori error, or `Err(e)` if
-/// `λ + ψᵀPψ` is not positive (nothing updated). The padding changes no
-/// result (bit-identical to `s = n`).
+/// One exponentially weighted RLS update of `auto`'s recursive candidates
+/// (the update of [`RlsEstimator`] on a scaled covariance) of the
+/// `n = θ.len()` parameters: the covariance is `P = κ·P̃`, `p` holding `P̃`
+/// row-major `n×s` with the stride `s = ψ.len() ≥ n` (the rows padded to
+/// `s` columns, for whole vectors: the pads of `p` and `ψ` must be zero,
+/// and they stay zero) and exactly symmetric in its `n×n` part, `kappa`
+/// holding `κ`; `g` a scratch of length `s`, trace bound `max` on `tr P`
+/// (∞ = none), `avx` from [`has_avx2`]. With `g̃ = P̃ψ` and
+/// `d = λ + κ·ψᵀg̃`:
+///
+/// ```text
+/// θ ← θ + g̃·(κ/d)·(ỹ − ψᵀθ),   P̃ᵢⱼ ← P̃ᵢⱼ − (g̃ᵢ·g̃ⱼ)·(κ/d),   κ ← κ/λ
+/// ```
+///
+/// — the forgetting and the trace bound act on `κ` alone (two
+/// multiplications per entry instead of three). Keep `κ` within a few
+/// hundred binary orders of 1 by folding it into `p` now and then
+/// ([`fold_scale`]). Returns the a-priori error, or `Err(e)` if `d` is not
+/// positive (nothing updated). The padding changes no result
+/// (bit-identical to `s = n`).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn rls_update(
     avx: bool,
     p: &mut [f64],
+    kappa: &mut f64,
     psi: &[f64],
     theta: &mut [f64],
     g: &mut [f64],
@@ -432,16 +452,29 @@ pub(crate) fn rls_update(
     #[cfg(target_arch = "x86_64")]
     if avx {
         // SAFETY: callers pass `avx` from `has_avx2`.
-        return unsafe { add_avx2(s, n, p, psi, theta, g, target, lambda, max) };
+        return unsafe { add_avx2::<true>(s, n, p, psi, theta, g, target, lambda, max, kappa) };
     }
     let _ = avx;
-    add_sized(s, n, p, psi, theta, g, target, lambda, max)
+    add_sized::<true>(s, n, p, psi, theta, g, target, lambda, max, kappa)
+}
+
+/// Fold the scale `κ` of a covariance `P = κ·P̃` (see [`rls_update`]) into
+/// `p` when it has left `[2⁻¹⁰⁰, 2¹⁰⁰]`, so that `P̃` neither underflows
+/// nor overflows; `P` is unchanged (to rounding).
+pub(crate) fn fold_scale(p: &mut [f64], kappa: &mut f64) {
+    const WIDE: f64 = 1.2676506002282294e30; // 2¹⁰⁰
+    if !(1.0 / WIDE..=WIDE).contains(kappa) {
+        for v in p.iter_mut() {
+            *v *= *kappa;
+        }
+        *kappa = 1.0;
+    }
 }
 
 /// [`add_kernel`] with the strides up to 16 as constants (unrolled, vectorised).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn add_sized(
+fn add_sized<const SCALED: bool>(
     s: usize,
     n: usize,
     p: &mut [f64],
@@ -451,13 +484,14 @@ fn add_sized(
     target: f64,
     lambda: f64,
     max: f64,
+    kappa: &mut f64,
 ) -> std::result::Result<f64, f64> {
     // each arm inlines the kernel with a constant size (unrolled loops)
     macro_rules! sized {
         ($($k:literal)*) => {
             match s {
-                $($k => add_kernel($k, n, p, psi, theta, g, target, lambda, max),)*
-                _ => add_kernel(s, n, p, psi, theta, g, target, lambda, max),
+                $($k => add_kernel::<SCALED>($k, n, p, psi, theta, g, target, lambda, max, kappa),)*
+                _ => add_kernel::<SCALED>(s, n, p, psi, theta, g, target, lambda, max, kappa),
             }
         };
     }
@@ -469,7 +503,7 @@ fn add_sized(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(clippy::too_many_arguments)]
-fn add_avx2(
+fn add_avx2<const SCALED: bool>(
     s: usize,
     n: usize,
     p: &mut [f64],
@@ -479,17 +513,20 @@ fn add_avx2(
     target: f64,
     lambda: f64,
     max: f64,
+    kappa: &mut f64,
 ) -> std::result::Result<f64, f64> {
-    add_sized(s, n, p, psi, theta, g, target, lambda, max)
+    add_sized::<SCALED>(s, n, p, psi, theta, g, target, lambda, max, kappa)
 }
 
 /// The update of [`RlsEstimator::add`] on `n` parameters stored with the
 /// stride `s ≥ n` (see [`rls_update`]) with the trace bound `max` (∞ =
 /// none); `Err(e)` if `λ + ψᵀg` is not positive (nothing updated, the
-/// trace bound not applied).
+/// trace bound not applied). `SCALED`: `p` holds `P̃` of `P = κ·P̃`
+/// (`kappa`, see [`rls_update`]); otherwise `p` holds `P` and `kappa` is
+/// not used.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn add_kernel(
+fn add_kernel<const SCALED: bool>(
     s: usize,
     n: usize,
     p: &mut [f64],
@@ -499,9 +536,11 @@ fn add_kernel(
     target: f64,
     lambda: f64,
     max: f64,
+    kappa: &mut f64,
 ) -> std::result::Result<f64, f64> {
     let (p, psi, theta, g) = (&mut p[..n * s], &psi[..s], &mut theta[..n], &mut g[..s]);
-    // the trace of P before the update (off the critical path)
+    let k = if SCALED { *kappa } else { 1.0 };
+    // the trace of P̃ before the update (off the critical path)
     let mut diag = 0.0;
     if max < f64::INFINITY {
         for i in 0..n {
@@ -510,36 +549,50 @@ fn add_kernel(
     }
     let pred = dot4(&psi[..n], theta);
     sym_mul(p, psi, g);
-    let den = lambda + dot4(psi, g);
+    let den = if SCALED {
+        lambda + k * dot4(psi, g)
+    } else {
+        lambda + dot4(psi, g)
+    };
     let e = target - pred;
     if !(den > 0.0) || !den.is_finite() {
         return Err(e);
     }
     let inv = 1.0 / den;
+    // κ/d (SCALED) or 1/d
+    let c = if SCALED { k * inv } else { inv };
     for (t, &gi) in theta.iter_mut().zip(g.iter()) {
-        *t += gi * inv * e;
+        *t += gi * c * e;
     }
     let il = 1.0 / lambda;
     let g = &*g;
-    let mut f = 1.0;
-    if max < f64::INFINITY {
-        // trace of the updated P: tr(P − g·gᵀ/den)/λ
-        let tr = (diag - dot4(&g[..n], &g[..n]) * inv) * il;
-        if tr > max {
-            f = max / tr;
-        }
-    }
-    // (gᵢ·gⱼ)·inv keeps P exactly symmetric without a square root
-    if f == 1.0 {
+    // trace of the updated P: κ·tr(P̃ − g̃·g̃ᵀ·κ/d)/λ
+    let tr = if max < f64::INFINITY {
+        (diag - dot4(&g[..n], &g[..n]) * c) * k * il
+    } else {
+        0.0
+    };
+    let f = if tr > max { max / tr } else { 1.0 };
+    if SCALED {
+        // (g̃ᵢ·g̃ⱼ)·c keeps P̃ exactly symmetric; forgetting and the bound
+        // act on κ
         for (row, &gi) in p.chunks_exact_mut(s).zip(g) {
             for (v, &gj) in row.iter_mut().zip(g) {
-                *v = (*v - gi * gj * inv) * il;
+                *v -= gi * gj * c;
+            }
+        }
+        *kappa = k * il * f;
+    } else if f == 1.0 {
+        // (gᵢ·gⱼ)·(1/d) keeps P exactly symmetric without a square root
+        for (row, &gi) in p.chunks_exact_mut(s).zip(g) {
+            for (v, &gj) in row.iter_mut().zip(g) {
+                *v = (*v - gi * gj * c) * il;
             }
         }
     } else {
         for (row, &gi) in p.chunks_exact_mut(s).zip(g) {
             for (v, &gj) in row.iter_mut().zip(g) {
-                *v = (*v - gi * gj * inv) * il * f;
+                *v = (*v - gi * gj * c) * il * f;
             }
         }
     }
@@ -1006,6 +1059,7 @@ mod tests {
                 }
                 let (mut th1, mut th2) = (vec![0.0; n], vec![0.0; n]);
                 let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; s]);
+                let (mut k1, mut k2) = (1.0, 1.0);
                 let mut psi2 = vec![0.0; s];
                 for k in 0..300 {
                     let psi1: Vec<f64> = (0..n)
@@ -1013,9 +1067,14 @@ mod tests {
                         .collect();
                     psi2[..n].copy_from_slice(&psi1);
                     let target = next();
-                    let a = rls_update(avx, &mut p1, &psi1, &mut th1, &mut g1, target, 0.99, max);
-                    let b = rls_update(avx, &mut p2, &psi2, &mut th2, &mut g2, target, 0.99, max);
+                    let a = rls_update(
+                        avx, &mut p1, &mut k1, &psi1, &mut th1, &mut g1, target, 0.99, max,
+                    );
+                    let b = rls_update(
+                        avx, &mut p2, &mut k2, &psi2, &mut th2, &mut g2, target, 0.99, max,
+                    );
                     assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "n {n} k {k}");
+                    assert_eq!(k1.to_bits(), k2.to_bits(), "n {n} k {k}");
                 }
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&th1), bits(&th2), "n {n}");
@@ -1031,6 +1090,70 @@ mod tests {
                     );
                 }
                 assert!(th1.iter().any(|&v| v != 0.0));
+            }
+        }
+    }
+
+    #[test]
+    fn the_scaled_covariance_update_equals_the_plain_update() {
+        // auto's update on P = κ·P̃ against the RlsEstimator's on P, with
+        // and without the trace bound (which binds: a weak prior, rows
+        // that stop exciting half the parameters), through κ being folded
+        // back into P̃ (unbounded)
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let avx = has_avx2();
+        for n in [5usize, 6, 7, 11, 15] {
+            let s = if n % 4 == 3 { n + 1 } else { n };
+            for max in [f64::INFINITY, 2.0 * n as f64] {
+                let (mut p1, mut p2) = (vec![0.0; n * n], vec![0.0; n * s]);
+                for i in 0..n {
+                    p1[i * n + i] = 1.0;
+                    p2[i * s + i] = 1.0;
+                }
+                let (mut th1, mut th2) = (vec![0.0; n], vec![0.0; n]);
+                let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; s]);
+                let mut kappa = 1.0;
+                let (mut psi1, mut psi2) = (vec![0.0; n], vec![0.0; s]);
+                let truth: Vec<f64> = (0..n).map(|j| 0.3 - 0.05 * j as f64).collect();
+                let mut folds = 0;
+                for k in 0..3000 {
+                    for (j, v) in psi1.iter_mut().enumerate() {
+                        *v = if k > 1500 && j % 2 == 1 {
+                            0.0
+                        } else {
+                            rng.random_range(-1.0..1.0)
+                        };
+                    }
+                    psi2[..n].copy_from_slice(&psi1);
+                    let t = psi1.iter().zip(&truth).map(|(a, b)| a * b).sum::<f64>()
+                        + 1e-3 * rng.random_range(-1.0..1.0);
+                    let _ = add_sized::<false>(
+                        n, n, &mut p1, &psi1, &mut th1, &mut g1, t, 0.95, max, &mut 1.0,
+                    );
+                    let _ = rls_update(
+                        avx, &mut p2, &mut kappa, &psi2, &mut th2, &mut g2, t, 0.95, max,
+                    );
+                    let before = kappa;
+                    fold_scale(&mut p2, &mut kappa);
+                    folds += usize::from(kappa != before);
+                }
+                let scale = p1.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for i in 0..n {
+                    for j in 0..n {
+                        let (a, b) = (p1[i * n + j], kappa * p2[i * s + j]);
+                        assert!(
+                            (a - b).abs() <= 1e-9 * scale,
+                            "n {n} max {max}: P[{i},{j}] {a} vs {b}"
+                        );
+                    }
+                }
+                for (a, b) in th1.iter().zip(&th2) {
+                    assert!((a - b).abs() <= 1e-9, "n {n} max {max}: θ {a} vs {b}");
+                }
+                if max.is_infinite() {
+                    // without the bound κ grows by 1/0.95 per update: folded
+                    assert!(folds > 0, "n {n}: κ was never folded");
+                }
             }
         }
     }

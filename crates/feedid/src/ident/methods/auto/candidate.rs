@@ -17,7 +17,7 @@ use std::ops::Range;
 
 use super::model;
 use crate::error::{Error, Result};
-use crate::ident::methods::rls::{has_avx2, rls_update};
+use crate::ident::methods::rls::{fold_scale, has_avx2, rls_update};
 use crate::ident::{ArxOrders, Signals};
 
 /// Initial covariance `P₀ = p0·I` of the recursive candidates, in
@@ -210,7 +210,10 @@ enum State {
 
 #[derive(Debug, Clone)]
 struct Recursive {
+    /// `P̃` of the covariance `P = κ·P̃` (see [`rls_update`]).
     p: Vec<f64>,
+    /// `κ`.
+    kappa: f64,
     psi: Vec<f64>,
     g: Vec<f64>,
     /// Next sample to process (absolute).
@@ -289,6 +292,7 @@ impl Predictor {
             Candidate::Hold | Candidate::Command => State::Plain,
             Candidate::Recursive { .. } => State::Recursive(Box::new(Recursive {
                 p: vec![0.0; n * stride(n)],
+                kappa: 1.0,
                 psi: vec![0.0; stride(n)],
                 g: vec![0.0; stride(n)],
                 cursor: None,
@@ -445,7 +449,7 @@ impl Predictor {
             State::Recursive(r) => {
                 r.cursor = None;
                 r.scale = 0.0;
-                reset_covariance(&mut r.p, self.theta.len());
+                reset_covariance(&mut r.p, &mut r.kappa, self.theta.len());
             }
             State::Windowed(l) => {
                 l.cursor = None;
@@ -479,7 +483,7 @@ impl Predictor {
                     self.theta.fill(0.0);
                     self.fitted = false;
                     r.scale = 0.0;
-                    reset_covariance(&mut r.p, self.theta.len());
+                    reset_covariance(&mut r.p, &mut r.kappa, self.theta.len());
                     cursor = start.max(first).min(end);
                 }
                 let Ok(w) = signals.window(cursor..end, lag, "auto candidate") else {
@@ -509,6 +513,7 @@ impl Predictor {
                         let _ = rls_update(
                             r.avx,
                             &mut r.p,
+                            &mut r.kappa,
                             &r.psi,
                             &mut self.theta,
                             &mut r.g,
@@ -518,9 +523,10 @@ impl Predictor {
                         );
                         self.fitted = true;
                     }
+                    fold_scale(&mut r.p, &mut r.kappa);
                     if !self.theta.iter().all(|v| v.is_finite()) {
                         self.theta.fill(0.0);
-                        reset_covariance(&mut r.p, n);
+                        reset_covariance(&mut r.p, &mut r.kappa, n);
                         self.fitted = false;
                     }
                 }
@@ -837,7 +843,8 @@ fn stride(n: usize) -> usize {
     }
 }
 
-fn reset_covariance(p: &mut [f64], n: usize) {
+fn reset_covariance(p: &mut [f64], kappa: &mut f64, n: usize) {
+    *kappa = 1.0;
     p.fill(0.0);
     let s = stride(n);
     for i in 0..n {

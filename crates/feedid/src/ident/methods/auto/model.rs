@@ -146,15 +146,18 @@ pub(crate) fn predict(
         past[i] = y[e - na + i] - r;
     }
     let keep = 1.0 + sum;
+    // the previous prediction stays in a register (not reloaded from `past`)
+    let mut prev = past[na - 1];
     for h in 0..out.len() {
         // the oldest terms first: the newest prediction enters last
         let mut v = out[h];
         for a in (2..=o.na).rev() {
             v -= ta[a - 2] * past[na + h - a];
         }
-        let d = v + past[na + h - 1] * keep;
+        let d = v + prev * keep;
         past[na + h] = d;
         out[h] = r + d;
+        prev = d;
     }
 }
 

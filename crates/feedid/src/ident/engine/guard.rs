@@ -294,7 +294,7 @@ impl Guard {
             let y = position(k);
             let mut latest: Option<(f64, usize)> = None;
             for i in 0..self.count {
-                let p = &self.slots[(self.first + i) % n_slots];
+                let p = &self.slots[wrap(self.first + i, n_slots)];
                 if k >= p.start && k < p.start + p.len {
                     latest = Some((p.values[k - p.start], k - p.start));
                 }
@@ -369,16 +369,17 @@ impl Guard {
             self.last = Some(c.y);
             // the largest motion over a horizon, on the cleaned samples
             let h = self.recent.len();
+            let at = self.seen % h;
             if self.seen >= h {
-                let old = self.recent[self.seen % h];
+                let old = self.recent[at];
                 self.motion = self.motion.max((y_clean - old).abs());
             }
-            self.recent[self.seen % h] = y_clean;
+            self.recent[at] = y_clean;
             self.seen += 1;
             if !outlier {
                 let w = self.config.adaptation;
                 for s in 0..self.count {
-                    let p = &self.slots[(self.first + s) % n_slots];
+                    let p = &self.slots[wrap(self.first + s, n_slots)];
                     if k >= p.start && k < p.start + p.len {
                         let j = k - p.start;
                         let e = (c.y - p.values[j]).abs();
@@ -454,6 +455,16 @@ impl Guard {
             *lo = v - q;
             *hi = v + q;
         }
+    }
+}
+
+/// `i mod n` for `i < 2n` (the ring index of a slot; no division).
+#[inline]
+fn wrap(i: usize, n: usize) -> usize {
+    if i >= n {
+        i - n
+    } else {
+        i
     }
 }
 

@@ -211,11 +211,17 @@ impl AutoEstimator {
         let from = self.experienced_to.max(signals.offset() + h).min(end);
         if let Ok(w) = signals.window(from..end, h, "auto experience") {
             let y = w.position;
+            // (plain comparisons: the positions are finite, and f64::min/max
+            // cost their NaN handling on every sample)
             for k in h..y.len() {
                 let (mut lo, mut hi) = (y[k], y[k]);
                 for &v in &y[k - h..k] {
-                    lo = lo.min(v);
-                    hi = hi.max(v);
+                    if v < lo {
+                        lo = v;
+                    }
+                    if v > hi {
+                        hi = v;
+                    }
                 }
                 if hi - lo > self.experience {
                     self.experience = hi - lo;

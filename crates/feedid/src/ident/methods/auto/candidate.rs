@@ -730,17 +730,9 @@ fn givens_add_rows_upto(r: &mut [f64], rows: &mut [f64], m: usize, cols: usize) 
                 continue;
             }
             let row = &mut rows[q * m..(q + 1) * m];
-            let x = row[i];
-            if x == 0.0 {
+            let Some((rho, c, s)) = rotation(r[i * m + i], row[i]) else {
                 continue;
-            }
-            let d = r[i * m + i];
-            let rho = (d * d + x * x).sqrt();
-            if !(rho > 0.0) {
-                continue;
-            }
-            let inv = 1.0 / rho;
-            let (c, s) = (d * inv, x * inv);
+            };
             r[i * m + i] = rho;
             for j in i + 1..m {
                 let a = r[i * m + j];
@@ -757,26 +749,7 @@ fn givens_add_rows_upto(r: &mut [f64], rows: &mut [f64], m: usize, cols: usize) 
 #[inline(always)]
 fn givens_add(r: &mut [f64], row: &mut [f64]) {
     let m = row.len();
-    for i in 0..m {
-        let x = row[i];
-        if x == 0.0 {
-            continue;
-        }
-        let d = r[i * m + i];
-        let rho = (d * d + x * x).sqrt();
-        if !(rho > 0.0) {
-            continue;
-        }
-        let inv = 1.0 / rho;
-        let (c, s) = (d * inv, x * inv);
-        r[i * m + i] = rho;
-        for j in i + 1..m {
-            let a = r[i * m + j];
-            let b = row[j];
-            r[i * m + j] = c * a + s * b;
-            row[j] = c * b - s * a;
-        }
-    }
+    givens_add_rows_upto(r, row, m, m);
 }
 
 /// Solve `min ‖R·θ − z‖² + λ‖θ‖²` from the upper-triangular factor of
@@ -968,6 +941,27 @@ mod tests {
         assert!(follower.fitted && (follower.constant() - 2e-6).abs() < 1e-7);
     }
 
+    /// The textbook row update, column by column (the reference).
+    fn givens_add_one_by_one(r: &mut [f64], row: &mut [f64]) {
+        let m = row.len();
+        for i in 0..m {
+            let x = row[i];
+            if x == 0.0 {
+                continue;
+            }
+            let d = r[i * m + i];
+            let rho = (d * d + x * x).sqrt();
+            let inv = 1.0 / rho;
+            let (c, s) = (d * inv, x * inv);
+            r[i * m + i] = rho;
+            for j in i + 1..m {
+                let (a, b) = (r[i * m + j], row[j]);
+                r[i * m + j] = c * a + s * b;
+                row[j] = c * b - s * a;
+            }
+        }
+    }
+
     #[test]
     fn rows_rotated_in_as_a_wavefront_equal_rows_rotated_in_one_by_one_bit_for_bit() {
         use rand::{Rng, SeedableRng};
@@ -987,7 +981,7 @@ mod tests {
                     })
                     .collect();
                 for row in rows.clone().chunks_exact(m) {
-                    givens_add(&mut a, &mut row.to_vec());
+                    givens_add_one_by_one(&mut a, &mut row.to_vec());
                 }
                 givens_add_rows(&mut b, &mut rows, m);
             }

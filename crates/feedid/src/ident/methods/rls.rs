@@ -1040,6 +1040,25 @@ mod tests {
         }
     }
 
+    /// An RLS state of `n` parameters twice, unpadded and with the stride
+    /// `s`: covariances `p0·I`, zero parameters, gain scratch —
+    /// `[p, p_padded, θ, θ_padded, g, g_padded]`.
+    fn two_states(n: usize, s: usize, p0: f64) -> [Vec<f64>; 6] {
+        let (mut p1, mut p2) = (vec![0.0; n * n], vec![0.0; n * s]);
+        for i in 0..n {
+            p1[i * n + i] = p0;
+            p2[i * s + i] = p0;
+        }
+        [
+            p1,
+            p2,
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; s],
+        ]
+    }
+
     #[test]
     fn padded_rows_give_the_unpadded_updates_bit_for_bit() {
         // rls_update on P stored with rows padded to whole 4-wide vectors
@@ -1052,13 +1071,7 @@ mod tests {
         for n in 2..=15usize {
             let s = n.div_ceil(4usize) * 4;
             for max in [f64::INFINITY, 50.0 * n as f64] {
-                let (mut p1, mut p2) = (vec![0.0; n * n], vec![0.0; n * s]);
-                for i in 0..n {
-                    p1[i * n + i] = 100.0;
-                    p2[i * s + i] = 100.0;
-                }
-                let (mut th1, mut th2) = (vec![0.0; n], vec![0.0; n]);
-                let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; s]);
+                let [mut p1, mut p2, mut th1, mut th2, mut g1, mut g2] = two_states(n, s, 100.0);
                 let (mut k1, mut k2) = (1.0, 1.0);
                 let mut psi2 = vec![0.0; s];
                 for k in 0..300 {
@@ -1105,13 +1118,7 @@ mod tests {
         for n in [5usize, 6, 7, 11, 15] {
             let s = if n % 4 == 3 { n + 1 } else { n };
             for max in [f64::INFINITY, 2.0 * n as f64] {
-                let (mut p1, mut p2) = (vec![0.0; n * n], vec![0.0; n * s]);
-                for i in 0..n {
-                    p1[i * n + i] = 1.0;
-                    p2[i * s + i] = 1.0;
-                }
-                let (mut th1, mut th2) = (vec![0.0; n], vec![0.0; n]);
-                let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; s]);
+                let [mut p1, mut p2, mut th1, mut th2, mut g1, mut g2] = two_states(n, s, 1.0);
                 let mut kappa = 1.0;
                 let (mut psi1, mut psi2) = (vec![0.0; n], vec![0.0; s]);
                 let truth: Vec<f64> = (0..n).map(|j| 0.3 - 0.05 * j as f64).collect();

@@ -565,8 +565,8 @@ impl Predictor {
                     // built in place (a copy reloaded the fresh scalar
                     // stores as vectors: a stall)
                     let row = &mut l.group[pending * m..(pending + 1) * m];
-                    let t = model::row(&o, y, u, k, &mut row[..nm]);
-                    if t == 0.0 && row[..nm].iter().all(|&v| v == 0.0) {
+                    let (t, informative) = model::row_scaled(&o, y, u, k, 1.0, &mut row[..nm]);
+                    if !informative {
                         continue;
                     }
                     // the column `scale` (no row before it is known): before

@@ -55,22 +55,14 @@ pub(crate) fn n_free(o: &ArxOrders) -> usize {
 /// Regression row of sample `k` (local index `≥ lag`) into `psi`; returns the target `y[k] − y[k−1]`.
 #[inline]
 pub(crate) fn row(o: &ArxOrders, y: &[f64], u: &[f64], k: usize, psi: &mut [f64]) -> f64 {
-    let rho = y[k - 1];
-    let mut i = 0;
-    for a in 2..=o.na {
-        psi[i] = -(y[k - a] - rho);
-        i += 1;
-    }
-    for j in 0..o.nb {
-        psi[i] = u[k - o.nk - j] - rho;
-        i += 1;
-    }
-    y[k] - rho
+    // (× 1 is exact)
+    row_scaled(o, y, u, k, 1.0, psi).0
 }
 
-/// [`row`] with every entry and the target multiplied by `inv`; also
-/// whether the unscaled row or target has a non-zero entry. Bit-identical
-/// to scaling the result of [`row`].
+/// Regression row of sample `k` (local index `≥ lag`) into `psi`, every
+/// entry multiplied by `inv` (scaled as it is built: bit-identical to
+/// scaling afterwards); returns the target `y[k] − y[k−1]` times `inv` and
+/// whether the unscaled row or target has a non-zero entry.
 #[inline]
 pub(crate) fn row_scaled(
     o: &ArxOrders,
@@ -109,7 +101,7 @@ pub(crate) fn row_scaled(
 /// and `ū` the commands minus `r`, the increment of the unit-gain model is
 /// `−Σ θ_a·d(h−a) + Σ θ_b·ū + d(h−1)·(Σθ_a − Σθ_b)`. The command's share
 /// does not depend on the predictions and is summed first; the recursion
-/// then only carries one product and two additions from one step to the
+/// then only carries one product and one addition from one step to the
 /// next (the step-by-step form chained every term through the previous
 /// prediction).
 #[allow(clippy::too_many_arguments)]

@@ -12,6 +12,17 @@
 //!   [`FROZEN_QUANTA`] position steps (the smallest non-zero `|Δx|` of the
 //!   recording: its resolution). A model that predicts a constant scores
 //!   "rms 0, fit 100 %" there; the warning says that this means nothing.
+//!   A run the axis only *lagged* through is not one: a slow or delayed
+//!   loop behind a fast command (a step, a steep ramp) stays put for its
+//!   dead time and more. The run is excused when the tracking error
+//!   `c − x` then comes back to within half the run's command motion of its
+//!   value before the run (within [`CATCH_UP_RUNS`] run lengths) without a
+//!   position increment beyond [`CATCH_UP_STEP`] times the command's
+//!   largest one. An encoder that resumes shows the true position at once
+//!   (a jump) or counts on from where it stopped (the missed motion stays
+//!   in the tracking error). (Behind a command step an encoder that
+//!   resumes after a few samples looks like a delayed fast axis: no
+//!   recording tells these apart.)
 //! - **unit mismatch** — the standard deviations of `x` and `c` differ by a
 //!   factor outside 1/10 … 10 (a loop follows its command); near 10³ or 10⁶
 //!   the two are in different units (mm and m, µm and m).
@@ -56,6 +67,16 @@ pub const FROZEN_SHARE: f64 = 0.1;
 
 /// Position steps (resolution) the command must cover while the position stays frozen.
 pub const FROZEN_QUANTA: f64 = 100.0;
+
+/// Largest position increment, in units of the command's largest increment,
+/// of an axis catching up after a lag (overshoot included): a frozen
+/// position that ends with a larger jump is an encoder that resumed.
+pub const CATCH_UP_STEP: f64 = 3.0;
+
+/// Samples, in units of the frozen run's length, within which a lagging
+/// axis must have caught up with its command (a slow loop takes many times
+/// its dead time).
+pub const CATCH_UP_RUNS: usize = 100;
 
 /// Fastest plausible position speed of a feed drive \[m/s\] (linear-motor axes reach about 5 m/s).
 pub const MAX_PLAUSIBLE_SPEED: f64 = 20.0;
@@ -168,6 +189,12 @@ fn frozen_position(t: &[f64], c: &[f64], x: &[f64], c_range: f64) -> Option<Stri
         .filter(|d| *d > 0.0)
         .fold(f64::INFINITY, f64::min);
     let quantum = if quantum.is_finite() { quantum } else { 0.0 };
+    let suspect =
+        |r: f64| r > FROZEN_SHARE * c_range && r > FROZEN_QUANTA * quantum && r > MOTION_THRESHOLD;
+    let step = c
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
     // (start, end inclusive, command range over the run)
     let mut best: Option<(usize, usize, f64)> = None;
     let mut start = 0;
@@ -179,7 +206,9 @@ fn frozen_position(t: &[f64], c: &[f64], x: &[f64], c_range: f64) -> Option<Stri
             continue;
         }
         let r = hi - lo;
-        if best.map_or(true, |b| r > b.2) {
+        if best.map_or(true, |b| r > b.2)
+            && !(suspect(r) && catches_up(c, x, start, k - 1, r, step))
+        {
             best = Some((start, k - 1, r));
         }
         if k < x.len() {
@@ -189,7 +218,7 @@ fn frozen_position(t: &[f64], c: &[f64], x: &[f64], c_range: f64) -> Option<Stri
         }
     }
     let (a, b, r) = best?;
-    if !(r > FROZEN_SHARE * c_range && r > FROZEN_QUANTA * quantum && r > MOTION_THRESHOLD) {
+    if !suspect(r) {
         return None;
     }
     let what = "a dead encoder or a wrong column? Predictions of a constant score \"rms 0, fit 100 %\" there, which means nothing";
@@ -210,6 +239,28 @@ fn frozen_position(t: &[f64], c: &[f64], x: &[f64], c_range: f64) -> Option<Stri
             100.0 * r / c_range
         )
     })
+}
+
+/// Whether the position, frozen over `a..=b` while the command moved over
+/// `r`, was only lagging: within [`CATCH_UP_RUNS`] times the run's length after it the
+/// tracking error `c − x` comes back to within `r/2` of its value before the
+/// run, and no position increment on the way exceeds [`CATCH_UP_STEP`] times
+/// the command's largest increment `step` (an encoder that resumes jumps by
+/// the missed motion at once; one that lost counts keeps the offset).
+fn catches_up(c: &[f64], x: &[f64], a: usize, b: usize, r: f64, step: f64) -> bool {
+    let before = a.checked_sub(1).map_or(c[a] - x[a], |k| c[k] - x[k]);
+    let end = (b + 1)
+        .saturating_add(CATCH_UP_RUNS.saturating_mul(b - a + 1))
+        .min(x.len());
+    for k in b + 1..end {
+        if (x[k] - x[k - 1]).abs() > CATCH_UP_STEP * step {
+            return false;
+        }
+        if ((c[k] - x[k]) - before).abs() <= 0.5 * r {
+            return true;
+        }
+    }
+    false
 }
 
 /// Standard deviation.
@@ -406,6 +457,54 @@ mod tests {
         let xq: Vec<f64> = x.iter().map(|v| (v / 1e-6).round() * 1e-6).collect();
         let rec = Recording::new(t, c, xq).unwrap();
         assert!(!kinds(&rec).contains(&WarningKind::FrozenPosition));
+    }
+
+    /// A first-order loop (time constant `tau` samples) with `dead` samples
+    /// of dead time behind a command step of 2 mm at sample 50.
+    fn lagging_step(n: usize, tau: f64, dead: usize) -> Recording {
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let c: Vec<f64> = (0..n).map(|k| if k >= 50 { 2e-3 } else { 0.0 }).collect();
+        let a = (-1.0 / tau).exp();
+        let mut x = vec![0.0; n];
+        for k in 1..n {
+            let u = if k > dead { c[k - 1 - dead] } else { 0.0 };
+            x[k] = a * x[k - 1] + (1.0 - a) * u;
+        }
+        Recording::new(t, c, x).unwrap()
+    }
+
+    #[test]
+    fn a_position_that_lags_behind_a_fast_command_is_not_a_dead_encoder() {
+        // frozen for the dead time after the step, then catching up
+        // smoothly (slowly: half-way after 35 samples)
+        for (tau, dead) in [(5.0, 3), (50.0, 3), (50.0, 12)] {
+            let rec = lagging_step(400, tau, dead);
+            assert!(
+                !kinds(&rec).contains(&WarningKind::FrozenPosition),
+                "{tau} {dead}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_encoder_that_resumes_with_a_jump_or_lost_counts_is_found() {
+        // a ramp (2000 samples, the motion from sample 200 on); the encoder
+        // stops counting over samples 1000..1300 of the move
+        let (t, c, x) = ramp(2000, 2e-4, 1.4e-3, 0.05);
+        let (a, b) = (1000, 1300);
+        // then shows the true position again: a jump by the missed motion
+        let mut jump = x.clone();
+        jump[a..b].iter_mut().for_each(|v| *v = x[a - 1]);
+        let rec = Recording::new(t.clone(), c.clone(), jump).unwrap();
+        assert!(kinds(&rec).contains(&WarningKind::FrozenPosition));
+        // or counts on from where it stopped: the missed motion stays as an
+        // offset of the tracking error
+        let mut lost = x.clone();
+        let missed = x[b - 1] - x[a - 1];
+        lost[a..b].iter_mut().for_each(|v| *v = x[a - 1]);
+        lost[b..].iter_mut().for_each(|v| *v -= missed);
+        let rec = Recording::new(t, c, lost).unwrap();
+        assert!(kinds(&rec).contains(&WarningKind::FrozenPosition));
     }
 
     #[test]

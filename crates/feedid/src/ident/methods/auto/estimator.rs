@@ -117,9 +117,23 @@ pub struct AutoEstimator {
     experience: f64,
     /// Samples below this index are in `experience`.
     experienced_to: usize,
-    /// Hold at the first prediction: holding backtested better than the
-    /// first choice.
-    hold_first: bool,
+    /// How the first prediction after a reset is made (decided by the
+    /// backtest; `None` after it).
+    first: Option<First>,
+    /// Scratch for the pointwise median of the predictions.
+    sorted: Vec<f64>,
+}
+
+/// The first prediction after a reset: whichever of the three backtested
+/// best on the first window's last horizon (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum First {
+    /// Hold the last measured position.
+    Hold,
+    /// The pointwise median of the candidates' predictions and holding.
+    Median,
+    /// The chosen candidate's prediction (the settings' first ready one).
+    Chosen,
 }
 
 impl AutoEstimator {
@@ -153,7 +167,8 @@ impl AutoEstimator {
             horizon: 10,
             experience: 0.0,
             experienced_to: 0,
-            hold_first: false,
+            first: None,
+            sorted: Vec::new(),
         }
     }
 
@@ -235,8 +250,10 @@ impl AutoEstimator {
     /// sample: fitted on `start..end − H`, predicting `end − H..end`
     /// (measured), so that the first choice is not blind. Needs `2·H`
     /// samples in the first window; without them nothing is scored yet.
-    /// Returns the mean squared error of holding the last position there.
-    fn backtest(&mut self, signals: &Signals<'_>, start: usize, end: usize) -> Option<f64> {
+    /// Returns the mean squared errors there of holding the last position
+    /// and of the pointwise median of the candidates' predictions and
+    /// holding.
+    fn backtest(&mut self, signals: &Signals<'_>, start: usize, end: usize) -> Option<(f64, f64)> {
         let h = self.horizon;
         if end < start + 2 * h {
             return None;
@@ -246,9 +263,8 @@ impl AutoEstimator {
             .window(split..end, 0, "auto backtest")
             .ok()?
             .position;
-        let hold = last_position(signals, start..split)
-            .ok()
-            .and_then(|last| mean_square_error(measured, std::iter::repeat(last)));
+        let last = last_position(signals, start..split).ok()?;
+        let hold = mean_square_error(measured, std::iter::repeat(last))?;
         // a predictor of its own: the candidate proper learns the first
         // window in one piece (its coordinates' scale is set by the first
         // rows it sees); followers after their leaders
@@ -279,7 +295,9 @@ impl AutoEstimator {
                 m.trial = mean_square_error(measured, buf.iter().copied());
             }
         }
-        hold
+        let (members, sorted) = (&self.members, &mut self.sorted);
+        let median = (0..h).map(|j| median_at(members, |m| m.trial.is_some(), last, j, sorted));
+        Some((hold, mean_square_error(measured, median)?))
     }
 
     /// Whether candidate `i`'s pending prediction (of `h` samples)
@@ -369,6 +387,27 @@ fn regime(signals: &Signals<'_>, from: usize, end: usize, h: usize) -> usize {
     }
 }
 
+/// The median of `last` and the `j`-th pending prediction of every member
+/// that `include`s (`sorted`: scratch, allocated once).
+fn median_at(
+    members: &[Member],
+    include: impl Fn(&Member) -> bool,
+    last: f64,
+    j: usize,
+    sorted: &mut Vec<f64>,
+) -> f64 {
+    sorted.clear();
+    sorted.push(last);
+    sorted.extend(members.iter().filter(|m| include(m)).map(|m| m.pending[j]));
+    sorted.sort_unstable_by(f64::total_cmp);
+    let n = sorted.len();
+    if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    }
+}
+
 /// Member `i` (mutable) and its leader, if it follows one.
 fn follower_and_leader(members: &mut [Member], i: usize) -> Option<(&mut Member, &Member)> {
     let j = members[i].leader.filter(|&j| j != i)?;
@@ -446,7 +485,7 @@ impl Estimator for AutoEstimator {
         self.regime = 2;
         self.experience = 0.0;
         self.experienced_to = 0;
-        self.hold_first = false;
+        self.first = None;
     }
 
     fn fit(
@@ -467,7 +506,7 @@ impl Estimator for AutoEstimator {
         self.regime = regime(signals, window.start, window.end, self.horizon);
         let first_fit = self.start.is_none();
         let start = *self.start.get_or_insert(window.start);
-        let hold_trial = if first_fit {
+        let backtest = if first_fit {
             self.backtest(signals, start, window.end)
         } else {
             None
@@ -481,13 +520,24 @@ impl Estimator for AutoEstimator {
             }
         }
         self.selected = self.choose();
-        // hold first unless the first choice backtested better than holding
-        self.hold_first = first_fit
-            && match (self.selected.map(|c| self.members[c].trial), hold_trial) {
-                (Some(Some(c)), Some(hold)) => hold <= c,
-                (_, Some(_)) => true,
-                _ => false,
-            };
+        // the first prediction: holding, the median or the first choice,
+        // whichever backtested best (ties to the former)
+        self.first = first_fit.then(|| match backtest {
+            Some((hold, median)) => {
+                let chosen = self
+                    .selected
+                    .and_then(|c| self.members[c].trial)
+                    .unwrap_or(f64::INFINITY);
+                if hold <= median && hold <= chosen {
+                    First::Hold
+                } else if median <= chosen {
+                    First::Median
+                } else {
+                    First::Chosen
+                }
+            }
+            None => First::Chosen,
+        });
         coef.fill(0.0);
         if let Some(x) = coef.get_mut(0) {
             *x = self.selected.map_or(-1.0, |c| c as f64);
@@ -543,9 +593,22 @@ impl Estimator for AutoEstimator {
                 m.ready = false;
             }
         }
+        match self.first.take() {
+            Some(First::Hold) => {
+                out.fill(last);
+                return Ok(PredictStatus::Predicted);
+            }
+            Some(First::Median) => {
+                let (members, sorted) = (&self.members, &mut self.sorted);
+                for (j, o) in out.iter_mut().enumerate() {
+                    *o = median_at(members, |m| m.pending_len == h, last, j, sorted);
+                }
+                return Ok(PredictStatus::Predicted);
+            }
+            Some(First::Chosen) | None => {}
+        }
         let usable = |i: usize| self.members[i].pending_len == h && !self.dissents(i, h);
         let chosen = match self.selected {
-            _ if self.hold_first => None,
             Some(c) if usable(c) => Some(c),
             _ => {
                 let r = self.regime;
@@ -622,6 +685,21 @@ mod tests {
         // from the second window on, the scored candidate predicts
         for k in second {
             assert_eq!(r.predicted[k], u[k], "sample {k}");
+        }
+    }
+
+    #[test]
+    fn the_first_prediction_is_the_median_when_it_backtests_better_than_holding_and_the_choice() {
+        // the command leads the position by half a horizon of its motion:
+        // holding lags, the command leads, their mean (the median of the
+        // command and holding) is closest
+        let (_, y0, _) = run_command_only(0.0);
+        let lead = y0[55] - y0[50];
+        let (u, y, r) = run_command_only(lead);
+        let first = r.windows[0].horizon.clone();
+        let last = y[first.start - 1];
+        for k in first {
+            assert_eq!(r.predicted[k], 0.5 * (last + u[k]), "sample {k}");
         }
     }
 

@@ -63,7 +63,7 @@ pub(crate) fn row(o: &ArxOrders, y: &[f64], u: &[f64], k: usize, psi: &mut [f64]
 /// entry multiplied by `inv` (scaled as it is built: bit-identical to
 /// scaling afterwards); returns the target `y[k] − y[k−1]` times `inv` and
 /// whether the unscaled row or target has a non-zero entry.
-#[inline]
+#[inline(always)]
 pub(crate) fn row_scaled(
     o: &ArxOrders,
     y: &[f64],
@@ -75,18 +75,20 @@ pub(crate) fn row_scaled(
     let rho = y[k - 1];
     let t = y[k] - rho;
     let mut any = t != 0.0;
-    let mut i = 0;
-    for a in 2..=o.na {
-        let v = -(y[k - a] - rho);
-        any |= v != 0.0;
-        psi[i] = v * inv;
-        i += 1;
+    // y[k−2] … y[k−na] and u[k−nk] … u[k−nk−nb+1], newest first (slices:
+    // one bounds check each)
+    let na = o.na.max(1) - 1;
+    let (pa, pb) = psi[..na + o.nb].split_at_mut(na);
+    for (p, &v) in pa.iter_mut().zip(y[k - 1 - na..k - 1].iter().rev()) {
+        let d = -(v - rho);
+        any |= d != 0.0;
+        *p = d * inv;
     }
-    for j in 0..o.nb {
-        let v = u[k - o.nk - j] - rho;
-        any |= v != 0.0;
-        psi[i] = v * inv;
-        i += 1;
+    let newest = k - o.nk;
+    for (p, &v) in pb.iter_mut().zip(u[newest + 1 - o.nb..=newest].iter().rev()) {
+        let d = v - rho;
+        any |= d != 0.0;
+        *p = d * inv;
     }
     (t * inv, any)
 }

@@ -85,7 +85,10 @@ pub(crate) fn row_scaled(
         *p = d * inv;
     }
     let newest = k - o.nk;
-    for (p, &v) in pb.iter_mut().zip(u[newest + 1 - o.nb..=newest].iter().rev()) {
+    for (p, &v) in pb
+        .iter_mut()
+        .zip(u[newest + 1 - o.nb..=newest].iter().rev())
+    {
         let d = v - rho;
         any |= d != 0.0;
         *p = d * inv;

@@ -57,7 +57,7 @@ struct Member {
     /// Whether the candidate can predict (fitted).
     ready: bool,
     /// Mean squared error of its backtest on the first window \[m²\]
-    /// (decides only whether the first prediction holds instead).
+    /// (decides only how the first prediction is made, [`First`]).
     trial: Option<f64>,
     /// The candidate whose factors this one is solved from
     /// ([`Predictor::fit_follower`]), if any.
@@ -117,9 +117,9 @@ pub struct AutoEstimator {
     experience: f64,
     /// Samples below this index are in `experience`.
     experienced_to: usize,
-    /// How the first prediction after a reset is made (decided by the
-    /// backtest; `None` after it).
-    first: Option<First>,
+    /// How the next prediction is made: decided by the backtest for the
+    /// first one after a reset, [`First::Chosen`] for every other.
+    first: First,
     /// Scratch for the pointwise median of the predictions.
     sorted: Vec<f64>,
 }
@@ -132,7 +132,8 @@ enum First {
     Hold,
     /// The pointwise median of the candidates' predictions and holding.
     Median,
-    /// The chosen candidate's prediction (the settings' first ready one).
+    /// The chosen candidate's prediction (at the first, the settings' first
+    /// ready one; every later prediction).
     Chosen,
 }
 
@@ -167,7 +168,7 @@ impl AutoEstimator {
             horizon: 10,
             experience: 0.0,
             experienced_to: 0,
-            first: None,
+            first: First::Chosen,
             sorted: Vec::new(),
         }
     }
@@ -485,7 +486,7 @@ impl Estimator for AutoEstimator {
         self.regime = 2;
         self.experience = 0.0;
         self.experienced_to = 0;
-        self.first = None;
+        self.first = First::Chosen;
     }
 
     fn fit(
@@ -522,8 +523,8 @@ impl Estimator for AutoEstimator {
         self.selected = self.choose();
         // the first prediction: holding, the median or the first choice,
         // whichever backtested best (ties to the former)
-        self.first = first_fit.then(|| match backtest {
-            Some((hold, median)) => {
+        self.first = match backtest {
+            Some((hold, median)) if first_fit => {
                 let chosen = self
                     .selected
                     .and_then(|c| self.members[c].trial)
@@ -536,8 +537,8 @@ impl Estimator for AutoEstimator {
                     First::Chosen
                 }
             }
-            None => First::Chosen,
-        });
+            _ => First::Chosen,
+        };
         coef.fill(0.0);
         if let Some(x) = coef.get_mut(0) {
             *x = self.selected.map_or(-1.0, |c| c as f64);
@@ -593,19 +594,19 @@ impl Estimator for AutoEstimator {
                 m.ready = false;
             }
         }
-        match self.first.take() {
-            Some(First::Hold) => {
+        match std::mem::replace(&mut self.first, First::Chosen) {
+            First::Hold => {
                 out.fill(last);
                 return Ok(PredictStatus::Predicted);
             }
-            Some(First::Median) => {
+            First::Median => {
                 let (members, sorted) = (&self.members, &mut self.sorted);
                 for (j, o) in out.iter_mut().enumerate() {
                     *o = median_at(members, |m| m.pending_len == h, last, j, sorted);
                 }
                 return Ok(PredictStatus::Predicted);
             }
-            Some(First::Chosen) | None => {}
+            First::Chosen => {}
         }
         let usable = |i: usize| self.members[i].pending_len == h && !self.dissents(i, h);
         let chosen = match self.selected {

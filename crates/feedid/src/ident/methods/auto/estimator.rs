@@ -307,8 +307,10 @@ impl AutoEstimator {
     /// by more than [`AutoConfig::consensus`] times its recent rms error (at
     /// least `1e-9` of the experienced motion, so that exact models of
     /// noise-free data agree) — with an odd count, its distance from their
-    /// median exceeds that. Never with fewer than three pending predictions,
-    /// nor for an unscored candidate.
+    /// median exceeds that — and no other candidate's prediction stays
+    /// within that distance of it over the whole horizon (two models that
+    /// agree outweigh a majority of less precise ones). Never with fewer
+    /// than three pending predictions, nor for an unscored candidate.
     fn dissents(&self, i: usize, h: usize) -> bool {
         let k = self.config.consensus;
         let me = &self.members[i];
@@ -321,7 +323,7 @@ impl AutoEstimator {
             return false;
         }
         let limit = k * score.sqrt().max(1e-9 * self.experience);
-        me.pending[..h].iter().enumerate().any(|(j, &p)| {
+        let outvoted = me.pending[..h].iter().enumerate().any(|(j, &p)| {
             if !p.is_finite() {
                 return true;
             }
@@ -335,7 +337,18 @@ impl AutoEstimator {
                 }
             }
             2 * above > count || 2 * below > count
-        })
+        });
+        let seconded = || {
+            self.members.iter().enumerate().any(|(o, m)| {
+                o != i
+                    && m.pending_len == h
+                    && m.pending[..h]
+                        .iter()
+                        .zip(&me.pending[..h])
+                        .all(|(q, p)| (q - p).abs() <= limit)
+            })
+        };
+        outvoted && !seconded()
     }
 
     /// The ready candidate with the lowest score in the current regime
@@ -768,6 +781,23 @@ mod consensus_tests {
             20.0,
         );
         assert!(dissenters(&est).is_empty());
+    }
+
+    #[test]
+    fn two_precise_predictions_that_agree_outweigh_a_majority_of_less_precise_ones() {
+        // three candidates with errors of 0.5 predict 1.0; two with errors
+        // of 0.01 predict 5.0 and 5.05 (within 20 × 0.01 of each other):
+        // the majority lies 4 below them, yet neither dissents
+        let rms = [Some(0.5), Some(0.5), Some(0.5), Some(0.01), Some(0.01)];
+        let est = with_pending(&[1.0, 1.0, 1.0, 5.0, 5.05], &rms, 20.0);
+        assert!(dissenters(&est).is_empty());
+        // apart by more than their limit, each is alone: both dissent
+        let est = with_pending(&[1.0, 1.0, 1.0, 5.0, 5.3], &rms, 20.0);
+        assert_eq!(dissenters(&est), vec![3, 4]);
+        // seconded at one step of the horizon only is not seconded
+        let mut est = with_pending(&[1.0, 1.0, 1.0, 5.0, 5.05], &rms, 20.0);
+        est.members[4].pending[7] = 9.0;
+        assert_eq!(dissenters(&est), vec![3, 4]);
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! one, check on the other) or `emps` (the EMPS recording, printed). Each
 //! line of `configs.txt` is a method and its settings, e.g.
 //! `arx o=3,3,0 w=100 ridge=1e-10 dc=1`, `rls o=8,8,0 lambda=0.999`,
-//! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995 mem=0.1` (`lsb:…`,
+//! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995 mem=0.1 cons=20` (`lsb:…`,
 //! `rlsb:…`: the same with a constant term), or `arx220 100`
 //! (the benchmark's plain ARX(2,2,0) baseline); `#` starts a comment. The
 //! CSV has per member and configuration the rms over the predicted samples,
@@ -83,6 +83,7 @@ fn parse(cfg: &str) -> Result<(Method, usize), String> {
                 (Method::Auto(c), "cands") => c.candidates = v.split(';').map(cand).collect(),
                 (Method::Auto(c), "mem") => c.memory = f()?,
                 (Method::Auto(c), "plaus") => c.plausibility = f()?,
+                (Method::Auto(c), "cons") => c.consensus = f()?,
                 (Method::Rls(c), "radius") => c.max_pole_radius = f()?,
                 (Method::Rls(c), "win") => c.window = Some(v.parse().unwrap()),
                 _ => return Err(format!("unknown {k} for {name}")),

@@ -75,11 +75,18 @@
 //! candidates' predictions lie on one side of it by more than
 //! [`AutoConfig::consensus`] (default 20) times its own recent rms error —
 //! with an odd count of predictions: its distance from their median exceeds
-//! that (fewer than three predictions make no consensus). A model well scored on a smooth motion can be thrown off by
-//! a motion it has not seen (a jerk of the command excites directions its
-//! nearly collinear regressors never determined): its prediction then
-//! leaves the others by far more than it ever erred. The factor is relative
-//! to the candidate's own errors, so it carries no unit.
+//! that (fewer than three predictions make no consensus) — unless another
+//! candidate's prediction stays within that distance of it at every step
+//! (it is *seconded*). A model well scored on a smooth motion can be thrown
+//! off by a motion it has not seen (a jerk of the command excites directions
+//! its nearly collinear regressors never determined): its prediction then
+//! leaves the others by far more than it ever erred, and alone. But when a
+//! few candidates have found the exact model and the rest have not (a
+//! first-order axis learnt by the ARX(4,4), (6,6) and (8,8) candidates to
+//! 1e-9 of the move while the low orders err by microns), the precise ones
+//! are outvoted by the imprecise majority; two models that agree to within
+//! one's own small error are evidence the majority lacks. The factor is
+//! relative to the candidate's own errors, so it carries no unit.
 //!
 //! A candidate's prediction is *implausible* when it leaves the last
 //! measured position by more than [`AutoConfig::plausibility`] times the

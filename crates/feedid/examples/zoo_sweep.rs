@@ -93,6 +93,14 @@ fn parse(cfg: &str) -> Result<(Method, usize), String> {
     Ok((m, w))
 }
 
+/// Shift of the baselines' horizon grid (`ZOO_SWEEP_PHASE`, samples; 0).
+fn phase() -> usize {
+    std::env::var("ZOO_SWEEP_PHASE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0)
+}
+
 fn arx220(u: &[f64], y: &[f64]) -> (Vec<f64>, Vec<bool>) {
     arx220f(u, y, false)
 }
@@ -102,7 +110,7 @@ fn arx220f(u: &[f64], y: &[f64], frame: bool) -> (Vec<f64>, Vec<bool>) {
     let n = y.len();
     let mut value = vec![0.0; n];
     let mut has = vec![false; n];
-    let mut t0 = W + 2;
+    let mut t0 = W + 2 + phase();
     while t0 < n {
         let r = if frame { y[t0 - 1] } else { 0.0 };
         let a = DMatrix::from_fn(W, 4, |i, j| {
@@ -308,8 +316,9 @@ fn main() {
                 }
                 let _ = cb;
                 // worst ratio to a baseline (command, hold, arx220) on the shared samples
-                let hold_has = |k: usize| k >= H;
-                let hold_at = |k: usize| y[k - 1 - (k - H) % H];
+                let h0 = H + phase();
+                let hold_has = |k: usize| k >= h0;
+                let hold_at = |k: usize| y[k - 1 - (k - h0) % H];
                 let mut worst = 0.0f64;
                 for b in 0..3 {
                     let (mut sa, mut sb, mut nn) = (0.0, 0.0, 0usize);
@@ -326,6 +335,13 @@ fn main() {
                         }
                     }
                     if nn >= 50 {
+                        if std::env::var("ZOO_SWEEP_WHO").is_ok_and(|v| v == "all" || sa > sb) {
+                            eprintln!(
+                                "LOSS {i} to {} {:.5} {sa:e} {sb:e}",
+                                ["command", "hold", "arx220"][b],
+                                (sa / sb).sqrt()
+                            );
+                        }
                         worst = worst.max((sa / sb).sqrt());
                     }
                 }

@@ -11,11 +11,19 @@
 //! line of `configs.txt` is a method and its settings, e.g.
 //! `arx o=3,3,0 w=100 ridge=1e-10 dc=1`, `rls o=8,8,0 lambda=0.999`,
 //! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995 mem=0.1 cons=20` (`lsb:…`,
-//! `rlsb:…`: the same with a constant term), or `arx220 100`
-//! (the benchmark's plain ARX(2,2,0) baseline); `#` starts a comment. The
-//! CSV has per member and configuration the rms over the predicted samples,
-//! the coverage, and the rms of the configuration and of `arx220` on the
-//! samples both predict.
+//! `rlsb:…`: the same with a constant term), `arx220frame` (the baseline
+//! in the frame of the last measured position) or `arx220unitW` (unit DC
+//! gain, W rows); `#` starts a comment. The CSV has per member and
+//! configuration the rms over the predicted samples, the coverage, the rms
+//! of the configuration and of `arx220` on the samples both predict, and
+//! the largest ratio to a baseline (command, hold, arx220).
+//!
+//! Environment: `ZOO_SWEEP_PHASE=P` starts the baselines' blocks `P`
+//! samples later (as `zoo_bench --baseline-phase`); `ZOO_SWEEP_WHO=1`
+//! prints every loss to a baseline on stderr (`all`: every comparison,
+//! with both sums of squares); `ZOO_SWEEP_DUMP=PREFIX` writes
+//! `PREFIX-N.csv` per member (k, u, y, prediction, flag, arx220, chosen
+//! candidate).
 
 use std::time::Instant;
 

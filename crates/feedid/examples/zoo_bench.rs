@@ -281,6 +281,9 @@ struct Row {
     interval_coverage: Option<f64>,
     seconds: f64,
     note: String,
+    /// Whether it loses to a baseline when the baselines' blocks start
+    /// `q` = 0 … H − 1 samples later (library methods only).
+    loses_by_phase: [bool; H],
 }
 
 /// Score every method on one member.
@@ -304,6 +307,7 @@ fn score(m: &ZooMember) -> Vec<Row> {
         interval_coverage: None,
         seconds: 0.0,
         note: String::new(),
+        loses_by_phase: [false; H],
     };
     let rec = match m.recording() {
         Ok(r) => r,
@@ -341,6 +345,14 @@ fn score(m: &ZooMember) -> Vec<Row> {
         scored[g.index] = false;
     }
     let by_name: BTreeMap<&str, &Predictions> = all.iter().map(|p| (p.name, p)).collect();
+    // the baselines at every phase of their blocks (command has none)
+    let phased: Vec<[Predictions; 2]> = (0..H)
+        .map(|q| [baseline_hold(y, q), baseline_arx220(u, y, q)])
+        .collect();
+    let loses_to = |p: &Predictions, b: &Predictions| {
+        // (as the table: a baseline without error beats any error)
+        shared_rms(y, p, b, &scored).is_some_and(|(a, r)| a > r)
+    };
     all.iter()
         .map(|p| {
             let own = stats(y, p, |k| scored[k]);
@@ -359,7 +371,7 @@ fn score(m: &ZooMember) -> Vec<Row> {
             for b in BASELINES.iter().filter(|&&b| b != p.name) {
                 if let Some((a, r)) = shared_rms(y, p, by_name[b], &scored) {
                     let q = a / r;
-                    if q.is_finite() && worst.map_or(true, |(_, w)| q > w) {
+                    if !q.is_nan() && worst.map_or(true, |(_, w)| q > w) {
                         worst = Some((b, q));
                     }
                 }
@@ -389,6 +401,11 @@ fn score(m: &ZooMember) -> Vec<Row> {
                 interval_coverage,
                 seconds: p.seconds,
                 note: p.error.clone().unwrap_or_default(),
+                loses_by_phase: std::array::from_fn(|q| {
+                    LIBRARY.contains(&p.name)
+                        && (loses_to(p, by_name["command"])
+                            || phased[q].iter().any(|b| loses_to(p, b)))
+                }),
                 ..base.clone()
             }
         })
@@ -560,6 +577,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             fmt(quantile(&cov, 0.5), 1),
             fmt(quantile(&rms, 0.5), 3),
             fmt(quantile(&intervals, 0.5), 1),
+        );
+    }
+    // the same count for every phase of the baselines' blocks
+    println!(
+        "\nRecordings where each library method loses to a baseline when the baselines' blocks \
+         start 0 … {} samples later (`--baseline-phase`; the table above: phase {}):\n",
+        H - 1,
+        PHASE.get().copied().unwrap_or(0)
+    );
+    println!(
+        "| method | {} | median |",
+        (0..H)
+            .map(|q| q.to_string())
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
+    println!("|---|{}---:|", "---:|".repeat(H));
+    for method in LIBRARY {
+        let counts: Vec<f64> = (0..H)
+            .map(|q| {
+                scored
+                    .iter()
+                    .filter(|r| r.method == method && r.loses_by_phase[q])
+                    .count() as f64
+            })
+            .collect();
+        println!(
+            "| {method} | {} | {} |",
+            counts
+                .iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(" | "),
+            fmt(quantile(&counts, 0.5), 1)
         );
     }
     // where the library methods lose to the baselines, by command and plant

@@ -39,7 +39,8 @@
 //!   baselines.
 //!
 //! `--baseline-phase P` (0 … 9) starts the blocks of `hold` and `arx220` `P`
-//! samples later. The methods' own blocks start where their first window
+//! samples later for the main table; a second table counts each library
+//! method's losses at every phase. The methods' own blocks start where their first window
 //! ends, so the phase decides which lead time each baseline has at each
 //! sample the two share: on a short recording whose error is made in its
 //! first horizons this alone moves the ratio by tens of percent (README,

@@ -477,11 +477,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--members" => members = parse_members(&args.next().unwrap_or_default(), &zoo)?,
             "--csv" => csv = args.next().map(PathBuf::from),
             "--offset" => {
-                let v: f64 = args.next().unwrap_or_default().parse()?;
+                let v: f64 = args
+                    .next()
+                    .unwrap_or_default()
+                    .parse()
+                    .map_err(|e| format!("--offset: {e} (metres)"))?;
                 OFFSET.set(v).map_err(|_| "--offset given twice")?;
             }
             "--baseline-phase" => {
-                let v: usize = args.next().unwrap_or_default().parse()?;
+                let v: usize = args
+                    .next()
+                    .unwrap_or_default()
+                    .parse()
+                    .map_err(|e| format!("--baseline-phase: {e} (0 … {})", H - 1))?;
                 if v >= H {
                     return Err(format!("--baseline-phase {v}: 0 … {}", H - 1).into());
                 }

@@ -263,6 +263,54 @@ fn identify_writes_predictions_coefficients_and_summary() {
 }
 
 #[test]
+fn identify_says_whose_parameters_the_simulation_model_has() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let rig = dir.path().join("my-axis.toml");
+    std::fs::write(&rig, "[control]\nkv = 350.0\n").unwrap();
+    let summary = |extra: &[&str]| {
+        let (pred, summ) = (dir.path().join("p.csv"), dir.path().join("s.json"));
+        let mut args = vec![
+            "identify",
+            input.to_str().unwrap(),
+            "-o",
+            pred.to_str().unwrap(),
+            "--summary",
+            summ.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = feedid(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&summ).unwrap()).unwrap();
+        (String::from_utf8(o.stdout).unwrap(), v)
+    };
+    let (text, built_in) = summary(&[]);
+    assert_eq!(built_in["nominal_rig"], "built-in");
+    assert!(
+        text.contains("simulation model (the built-in rig's nominal model):"),
+        "{text}"
+    );
+    let (text, v) = summary(&["--params", rig.to_str().unwrap()]);
+    assert_eq!(v["nominal_rig"], rig.to_str().unwrap());
+    assert!(
+        text.contains(&format!(
+            "simulation model (nominal model of {}):",
+            rig.display()
+        )),
+        "{text}"
+    );
+    // the other rig's model was simulated (Kv 350 instead of 700 lags more)
+    let sim = |v: &serde_json::Value| v["sim_rms_error_m"].as_f64().unwrap();
+    assert!(
+        sim(&v) > 1.5 * sim(&built_in),
+        "{} vs {}",
+        sim(&v),
+        sim(&built_in)
+    );
+}
+
+#[test]
 fn identify_simplex_agrees_with_qr_on_the_ramp() {
     let dir = tempfile::tempdir().unwrap();
     let input = simulated(dir.path(), "ramp");

@@ -89,6 +89,10 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
         );
     }
     let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
+    let rig = a
+        .params
+        .as_deref()
+        .map_or_else(|| "built-in".to_string(), |p| p.display().to_string());
     let mut pipeline = Pipeline::new(method)
         .window_or_default(a.windows.window)
         .horizon(a.windows.horizon)
@@ -135,7 +139,7 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
                 }
             };
             let pipeline = pipeline.progress(&update);
-            let text = identify_file(input, &a.recording, &pipeline, &paths, &bar);
+            let text = identify_file(input, &a.recording, &pipeline, &rig, &paths, &bar);
             bar.finish();
             let text = text?;
             print!("{text}");
@@ -186,6 +190,7 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
                         input,
                         &a.recording,
                         &pipeline,
+                        &rig,
                         &paths,
                         &ProgressBar::hidden(),
                     )
@@ -225,6 +230,7 @@ fn identify_file(
     input: &Path,
     read: &RecordingArgs,
     pipeline: &Pipeline<'_>,
+    rig: &str,
     paths: &OutputPaths,
     bar: &ProgressBar,
 ) -> Result<String> {
@@ -238,7 +244,8 @@ fn identify_file(
     for w in &run.warnings {
         eprintln!("warning: {}: {w}", input.display());
     }
-    let summary = run.summary();
+    let mut summary = run.summary();
+    summary.nominal_rig = Some(rig.to_string());
 
     let mut model_line = None;
     let mut model_json = None;

@@ -113,6 +113,7 @@ impl Identification {
                 .simulation_stats
                 .map(|x| x.fit_percent)
                 .filter(|v| v.is_finite()),
+            nominal_rig: None,
             simulation_diverged: self
                 .simulation_stats
                 .is_some_and(|x| !(x.rms.is_finite() && x.max_abs.is_finite())),

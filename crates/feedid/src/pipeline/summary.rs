@@ -81,6 +81,11 @@ pub struct IdentifySummary {
     /// NRMSE fit of the nominal simulation model \[%\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal_fit_percent: Option<f64>,
+    /// Whose parameters the nominal simulation model has: `"built-in"`
+    /// (the paper's rig, not the recorded drive unless it is that rig) or
+    /// the rig file given (`--params`); set by the caller, `None` = not said.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal_rig: Option<String>,
     /// Wall time of identification and prediction only (no I/O) \[s\].
     pub identification_seconds: f64,
     /// Mean wall time per window \[µs\].
@@ -193,15 +198,23 @@ impl fmt::Display for IdentifySummary {
         if let Some(n) = &self.global_note {
             writeln!(f, "  global model: {n}")?;
         }
+        let whose = match self.nominal_rig.as_deref() {
+            Some("built-in") => "the built-in rig's nominal model".to_string(),
+            Some(rig) => format!("nominal model of {rig}"),
+            None => "nominal".to_string(),
+        };
         if let (Some(r), Some(m)) = (self.sim_rms_error_m, self.sim_max_abs_error_m) {
             writeln!(
                 f,
-                "  simulation model:  rms {:.3} µm, max {:.3} µm",
+                "  simulation model ({whose}):  rms {:.3} µm, max {:.3} µm",
                 1e6 * r,
                 1e6 * m
             )?;
         } else if self.simulation_diverged {
-            writeln!(f, "  simulation model:  diverged (unstable parameters)")?;
+            writeln!(
+                f,
+                "  simulation model ({whose}):  diverged (unstable parameters)"
+            )?;
         }
         writeln!(
             f,

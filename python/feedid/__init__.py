@@ -351,8 +351,9 @@ def identify(
     nominal, global_model, residuals : bool
         What ``feedid identify`` computes beside the sliding predictions
         (default True, all three): the nominal model's simulation (the
-        summary's ``sim_rms_error_m``, ``sim_max_abs_error_m`` and
-        ``nominal_fit_percent``, ``simulated``), the method's global model
+        summary's ``sim_rms_error_m``, ``sim_max_abs_error_m``,
+        ``nominal_fit_percent`` and ``nominal_rig`` — ``"built-in"``, the
+        rig.toml's path or ``"dict"`` —, ``simulated``), the method's global model
         and its free-run fit (``global_model``, ``global_model_samples``,
         ``sim_fit_percent``, ``model``), the residual analysis
         (``residuals``). On long recordings they cost several times the

@@ -110,7 +110,15 @@ pub fn identify<'py>(
         }
     }
     .py_err()?;
-    let summary = run.summary();
+    let mut summary = run.summary();
+    if nominal {
+        // whose parameters the simulation model has, as the command line says
+        summary.nominal_rig = Some(match (&params_path, &params_json) {
+            (Some(p), _) => p.clone(),
+            (None, Some(_)) => "dict".to_string(),
+            (None, None) => "built-in".to_string(),
+        });
+    }
     let summary_json = serde_json::to_string(&summary)
         .map_err(|e| crate::errors::input(format!("summary: {e}")))?;
     let s = run.sliding;

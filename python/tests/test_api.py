@@ -104,6 +104,22 @@ def test_identification_has_its_arrays_and_frames():
     assert run.model is not None and "model" in run.model
 
 
+def test_the_summary_says_whose_parameters_the_simulation_model_has(tmp_path):
+    rec = feedid.simulate("ramp", seed=1)
+    built_in = feedid.identify(rec, method="arx").summary
+    assert built_in["nominal_rig"] == "built-in"
+    toml = tmp_path / "my-axis.toml"
+    toml.write_text("[control]\nkv = 350.0\n")
+    from_file = feedid.identify(rec, method="arx", params=toml).summary
+    assert from_file["nominal_rig"] == str(toml)
+    from_dict = feedid.identify(rec, method="arx", params={"control": {"kv": 350.0}}).summary
+    assert from_dict["nominal_rig"] == "dict"
+    # the other rig was simulated (Kv 350 lags the ramp more than 700)
+    assert from_file["sim_rms_error_m"] == pytest.approx(from_dict["sim_rms_error_m"], rel=1e-12)
+    assert from_file["sim_rms_error_m"] > 1.5 * built_in["sim_rms_error_m"]
+    assert "nominal_rig" not in feedid.identify(rec, method="arx", nominal=False).summary
+
+
 def test_the_gil_is_released_while_identifying():
     rec = feedid.simulate("multisine", seed=1, duration=4.0)
     done = threading.Event()

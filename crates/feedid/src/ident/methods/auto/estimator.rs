@@ -678,9 +678,18 @@ impl Estimator for AutoEstimator {
                 out.copy_from_slice(&self.members[c].pending[..h]);
                 Ok(PredictStatus::Predicted)
             }
-            // every candidate is implausible or unfitted: hold the last position
+            // every plausible candidate departs from the consensus: none is
+            // trusted alone, their median with holding is; none plausible or
+            // fitted: hold the last position
             None => {
-                out.fill(last);
+                let (members, sorted) = (&self.members, &mut self.sorted);
+                if members.iter().any(|m| m.pending_len == h) {
+                    for (j, o) in out.iter_mut().enumerate() {
+                        *o = median_at(members, |m| m.pending_len == h, last, j, sorted);
+                    }
+                } else {
+                    out.fill(last);
+                }
                 Ok(PredictStatus::Predicted)
             }
         }

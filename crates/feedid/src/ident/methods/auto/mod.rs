@@ -92,15 +92,22 @@
 //! 1e-9 of the move while the low orders err by microns), the precise ones
 //! are outvoted by the imprecise majority; two models that agree to within
 //! one's own small error are evidence the majority lacks. The factor is
-//! relative to the candidate's own errors, so it carries no unit.
+//! relative to the candidate's own errors, so it carries no unit. When
+//! *every* plausible candidate departs (each far from the others for its
+//! own small error — at the stop of a long, smooth ramp sampled at 16–20 kHz,
+//! where every model has erred by nanometres and each extrapolates the
+//! unseen stop its own way), none is trusted alone and the pointwise median
+//! of their predictions and holding predicts, as at the first horizon
+//! (holding instead, while the axis still moved at 8 µm per sample, made
+//! two recordings of the zoo 8× and 125× worse).
 //!
 //! A candidate's prediction is *implausible* when it leaves the last
 //! measured position by more than [`AutoConfig::plausibility`] times the
 //! largest motion of the position over `H + 1` samples so far: the
 //! candidate is then restarted (a wound-up or noise-fitted model learns
 //! again) and the best-scored plausible candidate predicts instead. If none
-//! can, `auto` holds the last position. So every window after the first
-//! gets a prediction: `auto` never withholds.
+//! is plausible, `auto` holds the last position. So every window after the
+//! first gets a prediction: `auto` never withholds.
 //!
 //! How far to trust a prediction is the engine's prediction interval
 //! ([`crate::ident::engine::Guard`]): the quantile of the method's own

@@ -40,8 +40,11 @@
 //! theirs: a wild sample is isolated, two in a row are a change of the
 //! motion and are kept. The last sample before a fit has no successor yet:
 //! it is an outlier only if its error also exceeds the factor times the
-//! largest change of the position over `H` samples seen so far (a jump no
-//! motion of the recording could make). The measurement itself must also
+//! largest change of the position between two consecutive samples seen so
+//! far (a jump within one sample that no motion of the recording has come
+//! near; the largest change over `H` samples, used before, let a glitch of
+//! 0.35 mm through on a fast sine sweep, and every method then predicted
+//! its next horizon from it). The measurement itself must also
 //! stand out from its neighbours — depart from the mean of the samples on
 //! both sides (for the last sample: from the sample before it) by at least
 //! half its error — so that a wild *prediction* of a smooth motion (a model
@@ -184,11 +187,11 @@ pub struct Guard {
     previous_exceeds: bool,
     /// The samples of the current check (scratch).
     batch: Vec<Checked>,
-    /// The last `H` cleaned samples (a ring) and how many were seen.
-    recent: Vec<f64>,
-    seen: usize,
-    /// Largest change of the cleaned position over `H` samples so far \[m\].
-    motion: f64,
+    /// Largest change of the cleaned position between consecutive samples
+    /// so far \[m\].
+    step: f64,
+    /// The last cleaned sample (for `step`).
+    last_clean: Option<f64>,
     /// Exponentially weighted mean squared error per step ahead \[m²\].
     mean_square: Vec<f64>,
     /// Smallest non-zero change between consecutive measured samples \[m\]
@@ -223,9 +226,8 @@ impl Guard {
             checked: None,
             previous_exceeds: false,
             batch: Vec::new(),
-            recent: vec![0.0; horizon],
-            seen: 0,
-            motion: 0.0,
+            step: 0.0,
+            last_clean: None,
             mean_square: vec![0.0; horizon],
             resolution: f64::INFINITY,
             last: None,
@@ -252,8 +254,8 @@ impl Guard {
         self.count = 0;
         self.checked = None;
         self.previous_exceeds = false;
-        self.seen = 0;
-        self.motion = 0.0;
+        self.step = 0.0;
+        self.last_clean = None;
         self.mean_square.fill(0.0);
         self.resolution = f64::INFINITY;
         self.last = None;
@@ -321,7 +323,7 @@ impl Guard {
         }
         // pass 2: an outlier exceeds its limit, the samples on both sides do
         // not; the last sample (its successor unknown) must also exceed the
-        // largest motion over a horizon seen so far
+        // largest change between two samples seen so far
         let n = self.batch.len();
         for i in 0..n {
             let c = self.batch[i];
@@ -350,7 +352,7 @@ impl Guard {
                 && if i + 1 < n {
                     !self.batch[i + 1].exceeds
                 } else {
-                    c.excess > self.config.outlier.unwrap_or(f64::INFINITY) * self.motion
+                    c.excess > self.config.outlier.unwrap_or(f64::INFINITY) * self.step
                 };
             let y_clean = match (outlier, c.latest) {
                 (true, Some((yh, _))) => {
@@ -367,15 +369,11 @@ impl Guard {
                 }
             }
             self.last = Some(c.y);
-            // the largest motion over a horizon, on the cleaned samples
-            let h = self.recent.len();
-            let at = self.seen % h;
-            if self.seen >= h {
-                let old = self.recent[at];
-                self.motion = self.motion.max((y_clean - old).abs());
+            // the largest change between two samples, on the cleaned ones
+            if let Some(p) = self.last_clean {
+                self.step = self.step.max((y_clean - p).abs());
             }
-            self.recent[at] = y_clean;
-            self.seen += 1;
+            self.last_clean = Some(y_clean);
             if !outlier {
                 let w = self.config.adaptation;
                 for s in 0..self.count {
@@ -547,6 +545,43 @@ mod tests {
         // second one is kept (a second wild sample in a row is a change)
         assert!(!replaced.contains(&301), "{replaced:?}");
         assert_eq!(clean[301], y[301]);
+    }
+
+    #[test]
+    fn a_glitch_in_the_last_sample_before_a_fit_is_replaced_on_a_fast_motion() {
+        // a ramp of one unit per sample (ten per horizon), predicted with
+        // small errors; the last sample before the fit at 310 jumps by 30:
+        // less than 8 times the motion over a horizon (80), far beyond 8
+        // times any change between two samples (8)
+        let h = 10;
+        let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
+        let mut y: Vec<f64> = (0..400)
+            .map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64))
+            .collect();
+        y[309] += 30.0;
+        let mut clean = y.clone();
+        let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
+        let mut replaced = Vec::new();
+        let mut start = 10;
+        while start + h <= y.len() {
+            g.observe(
+                start,
+                |k| y[k],
+                |k, v| {
+                    replaced.push(k);
+                    clean[k] = v;
+                },
+            );
+            // the next horizon starts from what the estimators see
+            assert!(
+                (clean[start - 1] - (start - 1) as f64).abs() < 0.1,
+                "{start}"
+            );
+            let pred: Vec<f64> = (start..start + h).map(|k| k as f64 + 0.02).collect();
+            g.predicted(start, &pred, clean[start - 1], 1.0, &mut lo, &mut hi);
+            start += h;
+        }
+        assert_eq!(replaced, vec![309]);
     }
 
     #[test]

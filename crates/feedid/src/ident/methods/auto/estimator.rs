@@ -710,12 +710,15 @@ mod tests {
         (t, u, y)
     }
 
-    /// `auto` with the command as its only candidate, so that the first
-    /// prediction is either the command or the held position.
-    fn run_command_only(offset: f64) -> (Vec<f64>, Vec<f64>, crate::ident::SlidingResult) {
+    /// `auto` with these candidates over [`signals_data`] (window 50,
+    /// H = hop = 10).
+    fn run_candidates(
+        candidates: Vec<Candidate>,
+        offset: f64,
+    ) -> (Vec<f64>, Vec<f64>, crate::ident::SlidingResult) {
         let (t, u, y) = signals_data(offset);
         let config = AutoConfig {
-            candidates: vec![Candidate::Command],
+            candidates,
             plausibility: 100.0,
             ..AutoConfig::default()
         };
@@ -729,6 +732,12 @@ mod tests {
         };
         let r = run(&mut est, &s, &cfg).unwrap();
         (u, y, r)
+    }
+
+    /// `auto` with the command as its only candidate, so that the first
+    /// prediction is either the command or the held position.
+    fn run_command_only(offset: f64) -> (Vec<f64>, Vec<f64>, crate::ident::SlidingResult) {
+        run_candidates(vec![Candidate::Command], offset)
     }
 
     #[test]
@@ -768,33 +777,14 @@ mod tests {
         // holding first: the first choice backtests as holding, the median
         // of holding (twice) and the command (twice) better; the two
         // command candidates backtest exactly (the position is the command)
-        let (t, u, y) = signals_data(0.0);
-        let config = AutoConfig {
-            candidates: vec![Candidate::Hold, Candidate::Command, Candidate::Command],
-            plausibility: 100.0,
-            ..AutoConfig::default()
-        };
-        let mut est = config.build().unwrap();
-        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
-        let cfg = EngineConfig {
-            window: 50,
-            horizon: 10,
-            hop: None,
-            warm_up: 0,
-        };
-        let r = run(&mut est, &s, &cfg).unwrap();
+        use Candidate::{Command, Hold};
+        let (u, _, r) = run_candidates(vec![Hold, Command, Command], 0.0);
         for k in r.windows[0].horizon.clone() {
             assert_eq!(r.predicted[k], u[k], "sample {k}: the command candidate's");
         }
         // one exact candidate is not enough: then holding (the median of
         // holding twice and the command is holding)
-        let config = AutoConfig {
-            candidates: vec![Candidate::Hold, Candidate::Command],
-            plausibility: 100.0,
-            ..AutoConfig::default()
-        };
-        let mut est = config.build().unwrap();
-        let r = run(&mut est, &s, &cfg).unwrap();
+        let (_, y, r) = run_candidates(vec![Hold, Command], 0.0);
         let first = r.windows[0].horizon.clone();
         let last = y[first.start - 1];
         for k in first {

@@ -52,6 +52,12 @@
 //! motion, while `arx220`, whose equations are in absolute coordinates,
 //! changes (see README, "The zoo benchmark").
 //!
+//! `--via-unit mm|um|nm` converts every member's command and position to
+//! that unit and back as the reader does with `--unit` (`v·10³`, then
+//! `·10⁻³` for mm): the same recording up to the last bits, which shows how
+//! far the predictions depend on them (a unit-invariant method changes
+//! nothing beyond rounding).
+//!
 //! Members with dropped rows are refused by the reader (as by
 //! `feedid identify`): they are listed as `refused` and left out of the summary.
 
@@ -67,6 +73,8 @@ use rayon::prelude::*;
 
 /// `--offset`: metres added to command and position of every member.
 static OFFSET: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+/// `--via-unit`: metres per unit of the round trip (1 = none).
+static VIA: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
 /// `--baseline-phase`: samples by which the baselines' blocks start later.
 static PHASE: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
 
@@ -325,14 +333,20 @@ fn score(m: &ZooMember) -> Vec<Row> {
         }
     };
     let offset = OFFSET.get().copied().unwrap_or(0.0);
-    let shift = |v: &[f64]| v.iter().map(|x| x + offset).collect::<Vec<f64>>();
+    let via = VIA.get().copied().unwrap_or(1.0);
+    // written in the unit (× 1/f, an exact power of ten), read back (× f)
+    let shift = |v: &[f64]| {
+        v.iter()
+            .map(|x| (x + offset) * (1.0 / via) * via)
+            .collect::<Vec<f64>>()
+    };
     let (u, y) = (&shift(&m.command), &shift(&m.position));
-    let rec = if offset == 0.0 {
+    let rec = if offset == 0.0 && via == 1.0 {
         rec
     } else {
         match Recording::new(rec.time().to_vec(), u.clone(), y.clone()) {
             Ok(r) => r,
-            Err(e) => panic!("member {}: offset recording: {e}", s.index),
+            Err(e) => panic!("member {}: shifted recording: {e}", s.index),
         }
     };
     let mut all = run_library_methods(&rec);
@@ -484,6 +498,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .map_err(|e| format!("--offset: {e} (metres)"))?;
                 OFFSET.set(v).map_err(|_| "--offset given twice")?;
             }
+            "--via-unit" => {
+                let f = match args.next().unwrap_or_default().as_str() {
+                    "mm" => 1e-3,
+                    "um" => 1e-6,
+                    "nm" => 1e-9,
+                    other => return Err(format!("--via-unit `{other}`: mm, um or nm").into()),
+                };
+                VIA.set(f).map_err(|_| "--via-unit given twice")?;
+            }
             "--baseline-phase" => {
                 let v: usize = args
                     .next()
@@ -498,7 +521,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             _ => {
                 return Err(format!(
                     "unknown argument `{a}` (--members SET, --csv FILE, --offset METRES, \
-                     --baseline-phase P)"
+                     --via-unit mm|um|nm, --baseline-phase P)"
                 )
                 .into())
             }

@@ -88,12 +88,15 @@ use crate::ident::methods::regressor::{poles_inside, predict_horizon};
 use crate::ident::{ArxOrders, Estimator, PredictStatus, Signals, WindowFit};
 use crate::solve::Termination;
 
-/// Configuration of the RLS estimator (defaults tuned on the virtual rig and EMPS).
+/// Configuration of the RLS estimator (defaults chosen on the drive zoo,
+/// [`crate::zoo`]).
 ///
-/// With these defaults the 2 ms-ahead rms error is 0.61 µm on EMPS (1 kHz,
-/// H = 10) and 0.35 … 0.80 µm on the rig's ramp, S-curve, chirp, PRBS and
-/// multisine; λ between 0.99 and 0.9995 changes it by a few percent
-/// (`tests/arx_rls_targets.rs`).
+/// With these defaults the 10-sample-ahead rms error is 0.44 µm on EMPS
+/// (1 kHz) and 0.35 … 0.80 µm 2 ms ahead on the rig's ramp, S-curve, chirp,
+/// PRBS and multisine (`tests/arx_rls_targets.rs`, `--nocapture` prints
+/// them). On slow sweeps of nearly noise-free axes the ARX(8,8)
+/// coefficients are undetermined in the directions the motion does not
+/// excite and can wind up there (README, zoo benchmark, "Read in mm").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RlsConfig {
     /// Model orders; default `na = 8, nb = 8, nk = 1`.

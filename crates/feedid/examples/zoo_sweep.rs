@@ -21,7 +21,9 @@
 //! Environment: `ZOO_SWEEP_PHASE=P` starts the baselines' blocks `P`
 //! samples later (as `zoo_bench --baseline-phase`); `ZOO_SWEEP_WHO=1`
 //! prints every loss to a baseline on stderr (`all`: every comparison,
-//! with both sums of squares); `ZOO_SWEEP_DUMP=PREFIX` writes
+//! with both sums of squares); `ZOO_SWEEP_VIA=mm|um` has the methods read
+//! every member converted to that unit and back (the baselines and the
+//! scores keep the metre values); `ZOO_SWEEP_DUMP=PREFIX` writes
 //! `PREFIX-N.csv` per member (k, u, y, prediction, flag, arx220, chosen
 //! candidate).
 
@@ -85,6 +87,7 @@ fn parse(cfg: &str) -> Result<(Method, usize), String> {
                 (Method::Arx(c), "slide") => c.sliding = v == "1",
                 (Method::Rls(c), "lambda") => c.lambda = f()?,
                 (Method::Rls(c), "p0") => c.p0 = f()?,
+                (Method::Rls(c), "trace") => c.max_trace = Some(f()?),
                 (Method::Rls(c), "minx") => c.min_excitation = f()?,
                 (Method::Rls(c), "scale") => c.scale = Some(f()?),
                 (Method::Rls(c), "span") => c.frame_span = f()?,
@@ -253,6 +256,24 @@ fn main() {
         .flat_map(|&i| {
             let m = zoo.member(i).unwrap();
             let rec = m.recording().unwrap();
+            // ZOO_SWEEP_VIA=mm|um: the methods see the recording converted
+            // to that unit and back (as `zoo_bench --via-unit`)
+            let via = match std::env::var("ZOO_SWEEP_VIA").as_deref() {
+                Ok("mm") => 1e-3,
+                Ok("um") => 1e-6,
+                _ => 1.0,
+            };
+            let rec = if via == 1.0 {
+                rec
+            } else {
+                let f = |v: &[f64]| {
+                    v.iter()
+                        .map(|x| x * (1.0 / via) * via)
+                        .collect::<Vec<f64>>()
+                };
+                feedid::Recording::new(rec.time().to_vec(), f(rec.command()), f(rec.position()))
+                    .unwrap()
+            };
             let s = rec.signals();
             let y = &m.position;
             let n = y.len();

@@ -510,22 +510,17 @@ mod tests {
         assert!((b.q - 1e-6 * a.q).abs() <= 1e-15 * a.q);
     }
 
-    #[test]
-    fn an_isolated_wild_sample_is_replaced_by_its_prediction_and_a_step_is_not() {
-        let mut g = Guard::new(GuardConfig::default(), 5, 5).unwrap();
-        // a ramp predicted with small errors, then a glitch, later a real step
-        let mut y: Vec<f64> = (0..400)
-            .map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64))
-            .collect();
-        y[203] += 1e3;
-        for v in &mut y[300..] {
-            *v += 50.0;
-        }
-        let mut clean = y.clone();
-        let (mut lo, mut hi) = ([0.0; 5], [0.0; 5]);
+    /// A ramp of one unit per sample (measured `y`, with whatever glitches
+    /// and steps) predicted as `k + 0.02` in horizons of `h` samples every
+    /// `h` from sample 10; returns what the estimators see and the
+    /// replaced samples.
+    fn guard_a_ramp(y: &[f64], h: usize) -> (Vec<f64>, Vec<usize>) {
+        let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
+        let mut clean = y.to_vec();
+        let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
         let mut replaced = Vec::new();
         let mut start = 10;
-        while start + 5 <= 400 {
+        while start + h <= y.len() {
             g.observe(
                 start,
                 |k| y[k],
@@ -534,11 +529,24 @@ mod tests {
                     clean[k] = v;
                 },
             );
-            let pred: Vec<f64> = (start..start + 5).map(|k| k as f64 + 0.02).collect();
-            let last = clean[start - 1];
-            g.predicted(start, &pred, last, 1.0, &mut lo, &mut hi);
-            start += 5;
+            let pred: Vec<f64> = (start..start + h).map(|k| k as f64 + 0.02).collect();
+            g.predicted(start, &pred, clean[start - 1], 1.0, &mut lo, &mut hi);
+            start += h;
         }
+        (clean, replaced)
+    }
+
+    #[test]
+    fn an_isolated_wild_sample_is_replaced_by_its_prediction_and_a_step_is_not() {
+        // a ramp predicted with small errors, then a glitch, later a real step
+        let mut y: Vec<f64> = (0..400)
+            .map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64))
+            .collect();
+        y[203] += 1e3;
+        for v in &mut y[300..] {
+            *v += 50.0;
+        }
+        let (clean, replaced) = guard_a_ramp(&y, 5);
         assert!(replaced.contains(&203), "{replaced:?}");
         assert!((clean[203] - 203.02).abs() < 1e-12);
         // the step at 300: its first sample may be taken for a glitch, the
@@ -554,32 +562,17 @@ mod tests {
         // less than 8 times the motion over a horizon (80), far beyond 8
         // times any change between two samples (8)
         let h = 10;
-        let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
         let mut y: Vec<f64> = (0..400)
             .map(|k| k as f64 + 0.01 * ((k * 7 % 5) as f64))
             .collect();
         y[309] += 30.0;
-        let mut clean = y.clone();
-        let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
-        let mut replaced = Vec::new();
-        let mut start = 10;
-        while start + h <= y.len() {
-            g.observe(
-                start,
-                |k| y[k],
-                |k, v| {
-                    replaced.push(k);
-                    clean[k] = v;
-                },
-            );
-            // the next horizon starts from what the estimators see
+        let (clean, replaced) = guard_a_ramp(&y, h);
+        // every horizon starts from what the estimators see
+        for start in (10..=y.len() - h).step_by(h) {
             assert!(
                 (clean[start - 1] - (start - 1) as f64).abs() < 0.1,
                 "{start}"
             );
-            let pred: Vec<f64> = (start..start + h).map(|k| k as f64 + 0.02).collect();
-            g.predicted(start, &pred, clean[start - 1], 1.0, &mut lo, &mut hi);
-            start += h;
         }
         assert_eq!(replaced, vec![309]);
     }

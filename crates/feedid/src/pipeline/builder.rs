@@ -289,6 +289,12 @@ impl<'a> Pipeline<'a> {
                 failed: sliding.failed_windows(),
                 withheld: sliding.withheld_windows(),
             });
+        } else if sliding.withheld_windows() > 0 {
+            warnings.push(Warning::ImplausibleWithheld {
+                withheld: sliding.withheld_windows(),
+                windows: sliding.windows.len(),
+                factor: self.guard.plausibility.unwrap_or(f64::INFINITY),
+            });
         }
 
         let simulated = match &self.nominal {

@@ -34,7 +34,9 @@ pub struct IdentifySummary {
     pub failed_windows: usize,
     /// Windows that kept the previous model (not informative).
     pub fallback_windows: usize,
-    /// Windows whose prediction the method withheld (not validated; `auto`).
+    /// Windows whose prediction was withheld: implausible, beyond 4× the
+    /// motion the recording has shown (the estimator then restarts; see
+    /// [`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility)).
     pub withheld_windows: usize,
     /// Samples with a prediction.
     pub samples_predicted: usize,

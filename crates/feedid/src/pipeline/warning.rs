@@ -30,6 +30,18 @@ pub enum Warning {
         /// Windows whose prediction the method withheld.
         withheld: usize,
     },
+    /// Some predictions left the last measured position by more than the
+    /// plausibility factor times the motion the recording has shown: they
+    /// were withheld and the method restarted after each
+    /// ([`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility)).
+    ImplausibleWithheld {
+        /// Windows whose prediction was withheld.
+        withheld: usize,
+        /// Windows visited.
+        windows: usize,
+        /// The plausibility factor.
+        factor: f64,
+    },
     /// Paper method with the window time origin: the output model
     /// `P5·τ⁵ + P6·τ⁶ + P7·τ⁷` is zero with its first four derivatives at each
     /// window's first sample, so it cannot represent an axis that is away from
@@ -84,6 +96,17 @@ impl fmt::Display for Warning {
                     )
                 }
             }
+            Warning::ImplausibleWithheld {
+                withheld,
+                windows,
+                factor,
+            } => write!(
+                f,
+                "{withheld} of {windows} windows predicted implausibly (more than {factor} times \
+                 the motion the recording has shown, away from the last measured position: a \
+                 model that wound up or diverged); those predictions were withheld, are not in \
+                 the error figures, and the method restarted after each"
+            ),
             Warning::PaperWindowOrigin => write!(
                 f,
                 "paper method, time origin window: the output model P5·τ⁵ + P6·τ⁶ + P7·τ⁷ \

@@ -70,7 +70,9 @@ pub enum WindowOutcome {
     Predicted(Termination),
     /// The window kept the last good model, which predicted.
     Fallback,
-    /// A model was identified but the method withheld its prediction (`auto`).
+    /// A model was identified but its prediction was withheld: the method
+    /// declined ([`PredictStatus::Withheld`]) or the engine found it
+    /// implausible ([`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility)).
     Withheld,
     /// The fit or the prediction failed (an error or a non-finite value): no prediction.
     Failed,
@@ -137,6 +139,22 @@ pub trait Estimator {
     /// Forget all state (start of a new recording).
     fn reset(&mut self) {}
 
+    /// Learn again: the engine found the last prediction implausible (see
+    /// [`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility)),
+    /// so the model behind it is not to be trusted. Default:
+    /// [`Estimator::reset`].
+    fn restart(&mut self) {
+        self.reset()
+    }
+
+    /// Whether the engine withholds this method's implausible predictions
+    /// ([`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility);
+    /// default `true`). The paper's method answers `false`: it is
+    /// reproduced as published, wild polynomial extrapolations included.
+    fn checks_plausibility(&self) -> bool {
+        true
+    }
+
     /// Identify from the samples `window` (absolute indices) and write the
     /// coefficients into `coef` (length `coefficient_names().len()`).
     fn fit(
@@ -175,6 +193,12 @@ impl<E: Estimator + ?Sized> Estimator for Box<E> {
     }
     fn reset(&mut self) {
         (**self).reset()
+    }
+    fn restart(&mut self) {
+        (**self).restart()
+    }
+    fn checks_plausibility(&self) -> bool {
+        (**self).checks_plausibility()
     }
     fn fit(
         &mut self,

@@ -55,6 +55,28 @@
 //! measured value is kept for the scores: the statistics of a run are over
 //! the measured positions.
 //!
+//! # Implausible predictions
+//!
+//! A prediction is *implausible* when it leaves the last measured position
+//! by more than [`GuardConfig::plausibility`] (default 4) times the motion
+//! the recording has shown — the larger of the largest range of the
+//! measured position over one window so far and the range of the command
+//! over the window and the horizon ([`Guard::plausible`]). A position servo
+//! follows its command: within a horizon it does not travel four times
+//! farther than it ever did within a window and than it is commanded to.
+//! Such a prediction comes from a model that has wound up or diverged (on
+//! a zoo recording read in mm, an output-error fit thrown off by the
+//! rounding predicted 113 mm away on a 0.8 mm motion). The engine withholds
+//! it — the window's outcome is `withheld` and none of its samples is
+//! scored — and calls [`Estimator::restart`](crate::ident::Estimator::restart):
+//! `rls` forgets its model and learns again, `oe` fits the next window
+//! with a moving command from its initial estimate. The bound is a ratio
+//! of lengths of the recording itself, so it has no unit. `auto` applies
+//! the same bound to each of its candidates and so never has a prediction
+//! withheld; the paper's method is reproduced as published and is not
+//! checked ([`Estimator::checks_plausibility`](crate::ident::Estimator::checks_plausibility)).
+//! Until anything has moved there is no scale and nothing is withheld.
+//!
 //! All buffers are allocated in [`Guard::new`]; the per-sample work is a
 //! constant number of operations per pending prediction (at most
 //! `⌈H / hop⌉ + 1`).
@@ -83,6 +105,11 @@ pub struct GuardConfig {
     /// `e^{−η·(1−P)}` (within it); default 0.1 (a jump of the errors is
     /// caught up within tens of horizons).
     pub adaptation: f64,
+    /// A prediction that leaves the last measured position by more than
+    /// this many times the motion the recording has shown (see the module
+    /// doc, *Implausible predictions*) is withheld and the estimator
+    /// restarts; `None` keeps every prediction; default `Some(4.0)`.
+    pub plausibility: Option<f64>,
 }
 
 impl Default for GuardConfig {
@@ -91,6 +118,7 @@ impl Default for GuardConfig {
             interval: 0.95,
             outlier: Some(8.0),
             adaptation: 0.1,
+            plausibility: Some(4.0),
         }
     }
 }
@@ -120,6 +148,15 @@ impl GuardConfig {
                 value: self.adaptation,
                 reason: "must be in (0, 1]",
             });
+        }
+        if let Some(k) = self.plausibility {
+            if !(k.is_finite() && k >= 1.0) {
+                return Err(Error::InvalidParameter {
+                    name: "plausibility",
+                    value: k,
+                    reason: "must be finite and ≥ 1",
+                });
+            }
         }
         Ok(())
     }
@@ -200,6 +237,10 @@ pub struct Guard {
     /// The last measured sample (for the resolution).
     last: Option<f64>,
     outliers: usize,
+    /// Largest range of the measured position over one window so far \[m\].
+    motion: f64,
+    /// Predictions withheld as implausible since the reset.
+    implausible: usize,
 }
 
 impl Guard {
@@ -232,6 +273,8 @@ impl Guard {
             resolution: f64::INFINITY,
             last: None,
             outliers: 0,
+            motion: 0.0,
+            implausible: 0,
         })
     }
 
@@ -244,6 +287,8 @@ impl Guard {
     pub fn reset(&mut self) {
         self.reset_segment();
         self.outliers = 0;
+        self.motion = 0.0;
+        self.implausible = 0;
     }
 
     /// Forget the errors and pending predictions but keep the outlier count
@@ -269,6 +314,37 @@ impl Guard {
     /// Outliers found since the reset.
     pub fn outliers(&self) -> usize {
         self.outliers
+    }
+
+    /// Predictions found implausible since the reset ([`Guard::plausible`]).
+    pub fn implausible(&self) -> usize {
+        self.implausible
+    }
+
+    /// Whether the prediction `values` of a window is plausible: it leaves
+    /// the last measured position `last` by at most
+    /// [`GuardConfig::plausibility`] times the larger of the largest range
+    /// of the measured position over a window so far (this one's, `spread`,
+    /// included) and the range of the command over the window and the
+    /// horizon (`command_span`). Counts the implausible ones.
+    pub fn plausible(&mut self, values: &[f64], last: f64, spread: f64, command_span: f64) -> bool {
+        if spread > self.motion {
+            self.motion = spread;
+        }
+        let Some(f) = self.config.plausibility else {
+            return true;
+        };
+        let motion = self.motion.max(command_span);
+        if !(motion > 0.0) {
+            // nothing has moved yet: no scale to judge by
+            return true;
+        }
+        let limit = f * motion;
+        let ok = values.iter().all(|v| (v - last).abs() <= limit);
+        if !ok {
+            self.implausible += 1;
+        }
+        ok
     }
 
     /// Check the samples measured since the last call, up to `end`

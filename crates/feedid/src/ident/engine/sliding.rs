@@ -9,8 +9,9 @@
 //!
 //! Each window ends with a [`WindowOutcome`] — predicted (with the
 //! solver's termination), fallback (the last good model predicted),
-//! withheld by the method, or failed — a value, apart from how a solver
-//! stopped. A window whose fit or prediction fails (singular problem,
+//! withheld (an implausible prediction, see [`GuardConfig::plausibility`],
+//! after which the estimator restarts), or failed — a value, apart from how
+//! a solver stopped. A window whose fit or prediction fails (singular problem,
 //! non-finite result) gives no prediction and is recorded as
 //! [`WindowOutcome::Failed`]; no NaN ever reaches the prediction series.
 //!
@@ -231,7 +232,8 @@ impl SlidingResult {
             .count()
     }
 
-    /// Number of windows whose prediction the method withheld (`auto`).
+    /// Number of windows whose prediction was withheld (implausible, see
+    /// [`GuardConfig::plausibility`], or declined by the method).
     pub fn withheld_windows(&self) -> usize {
         self.windows
             .iter()
@@ -348,24 +350,25 @@ pub fn run_with<E: Estimator + ?Sized>(
         let coef = &mut coefficients[w * nc..(w + 1) * nc];
         let h = horizon.len();
         let out = &mut buf[..h];
-        let record = fit_and_predict(estimator, &seen, window.clone(), horizon, coef, out);
-        if record.outcome.predicted() {
-            let y = seen.all().position;
-            let win = &y[window.clone()];
-            let (mn, mx) = win
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            let (lo, hi) = (&mut lo[..h], &mut hi[..h]);
-            guard.predicted(
-                record.horizon.start,
+        let mut record = fit_and_predict(estimator, &seen, window.clone(), horizon, coef, out);
+        let all = seen.all();
+        let spread = range(&all.position[window.clone()]);
+        let last = all.position[window.end - 1];
+        if record.outcome.predicted()
+            && estimator.checks_plausibility()
+            && !guard.plausible(
                 out,
-                y[window.end - 1],
-                mx - mn,
-                lo,
-                hi,
-            );
+                last,
+                spread,
+                range(&all.command[window.start..record.horizon.end]),
+            )
+        {
+            record.outcome = WindowOutcome::Withheld;
+            estimator.restart();
+        }
+        if record.outcome.predicted() {
+            let (lo, hi) = (&mut lo[..h], &mut hi[..h]);
+            guard.predicted(record.horizon.start, out, last, spread, lo, hi);
             predicted[record.horizon.clone()].copy_from_slice(out);
             has_prediction[record.horizon.clone()].fill(true);
             lower[record.horizon.clone()].copy_from_slice(lo);
@@ -443,6 +446,16 @@ pub(crate) fn fit_and_predict<E: Estimator + ?Sized>(
         iterations,
         outcome,
     }
+}
+
+/// `max − min` of `v` (NaN entries ignored; −∞ if all are NaN or `v` is empty).
+pub(crate) fn range(v: &[f64]) -> f64 {
+    let (mn, mx) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    mx - mn
 }
 
 fn finite_or_zero(v: f64) -> f64 {
@@ -526,6 +539,106 @@ mod tests {
             out.fill(f64::NAN);
             Ok(PredictStatus::Predicted)
         }
+    }
+
+    /// Holds the last position, except on window `wild` (counted from 1),
+    /// where it predicts `jump` away; counts its restarts.
+    struct Wild {
+        k: usize,
+        wild: usize,
+        jump: f64,
+        restarts: usize,
+    }
+
+    impl Estimator for Wild {
+        fn name(&self) -> &'static str {
+            "wild"
+        }
+        fn coefficient_names(&self) -> Vec<String> {
+            vec![]
+        }
+        fn restart(&mut self) {
+            self.restarts += 1;
+        }
+        fn fit(&mut self, _: &Signals<'_>, _: Range<usize>, _: &mut [f64]) -> Result<WindowFit> {
+            self.k += 1;
+            Ok(WindowFit::identified(0.0, 0, Termination::Exact))
+        }
+        fn predict(
+            &mut self,
+            s: &Signals<'_>,
+            w: Range<usize>,
+            _: Range<usize>,
+            out: &mut [f64],
+        ) -> Result<PredictStatus> {
+            let last = s.window(w.end - 1..w.end, 0, "test").unwrap().position[0];
+            let jump = if self.k == self.wild { self.jump } else { 0.0 };
+            out.fill(last + jump);
+            Ok(PredictStatus::Predicted)
+        }
+    }
+
+    #[test]
+    fn a_prediction_far_beyond_the_recordings_motion_is_withheld_and_the_method_restarts() {
+        // a ramp of 10 µm per sample: a window of 20 spans 190 µm, the
+        // command (the same ramp) over window and horizon 290 µm
+        let (t, _) = ramp(300);
+        let y: Vec<f64> = (0..300).map(|k| 1e-5 * k as f64).collect();
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let cfg = EngineConfig {
+            window: 20,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        };
+        for (jump, withheld) in [(4.0 * 290e-6 * 1.01, true), (4.0 * 290e-6 * 0.99, false)] {
+            for sign in [1.0, -1.0] {
+                let mut est = Wild {
+                    k: 0,
+                    wild: 5,
+                    jump: sign * jump,
+                    restarts: 0,
+                };
+                let r = run(&mut est, &s, &cfg).unwrap();
+                assert_eq!(r.withheld_windows(), usize::from(withheld), "{jump}");
+                assert_eq!(est.restarts, usize::from(withheld));
+                let w = &r.windows[4];
+                assert_eq!(w.outcome == WindowOutcome::Withheld, withheld);
+                // nothing of the withheld window is scored; every other is
+                assert_eq!(r.prediction(w.horizon.start).is_none(), withheld);
+                assert_eq!(r.stats.samples, 280 - 10 * usize::from(withheld));
+            }
+        }
+        // the bound disabled: every prediction is kept
+        let mut est = Wild {
+            k: 0,
+            wild: 5,
+            jump: 1.0,
+            restarts: 0,
+        };
+        let guard = GuardConfig {
+            plausibility: None,
+            ..GuardConfig::default()
+        };
+        let r = run_with(&mut est, &s, &cfg, &guard, None).unwrap();
+        assert_eq!((r.withheld_windows(), est.restarts), (0, 0));
+    }
+
+    #[test]
+    fn nothing_is_withheld_before_anything_has_moved() {
+        // at rest with a still command, there is no scale: a prediction
+        // 1 mm off stands (nothing says it is implausible)
+        let (t, _) = ramp(100);
+        let y = vec![0.5; 100];
+        let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
+        let mut est = Wild {
+            k: 0,
+            wild: 3,
+            jump: 1e-3,
+            restarts: 0,
+        };
+        let r = run(&mut est, &s, &EngineConfig::default()).unwrap();
+        assert_eq!((r.withheld_windows(), est.restarts), (0, 0));
     }
 
     fn ramp(n: usize) -> (Vec<f64>, Vec<f64>) {

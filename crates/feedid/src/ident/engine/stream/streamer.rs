@@ -4,6 +4,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
+use crate::ident::engine::sliding::range;
 use crate::ident::engine::stream::options::{
     Arrival, CommandExtrapolation, HorizonCommand, Interval, Jump, StreamOptions,
 };
@@ -72,7 +73,8 @@ pub struct StreamStats {
     pub windows: usize,
     /// Windows whose fit or prediction failed.
     pub failed_windows: usize,
-    /// Windows whose prediction the method withheld (not validated; `auto`).
+    /// Windows whose prediction was withheld (implausible, see
+    /// [`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility)).
     pub withheld_windows: usize,
     /// Predicted samples whose prediction was made before their position arrived.
     pub predicted_ahead: usize,
@@ -630,19 +632,24 @@ impl<E: Estimator> Streamer<E> {
         );
         let out = &mut self.pred[..he - we];
         self.coef.fill(0.0);
-        let record = fit_and_predict(&mut self.est, &signals, s..we, we..he, &mut self.coef, out);
+        let mut record =
+            fit_and_predict(&mut self.est, &signals, s..we, we..he, &mut self.coef, out);
+        let spread = range(&self.y[s - off..we - off]);
+        let last = self.y[we - 1 - off];
+        if record.outcome.predicted()
+            && self.est.checks_plausibility()
+            && !self
+                .guard
+                .plausible(out, last, spread, range(&self.u[s - off..he - off]))
+        {
+            record.outcome = WindowOutcome::Withheld;
+            self.est.restart();
+        }
         let ok = record.outcome.predicted();
         let already = np.clamp(we, he) - we;
         let (lo, hi) = (&mut self.pred_lo[..he - we], &mut self.pred_hi[..he - we]);
         if ok {
-            let win = &self.y[s - off..we - off];
-            let (mn, mx) = win
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            self.guard
-                .predicted(we, out, self.y[we - 1 - off], mx - mn, lo, hi);
+            self.guard.predicted(we, out, last, spread, lo, hi);
             self.p[we - off..he - off].copy_from_slice(out);
             self.lo[we - off..he - off].copy_from_slice(lo);
             self.hi[we - off..he - off].copy_from_slice(hi);

@@ -606,6 +606,9 @@ pub struct OeEstimator {
     dt: f64,
     /// Residual rms of the last window (noise scale of the prior) \[m\].
     sigma: f64,
+    /// Start again from the initial estimate at the next window with a
+    /// moving command ([`Estimator::restart`]); until then the model stays.
+    restart_pending: bool,
 }
 
 impl OeEstimator {
@@ -624,6 +627,7 @@ impl OeEstimator {
             last_window: None,
             dt: 0.0,
             sigma: 0.0,
+            restart_pending: false,
         }
     }
 
@@ -666,6 +670,14 @@ impl Estimator for OeEstimator {
     fn reset(&mut self) {
         self.structure = None;
         self.last_window = None;
+        self.restart_pending = false;
+    }
+
+    /// The model is fitted again from the initial estimate at the next
+    /// window with a moving command; windows before it keep the model (a
+    /// reset would leave a recording that no longer moves without any).
+    fn restart(&mut self) {
+        self.restart_pending = true;
     }
 
     fn fit(
@@ -690,13 +702,21 @@ impl Estimator for OeEstimator {
         let w = u.len();
         check_signals(u, y, signals.dt(), p + n + 2)?;
         self.last_window = None;
-        let first =
-            self.structure.is_none() || (self.dt - signals.dt()).abs() > 1e-12 * signals.dt();
+        let (u_min, u_max) = u
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let excited = u_max > u_min;
+        let first = self.structure.is_none()
+            || (self.dt - signals.dt()).abs() > 1e-12 * signals.dt()
+            || (self.restart_pending && excited);
         if first {
             let (st, theta, _) = initial_estimate(u, y, signals.dt(), &self.config)?;
             self.theta.copy_from_slice(&theta);
             self.structure = Some(st);
             self.dt = signals.dt();
+            self.restart_pending = false;
         }
         let Some(st) = self.structure else {
             return Err(Error::InvalidModel {
@@ -714,12 +734,6 @@ impl Estimator for OeEstimator {
             .get_or_insert_with(|| LevenbergMarquardt::new(w + p, p));
         self.theta_prev.copy_from_slice(&self.theta);
 
-        let (u_min, u_max) = u
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                (a.min(v), b.max(v))
-            });
-        let excited = u_max > u_min;
         let mut iterations = 0;
         // `None`: the previous window's model is kept (fallback)
         let mut termination = None;
@@ -1233,6 +1247,51 @@ mod tests {
         let f = oe.fit(&s, 250..400, &mut c1).unwrap();
         assert_eq!(f.status, FitStatus::Fallback);
         assert_eq!(c0, c1);
+    }
+
+    #[test]
+    fn a_restart_keeps_the_model_until_a_moving_command_refits_it_from_the_start() {
+        let tf = second_order();
+        let mut u = binary_input(700, 20, 0, 1e-4, 4);
+        for v in u[250..400].iter_mut() {
+            *v = 2e-4;
+        }
+        let y = simulate(&tf, &u, DT);
+        let t: Vec<f64> = (0..u.len()).map(|k| k as f64 * DT).collect();
+        let s = Signals::new(&t, &u, &y, DT, 0.0);
+        let cfg = OeConfig {
+            poles: 2,
+            zeros: 0,
+            ..OeConfig::default()
+        };
+        let mut oe = cfg.clone().build().unwrap();
+        let mut c0 = [0.0; 4];
+        oe.fit(&s, 100..250, &mut c0).unwrap();
+        oe.restart();
+        // a still command: the model stays (a reset would fail here)
+        let mut c1 = [0.0; 4];
+        let f = oe.fit(&s, 250..400, &mut c1).unwrap();
+        assert_eq!(f.status, FitStatus::Fallback);
+        assert_eq!(c0, c1);
+        let mut out = [0.0; 10];
+        oe.predict(&s, 250..400, 400..410, &mut out).unwrap();
+        assert!(out.iter().all(|v| v.is_finite()));
+        // the next moving window is fitted as a first one: as a fresh estimator
+        let mut c2 = [0.0; 4];
+        oe.fit(&s, 400..550, &mut c2).unwrap();
+        let mut fresh = cfg.clone().build().unwrap();
+        let mut c3 = [0.0; 4];
+        fresh.fit(&s, 400..550, &mut c3).unwrap();
+        assert_eq!(c2, c3);
+        // without the restart, the window is fitted from the previous model
+        let mut warm = cfg.clone().build().unwrap();
+        warm.fit(&s, 100..250, &mut c0).unwrap();
+        warm.fit(&s, 250..400, &mut c1).unwrap();
+        let f = warm.fit(&s, 400..550, &mut c1).unwrap();
+        assert!(f.iterations <= cfg.window_iterations);
+        // and after it, the restart is spent: the next window is warm-started
+        let f = oe.fit(&s, 550..700, &mut c2).unwrap();
+        assert!(f.iterations <= cfg.window_iterations);
     }
 
     #[test]

@@ -212,6 +212,12 @@ impl Estimator for PaperMethod {
         self.config.prediction != PredictionMode::Polynomial
     }
 
+    /// The paper's method is reproduced as published: its predictions are
+    /// kept however far its polynomial extrapolates.
+    fn checks_plausibility(&self) -> bool {
+        false
+    }
+
     fn coefficient_names(&self) -> Vec<String> {
         NAMES.iter().map(|s| s.to_string()).collect()
     }

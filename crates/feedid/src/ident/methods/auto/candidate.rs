@@ -498,29 +498,21 @@ impl Predictor {
                 if r.scale > 0.0 {
                     let inv = 1.0 / r.scale;
                     let max_trace = n as f64 * P0;
-                    for k in rows {
-                        // scaled as it is built (a separate pass reloaded
-                        // the fresh scalar stores as vectors: a stall)
-                        let (t, informative) =
-                            model::row_scaled(&o, y, u, k, inv, &mut r.psi[..nm]);
-                        if !informative {
-                            continue;
-                        }
-                        if bias {
-                            // the column `scale`, in scaled coordinates
-                            r.psi[nm] = 1.0;
-                        }
-                        let _ = rls_update(
-                            r.avx,
-                            &mut r.p,
-                            &mut r.kappa,
-                            &r.psi,
-                            &mut self.theta,
-                            &mut r.g,
-                            t,
-                            lambda,
-                            max_trace,
-                        );
+                    let theta = &mut self.theta;
+                    // the default candidates' orders unrolled
+                    macro_rules! update {
+                        ($($na1:literal $nb:literal)*) => {
+                            match (o.na.max(1) - 1, o.nb) {
+                                $(($na1, $nb) => update_rows(r, theta, rows, bias, nm, lambda, max_trace, |k, psi| {
+                                    model::row_scaled_fixed::<$na1, $nb>(o.nk, y, u, k, inv, psi)
+                                }),)*
+                                _ => update_rows(r, theta, rows, bias, nm, lambda, max_trace, |k, psi| {
+                                    model::row_scaled(&o, y, u, k, inv, psi)
+                                }),
+                            }
+                        };
+                    }
+                    if update!(2 3  3 4  5 6  7 8) {
                         self.fitted = true;
                     }
                     fold_scale(&mut r.p, &mut r.kappa);
@@ -826,6 +818,50 @@ fn reset_covariance(p: &mut [f64], kappa: &mut f64, n: usize) {
 }
 
 /// Largest magnitude of a regressor or target over the rows (0 if all zero or not finite).
+/// Feed the rows `rows` (local indices), built by `row` (scaled; the
+/// target and whether the unscaled row is informative), to the recursive
+/// least squares of `r` and `theta`; uninformative rows are skipped.
+/// Returns whether any row was used.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn update_rows(
+    r: &mut Recursive,
+    theta: &mut [f64],
+    rows: Range<usize>,
+    bias: bool,
+    nm: usize,
+    lambda: f64,
+    max_trace: f64,
+    row: impl Fn(usize, &mut [f64]) -> (f64, bool),
+) -> bool {
+    let mut used = false;
+    for k in rows {
+        // scaled as it is built (a separate pass reloaded the fresh scalar
+        // stores as vectors: a stall)
+        let (t, informative) = row(k, &mut r.psi[..nm]);
+        if !informative {
+            continue;
+        }
+        if bias {
+            // the column `scale`, in scaled coordinates
+            r.psi[nm] = 1.0;
+        }
+        let _ = rls_update(
+            r.avx,
+            &mut r.p,
+            &mut r.kappa,
+            &r.psi,
+            theta,
+            &mut r.g,
+            t,
+            lambda,
+            max_trace,
+        );
+        used = true;
+    }
+    used
+}
+
 fn largest_row_entry(
     o: &ArxOrders,
     y: &[f64],

@@ -96,6 +96,37 @@ pub(crate) fn row_scaled(
     (t * inv, any)
 }
 
+/// [`row_scaled`] with `na − 1 = NA1` and `nb = NB` known at compile time
+/// (unrolled, for the default candidates' orders): the same values.
+#[inline(always)]
+pub(crate) fn row_scaled_fixed<const NA1: usize, const NB: usize>(
+    nk: usize,
+    y: &[f64],
+    u: &[f64],
+    k: usize,
+    inv: f64,
+    psi: &mut [f64],
+) -> (f64, bool) {
+    let rho = y[k - 1];
+    let t = y[k] - rho;
+    let mut any = t != 0.0;
+    let ya = &y[k - 1 - NA1..k - 1];
+    let newest = k - nk;
+    let ub = &u[newest + 1 - NB..=newest];
+    let (pa, pb) = psi[..NA1 + NB].split_at_mut(NA1);
+    for i in 0..NA1 {
+        let d = -(ya[NA1 - 1 - i] - rho);
+        any |= d != 0.0;
+        pa[i] = d * inv;
+    }
+    for j in 0..NB {
+        let d = ub[NB - 1 - j] - rho;
+        any |= d != 0.0;
+        pb[j] = d * inv;
+    }
+    (t * inv, any)
+}
+
 /// k-step prediction of `out.len()` samples from the local index `e`: `y`
 /// measured below `e`, `u` known up to `e + out.len()`; `c` the constant
 /// added to every increment (0 without a bias); `past` a scratch of length

@@ -15,7 +15,7 @@
 use std::fmt;
 use std::ops::Range;
 
-use super::model;
+use super::model::{self, with_dims};
 use crate::error::{Error, Result};
 use crate::ident::methods::rls::{fold_scale, has_avx2, rls_update};
 use crate::ident::{ArxOrders, Signals};
@@ -499,20 +499,16 @@ impl Predictor {
                     let inv = 1.0 / r.scale;
                     let max_trace = n as f64 * P0;
                     let theta = &mut self.theta;
-                    // the default candidates' orders unrolled
-                    macro_rules! update {
-                        ($($na1:literal $nb:literal)*) => {
-                            match (o.na.max(1) - 1, o.nb) {
-                                $(($na1, $nb) => update_rows(r, theta, rows, bias, nm, lambda, max_trace, |k, psi| {
-                                    model::row_scaled_fixed::<$na1, $nb>(o.nk, y, u, k, inv, psi)
-                                }),)*
-                                _ => update_rows(r, theta, rows, bias, nm, lambda, max_trace, |k, psi| {
-                                    model::row_scaled(&o, y, u, k, inv, psi)
-                                }),
-                            }
-                        };
-                    }
-                    if update!(2 3  3 4  5 6  7 8) {
+                    let rls = Rows {
+                        y,
+                        u,
+                        inv,
+                        bias,
+                        nm,
+                        lambda,
+                        max_trace,
+                    };
+                    if with_dims!(o, update_rows(r, theta, rows, &rls)) {
                         self.fitted = true;
                     }
                     fold_scale(&mut r.p, &mut r.kappa);
@@ -557,7 +553,7 @@ impl Predictor {
                     // built in place (a copy reloaded the fresh scalar
                     // stores as vectors: a stall)
                     let row = &mut l.group[pending * m..(pending + 1) * m];
-                    let (t, informative) = model::row_scaled(&o, y, u, k, 1.0, &mut row[..nm]);
+                    let (t, informative) = model::row_scaled(o, y, u, k, 1.0, &mut row[..nm]);
                     if !informative {
                         continue;
                     }
@@ -637,16 +633,9 @@ impl Predictor {
                 if past.len() < need {
                     past.resize(need, 0.0);
                 }
-                model::predict(
-                    &orders,
-                    &self.theta[..self.n_model],
-                    c,
-                    w.position,
-                    w.command,
-                    lag,
-                    past,
-                    out,
-                );
+                let theta = &self.theta[..self.n_model];
+                let (y, u) = (w.position, w.command);
+                model::predict(orders, theta, c, y, u, lag, past, out);
             }
         }
         if out.iter().all(|v| v.is_finite()) {
@@ -818,27 +807,40 @@ fn reset_covariance(p: &mut [f64], kappa: &mut f64, n: usize) {
 }
 
 /// Largest magnitude of a regressor or target over the rows (0 if all zero or not finite).
-/// Feed the rows `rows` (local indices), built by `row` (scaled; the
-/// target and whether the unscaled row is informative), to the recursive
+/// What a recursive candidate's rows are built from and how they are fed.
+struct Rows<'a> {
+    /// Positions and commands of the window (local indices).
+    y: &'a [f64],
+    u: &'a [f64],
+    /// Scale of the coordinates (1 / the largest regressor of the first window).
+    inv: f64,
+    /// Whether the model has a constant term (column `nm`).
+    bias: bool,
+    /// Free parameters of the unit-gain model.
+    nm: usize,
+    lambda: f64,
+    /// Trace bound of the covariance.
+    max_trace: f64,
+}
+
+/// Feed the rows `rows` (local indices) of orders `o` to the recursive
 /// least squares of `r` and `theta`; uninformative rows are skipped.
 /// Returns whether any row was used.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn update_rows(
+fn update_rows<D: model::Dims>(
+    o: D,
     r: &mut Recursive,
     theta: &mut [f64],
     rows: Range<usize>,
-    bias: bool,
-    nm: usize,
-    lambda: f64,
-    max_trace: f64,
-    row: impl Fn(usize, &mut [f64]) -> (f64, bool),
+    a: &Rows<'_>,
 ) -> bool {
+    let (y, u, inv, bias, nm) = (a.y, a.u, a.inv, a.bias, a.nm);
+    let (lambda, max_trace) = (a.lambda, a.max_trace);
     let mut used = false;
     for k in rows {
         // scaled as it is built (a separate pass reloaded the fresh scalar
         // stores as vectors: a stall)
-        let (t, informative) = row(k, &mut r.psi[..nm]);
+        let (t, informative) = model::row_scaled(o, y, u, k, inv, &mut r.psi[..nm]);
         if !informative {
             continue;
         }

@@ -52,11 +52,75 @@ pub(crate) fn n_free(o: &ArxOrders) -> usize {
     o.na.saturating_sub(1) + o.nb
 }
 
+/// The orders a row or a prediction is computed with: at run time
+/// ([`ArxOrders`]) or known at compile time ([`Fixed`], the default
+/// candidates': the loops are unrolled). Both give the same values.
+pub(crate) trait Dims: Copy {
+    /// `na − 1` (0 for `na = 0`): the free autoregressive coefficients.
+    fn na1(self) -> usize;
+    /// `nb`.
+    fn nb(self) -> usize;
+    /// `nk`.
+    fn nk(self) -> usize;
+}
+
+impl Dims for ArxOrders {
+    #[inline(always)]
+    fn na1(self) -> usize {
+        self.na.max(1) - 1
+    }
+    #[inline(always)]
+    fn nb(self) -> usize {
+        self.nb
+    }
+    #[inline(always)]
+    fn nk(self) -> usize {
+        self.nk
+    }
+}
+
+/// Orders `na = NA1 + 1`, `nb = NB` known at compile time, delay `nk` (the field).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Fixed<const NA1: usize, const NB: usize>(pub usize);
+
+impl<const NA1: usize, const NB: usize> Dims for Fixed<NA1, NB> {
+    #[inline(always)]
+    fn na1(self) -> usize {
+        NA1
+    }
+    #[inline(always)]
+    fn nb(self) -> usize {
+        NB
+    }
+    #[inline(always)]
+    fn nk(self) -> usize {
+        self.0
+    }
+}
+
+/// Call `$f` (a generic function's name, its first argument the orders)
+/// with `$o` (an [`ArxOrders`]) as [`Fixed`] orders when they are a default
+/// candidate's, else as they are, and the remaining arguments.
+macro_rules! with_dims {
+    ($o:expr, $f:ident ( $($arg:expr),* $(,)? )) => {{
+        let o: ArxOrders = $o;
+        match (o.na.max(1) - 1, o.nb) {
+            (1, 2) => $f($crate::ident::methods::auto::model::Fixed::<1, 2>(o.nk), $($arg),*),
+            (2, 3) => $f($crate::ident::methods::auto::model::Fixed::<2, 3>(o.nk), $($arg),*),
+            (3, 4) => $f($crate::ident::methods::auto::model::Fixed::<3, 4>(o.nk), $($arg),*),
+            (5, 6) => $f($crate::ident::methods::auto::model::Fixed::<5, 6>(o.nk), $($arg),*),
+            (7, 8) => $f($crate::ident::methods::auto::model::Fixed::<7, 8>(o.nk), $($arg),*),
+            _ => $f(o, $($arg),*),
+        }
+    }};
+}
+pub(crate) use with_dims;
+
 /// Regression row of sample `k` (local index `≥ lag`) into `psi`; returns the target `y[k] − y[k−1]`.
 #[inline]
 pub(crate) fn row(o: &ArxOrders, y: &[f64], u: &[f64], k: usize, psi: &mut [f64]) -> f64 {
     // (× 1 is exact)
-    row_scaled(o, y, u, k, 1.0, psi).0
+    row_scaled(*o, y, u, k, 1.0, psi).0
 }
 
 /// Regression row of sample `k` (local index `≥ lag`) into `psi`, every
@@ -64,63 +128,31 @@ pub(crate) fn row(o: &ArxOrders, y: &[f64], u: &[f64], k: usize, psi: &mut [f64]
 /// scaling afterwards); returns the target `y[k] − y[k−1]` times `inv` and
 /// whether the unscaled row or target has a non-zero entry.
 #[inline(always)]
-pub(crate) fn row_scaled(
-    o: &ArxOrders,
+pub(crate) fn row_scaled<D: Dims>(
+    o: D,
     y: &[f64],
     u: &[f64],
     k: usize,
     inv: f64,
     psi: &mut [f64],
 ) -> (f64, bool) {
+    let (na1, nb) = (o.na1(), o.nb());
     let rho = y[k - 1];
     let t = y[k] - rho;
     let mut any = t != 0.0;
     // y[k−2] … y[k−na] and u[k−nk] … u[k−nk−nb+1], newest first (slices:
     // one bounds check each)
-    let na = o.na.max(1) - 1;
-    let (pa, pb) = psi[..na + o.nb].split_at_mut(na);
-    for (p, &v) in pa.iter_mut().zip(y[k - 1 - na..k - 1].iter().rev()) {
-        let d = -(v - rho);
-        any |= d != 0.0;
-        *p = d * inv;
-    }
-    let newest = k - o.nk;
-    for (p, &v) in pb
-        .iter_mut()
-        .zip(u[newest + 1 - o.nb..=newest].iter().rev())
-    {
-        let d = v - rho;
-        any |= d != 0.0;
-        *p = d * inv;
-    }
-    (t * inv, any)
-}
-
-/// [`row_scaled`] with `na − 1 = NA1` and `nb = NB` known at compile time
-/// (unrolled, for the default candidates' orders): the same values.
-#[inline(always)]
-pub(crate) fn row_scaled_fixed<const NA1: usize, const NB: usize>(
-    nk: usize,
-    y: &[f64],
-    u: &[f64],
-    k: usize,
-    inv: f64,
-    psi: &mut [f64],
-) -> (f64, bool) {
-    let rho = y[k - 1];
-    let t = y[k] - rho;
-    let mut any = t != 0.0;
-    let ya = &y[k - 1 - NA1..k - 1];
-    let newest = k - nk;
-    let ub = &u[newest + 1 - NB..=newest];
-    let (pa, pb) = psi[..NA1 + NB].split_at_mut(NA1);
-    for i in 0..NA1 {
-        let d = -(ya[NA1 - 1 - i] - rho);
+    let ya = &y[k - 1 - na1..k - 1];
+    let newest = k - o.nk();
+    let ub = &u[newest + 1 - nb..=newest];
+    let (pa, pb) = psi[..na1 + nb].split_at_mut(na1);
+    for i in 0..na1 {
+        let d = -(ya[na1 - 1 - i] - rho);
         any |= d != 0.0;
         pa[i] = d * inv;
     }
-    for j in 0..NB {
-        let d = ub[NB - 1 - j] - rho;
+    for j in 0..nb {
+        let d = ub[nb - 1 - j] - rho;
         any |= d != 0.0;
         pb[j] = d * inv;
     }
@@ -141,8 +173,8 @@ pub(crate) fn row_scaled_fixed<const NA1: usize, const NB: usize>(
 /// next (the step-by-step form chained every term through the previous
 /// prediction).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn predict(
-    o: &ArxOrders,
+pub(crate) fn predict<D: Dims>(
+    o: D,
     theta: &[f64],
     c: f64,
     y: &[f64],
@@ -151,9 +183,10 @@ pub(crate) fn predict(
     past: &mut [f64],
     out: &mut [f64],
 ) {
-    let na = o.na.max(1);
+    let (na1, nb) = (o.na1(), o.nb());
+    let na = na1 + 1;
     let r = y[e - 1];
-    let (ta, tb) = theta.split_at(o.na.saturating_sub(1));
+    let (ta, tb) = theta[..na1 + nb].split_at(na1);
     let mut sum = 0.0;
     for &a in ta {
         sum += a;
@@ -163,10 +196,11 @@ pub(crate) fn predict(
     }
     // the command's share of each increment (off the recursion)
     for (h, v) in out.iter_mut().enumerate() {
-        let t = e + h - o.nk;
+        let t = e + h - o.nk();
+        let ub = &u[t + 1 - nb..=t];
         let mut acc = 0.0;
-        for (j, &b) in tb.iter().enumerate() {
-            acc += b * (u[t - j] - r);
+        for j in 0..nb {
+            acc += tb[j] * (ub[nb - 1 - j] - r);
         }
         *v = acc + c;
     }
@@ -179,7 +213,7 @@ pub(crate) fn predict(
     for h in 0..out.len() {
         // the oldest terms first: the newest prediction enters last
         let mut v = out[h];
-        for a in (2..=o.na).rev() {
+        for a in (2..=na1 + 1).rev() {
             v -= ta[a - 2] * past[na + h - a];
         }
         let d = v + prev * keep;
@@ -242,7 +276,7 @@ mod tests {
         let (u, y) = system(200, 0.0);
         let mut out = [0.0; 10];
         let mut past = [0.0; 12];
-        predict(&o, &theta, 0.0, &y, &u, 150, &mut past, &mut out);
+        predict(o, &theta, 0.0, &y, &u, 150, &mut past, &mut out);
         let mut reference = [0.0; 10];
         let mut past2 = [0.0; 12];
         predict_k_step(
@@ -283,8 +317,8 @@ mod tests {
             }
         }
         let (mut a, mut b) = ([0.0; 10], [0.0; 10]);
-        predict(&o, &theta, 0.0, &y0, &u0, 80, &mut [0.0; 13], &mut a);
-        predict(&o, &theta, 0.0, &y1, &u1, 80, &mut [0.0; 13], &mut b);
+        predict(o, &theta, 0.0, &y0, &u0, 80, &mut [0.0; 13], &mut a);
+        predict(o, &theta, 0.0, &y1, &u1, 80, &mut [0.0; 13], &mut b);
         for (a, b) in a.iter().zip(&b) {
             assert!((a + shift - b).abs() < 1e-12);
         }
@@ -295,7 +329,7 @@ mod tests {
         let o = ArxOrders::new(2, 3, 0);
         let (u, y) = system(50, 0.0);
         let mut out = [0.0; 5];
-        predict(&o, &[0.0; 4], 0.0, &y, &u, 40, &mut [0.0; 7], &mut out);
+        predict(o, &[0.0; 4], 0.0, &y, &u, 40, &mut [0.0; 7], &mut out);
         assert!(out.iter().all(|&v| v == y[39]));
     }
 }

@@ -115,7 +115,7 @@ pub enum Error {
     },
 
     /// Sampling interval deviates from the nominal one by more than the tolerance.
-    #[error("sampling jitter at sample {index}: interval {interval} s vs nominal {nominal} s ({relative_percent:.3} % > tolerance {tolerance_percent} %)")]
+    #[error("sampling jitter at sample {index}: interval {interval} s vs nominal {nominal} s ({relative_percent:.3} % > tolerance {tolerance_percent} %){}", missing_note(*.missing))]
     SamplingJitter {
         /// Zero-based index of the sample ending the offending interval.
         index: usize,
@@ -127,6 +127,9 @@ pub enum Error {
         relative_percent: f64,
         /// Allowed deviation \[%\].
         tolerance_percent: f64,
+        /// Whole samples that look missing there (the interval is close to
+        /// `missing + 1` nominal intervals; 0 otherwise).
+        missing: usize,
     },
 
     // ------------------------------------------------------------------- I/O
@@ -366,6 +369,20 @@ fn display_path(path: &Option<PathBuf>) -> String {
     match path {
         Some(p) => p.display().to_string(),
         None => "parameters".to_string(),
+    }
+}
+
+/// The note of [`Error::SamplingJitter`] on samples that look dropped.
+fn missing_note(missing: usize) -> String {
+    match missing {
+        0 => String::new(),
+        m => format!(
+            "; the interval spans {} sampling intervals: {m} sample{} missing (dropped by the \
+             acquisition?); the sliding engine needs uniform sampling — cut the recording \
+             there, or stream it (`feedid stream`), which restarts its windows at a gap",
+            m + 1,
+            if m == 1 { " looks" } else { "s look" }
+        ),
     }
 }
 

@@ -360,12 +360,26 @@ fn check(
         }
     }
     if max_jitter > jitter_tolerance {
+        let interval = time[worst] - time[worst - 1];
+        // a whole number of typical (median) intervals, within a quarter:
+        // samples dropped (the mean is stretched by the gaps themselves)
+        let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+        let mid = steps.len() / 2;
+        let (_, median, _) = steps.select_nth_unstable_by(mid, f64::total_cmp);
+        let ratio = interval / *median;
+        let whole = ratio.round();
+        let missing = if whole >= 2.0 && (ratio - whole).abs() <= 0.25 {
+            whole as usize - 1
+        } else {
+            0
+        };
         return Err(Error::SamplingJitter {
             index: worst,
-            interval: time[worst] - time[worst - 1],
+            interval,
             nominal: dt,
             relative_percent: 100.0 * max_jitter,
             tolerance_percent: 100.0 * jitter_tolerance,
+            missing,
         });
     }
     Ok((dt, max_jitter))
@@ -488,6 +502,37 @@ mod tests {
                 assert!((relative_percent - 10.0).abs() < 1e-6)
             }
             other => panic!("unexpected {other}"),
+        }
+    }
+
+    #[test]
+    fn dropped_samples_are_named_in_the_jitter_error() {
+        // 40 samples at 1 ms with `drop` consecutive ones missing after sample 20
+        for (drop, missing) in [(1, 1), (3, 3), (0, 0)] {
+            let mut tt: Vec<f64> = (0..40)
+                .filter(|&k| !(21..21 + drop).contains(&k))
+                .map(|k| k as f64 * 1e-3)
+                .collect();
+            if drop == 0 {
+                tt[21] += 0.4e-3; // 40 % jitter: not a whole interval
+            }
+            let n = tt.len();
+            let e = Recording::new(tt, vec![0.0; n], vec![0.0; n]).unwrap_err();
+            match &e {
+                Error::SamplingJitter {
+                    index, missing: m, ..
+                } => {
+                    assert_eq!(*m, missing, "{e}");
+                    // (the jittered sample makes two intervals 40 % off)
+                    assert!(*index == 21 || drop == 0, "{e}");
+                }
+                other => panic!("unexpected {other}"),
+            }
+            let text = e.to_string();
+            assert_eq!(text.contains("feedid stream"), missing > 0, "{text}");
+            if missing == 1 {
+                assert!(text.contains("1 sample looks missing"), "{text}");
+            }
         }
     }
 

@@ -16,7 +16,9 @@
 //! gain, W rows); `#` starts a comment. The CSV has per member and
 //! configuration the rms over the predicted samples, the coverage, the rms
 //! of the configuration and of `arx220` on the samples both predict, and
-//! the largest ratio to a baseline (command, hold, arx220).
+//! the largest ratio to a baseline (command, hold, arx220). `oe` takes
+//! `poles=`, `zeros=`, `prior=` (the sliding prior's weight) and `iters=`
+//! (LM iterations per window).
 //!
 //! Environment: `ZOO_SWEEP_PHASE=P` starts the baselines' blocks `P`
 //! samples later (as `zoo_bench --baseline-phase`); `ZOO_SWEEP_WHO=1`
@@ -95,6 +97,12 @@ fn parse(cfg: &str) -> Result<(Method, usize), String> {
                 (Method::Auto(c), "mem") => c.memory = f()?,
                 (Method::Auto(c), "plaus") => c.plausibility = f()?,
                 (Method::Auto(c), "cons") => c.consensus = f()?,
+                (Method::Oe(c), "poles") => c.poles = v.parse().map_err(|e| format!("{e}"))?,
+                (Method::Oe(c), "zeros") => c.zeros = v.parse().map_err(|e| format!("{e}"))?,
+                (Method::Oe(c), "prior") => c.prior_weight = f()?,
+                (Method::Oe(c), "iters") => {
+                    c.window_iterations = v.parse().map_err(|e| format!("{e}"))?
+                }
                 (Method::Rls(c), "radius") => c.max_pole_radius = f()?,
                 (Method::Rls(c), "win") => c.window = Some(v.parse().unwrap()),
                 _ => return Err(format!("unknown {k} for {name}")),

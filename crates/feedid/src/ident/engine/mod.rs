@@ -8,6 +8,8 @@ mod guard;
 mod signals;
 mod sliding;
 pub mod stream;
+#[cfg(test)]
+mod test_estimators;
 
 pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
 pub use guard::{Guard, GuardConfig, MIN_HISTORY};

@@ -469,6 +469,7 @@ fn finite_or_zero(v: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ident::engine::test_estimators::Wild;
     use crate::ident::WindowFit;
     use crate::solve::Termination;
 
@@ -541,43 +542,6 @@ mod tests {
         }
     }
 
-    /// Holds the last position, except on window `wild` (counted from 1),
-    /// where it predicts `jump` away; counts its restarts.
-    struct Wild {
-        k: usize,
-        wild: usize,
-        jump: f64,
-        restarts: usize,
-    }
-
-    impl Estimator for Wild {
-        fn name(&self) -> &'static str {
-            "wild"
-        }
-        fn coefficient_names(&self) -> Vec<String> {
-            vec![]
-        }
-        fn restart(&mut self) {
-            self.restarts += 1;
-        }
-        fn fit(&mut self, _: &Signals<'_>, _: Range<usize>, _: &mut [f64]) -> Result<WindowFit> {
-            self.k += 1;
-            Ok(WindowFit::identified(0.0, 0, Termination::Exact))
-        }
-        fn predict(
-            &mut self,
-            s: &Signals<'_>,
-            w: Range<usize>,
-            _: Range<usize>,
-            out: &mut [f64],
-        ) -> Result<PredictStatus> {
-            let last = s.window(w.end - 1..w.end, 0, "test").unwrap().position[0];
-            let jump = if self.k == self.wild { self.jump } else { 0.0 };
-            out.fill(last + jump);
-            Ok(PredictStatus::Predicted)
-        }
-    }
-
     #[test]
     fn a_prediction_far_beyond_the_recordings_motion_is_withheld_and_the_method_restarts() {
         // a ramp of 10 µm per sample: a window of 20 spans 190 µm, the
@@ -593,12 +557,7 @@ mod tests {
         };
         for (jump, withheld) in [(4.0 * 290e-6 * 1.01, true), (4.0 * 290e-6 * 0.99, false)] {
             for sign in [1.0, -1.0] {
-                let mut est = Wild {
-                    k: 0,
-                    wild: 5,
-                    jump: sign * jump,
-                    restarts: 0,
-                };
+                let mut est = Wild::new(5, sign * jump);
                 let r = run(&mut est, &s, &cfg).unwrap();
                 assert_eq!(r.withheld_windows(), usize::from(withheld), "{jump}");
                 assert_eq!(est.restarts, usize::from(withheld));
@@ -610,12 +569,7 @@ mod tests {
             }
         }
         // the bound disabled: every prediction is kept
-        let mut est = Wild {
-            k: 0,
-            wild: 5,
-            jump: 1.0,
-            restarts: 0,
-        };
+        let mut est = Wild::new(5, 1.0);
         let guard = GuardConfig {
             plausibility: None,
             ..GuardConfig::default()
@@ -631,12 +585,7 @@ mod tests {
         let (t, _) = ramp(100);
         let y = vec![0.5; 100];
         let s = Signals::new(&t, &y, &y, 2e-4, 0.0);
-        let mut est = Wild {
-            k: 0,
-            wild: 3,
-            jump: 1e-3,
-            restarts: 0,
-        };
+        let mut est = Wild::new(3, 1e-3);
         let r = run(&mut est, &s, &EngineConfig::default()).unwrap();
         assert_eq!((r.withheld_windows(), est.restarts), (0, 0));
     }

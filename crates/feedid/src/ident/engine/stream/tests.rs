@@ -8,6 +8,7 @@ use std::ops::Range;
 use super::*;
 use crate::drive::{RigParams, VirtualRig};
 use crate::error::{Error, Result};
+use crate::ident::engine::test_estimators::Wild;
 use crate::ident::engine::{run, EngineConfig, SlidingResult};
 use crate::ident::{
     Estimator, PaperConfig, PaperMethod, PredictStatus, Signals, Solver, WindowFit, WindowOutcome,
@@ -1029,52 +1030,11 @@ fn boxed_estimators_stream_like_concrete_ones() {
     assert_eq!(a.stats, b.stats);
 }
 
-/// Holds the last position, except on window `wild` (counted from 1), where
-/// it predicts `jump` away.
-struct Wild {
-    k: usize,
-    wild: usize,
-    jump: f64,
-}
-
-impl Estimator for Wild {
-    fn name(&self) -> &'static str {
-        "wild"
-    }
-    fn coefficient_names(&self) -> Vec<String> {
-        vec![]
-    }
-    fn reset(&mut self) {
-        self.k = 0;
-    }
-    fn restart(&mut self) {}
-    fn fit(&mut self, _: &Signals<'_>, _: Range<usize>, _: &mut [f64]) -> Result<WindowFit> {
-        self.k += 1;
-        Ok(WindowFit::identified(0.0, 0, Termination::Exact))
-    }
-    fn predict(
-        &mut self,
-        s: &Signals<'_>,
-        w: Range<usize>,
-        _: Range<usize>,
-        out: &mut [f64],
-    ) -> Result<PredictStatus> {
-        let last = s.window(w.end - 1..w.end, 0, "test").unwrap().position[0];
-        let jump = if self.k == self.wild { self.jump } else { 0.0 };
-        out.fill(last + jump);
-        Ok(PredictStatus::Predicted)
-    }
-}
-
 #[test]
 fn an_implausible_prediction_is_withheld_in_the_stream_as_in_batch() {
     let rec = rig_recording(Scenario::Ramp, 0.08);
     let cfg = configs()[0];
-    let wild = || Wild {
-        k: 0,
-        wild: 12,
-        jump: 1.0,
-    };
+    let wild = || Wild::new(12, 1.0);
     let b = run(&mut wild(), &rec.signals(), &cfg).unwrap();
     assert_eq!(b.withheld_windows(), 1);
     let c = stream(wild(), cfg, &rec, Feed::Lines(0), Wait);

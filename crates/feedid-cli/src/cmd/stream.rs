@@ -300,8 +300,15 @@ fn summary(
         lines.read, lines.headers, lines.skipped, st.samples, st.gaps, st.irregular_intervals
     );
     let predicted = st.windows - st.failed_windows - st.withheld_windows;
+    // (the stream runs with the default plausibility bound)
+    let why = match GuardConfig::default().plausibility {
+        Some(f) if st.withheld_windows > 0 => {
+            format!(" (implausible: beyond {f}× the motion seen; the method restarted)")
+        }
+        _ => String::new(),
+    };
     o += &format!(
-        "windows {}: {predicted} predicted, {} withheld, {} failed; {rows} rows written\n",
+        "windows {}: {predicted} predicted, {} withheld{why}, {} failed; {rows} rows written\n",
         st.windows, st.withheld_windows, st.failed_windows
     );
     o += &format!("command over the horizon: {command}\n");

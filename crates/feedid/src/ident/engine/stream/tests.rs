@@ -8,112 +8,13 @@ use std::ops::Range;
 use super::*;
 use crate::drive::{RigParams, VirtualRig};
 use crate::error::{Error, Result};
-use crate::ident::engine::test_estimators::Wild;
+use crate::ident::engine::test_estimators::{follow, follow7, Linear, Wild};
 use crate::ident::engine::{run, EngineConfig, SlidingResult};
-use crate::ident::{
-    Estimator, PaperConfig, PaperMethod, PredictStatus, Signals, Solver, WindowFit, WindowOutcome,
-};
+use crate::ident::{Estimator, PaperConfig, PaperMethod, Solver, WindowOutcome};
 use crate::recording::MOTION_THRESHOLD;
 use crate::signal::Scenario;
-use crate::solve::Termination;
 use crate::stats::ErrorStats;
 use crate::Recording;
-
-/// Straight line through the last two window samples (window-end estimator).
-struct Linear;
-
-impl Estimator for Linear {
-    fn name(&self) -> &'static str {
-        "linear"
-    }
-    fn coefficient_names(&self) -> Vec<String> {
-        vec!["last".into(), "slope".into()]
-    }
-    fn uses_future_command(&self) -> bool {
-        false
-    }
-    fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, c: &mut [f64]) -> Result<WindowFit> {
-        let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
-        c[0] = y[1];
-        c[1] = y[1] - y[0];
-        Ok(WindowFit::identified(0.0, 0, Termination::Exact))
-    }
-    fn predict(
-        &mut self,
-        s: &Signals<'_>,
-        w: Range<usize>,
-        _: Range<usize>,
-        out: &mut [f64],
-    ) -> Result<PredictStatus> {
-        let y = s.window(w.end - 2..w.end, 0, "test").unwrap().position;
-        for (j, o) in out.iter_mut().enumerate() {
-            *o = y[1] + (j as f64 + 1.0) * (y[1] - y[0]);
-        }
-        Ok(PredictStatus::Predicted)
-    }
-}
-
-/// Last position plus the command change over the horizon; reads one
-/// sample before the window (warm-up 1) and fails on every `fail`-th window
-/// (never if 0).
-struct Follow {
-    k: usize,
-    fail: usize,
-}
-
-/// `Follow` failing on every 7th window.
-fn follow7() -> Follow {
-    Follow { k: 0, fail: 7 }
-}
-
-/// `Follow` that never fails.
-fn follow() -> Follow {
-    Follow { k: 0, fail: 0 }
-}
-
-impl Estimator for Follow {
-    fn name(&self) -> &'static str {
-        "follow"
-    }
-    fn coefficient_names(&self) -> Vec<String> {
-        vec!["gain".into()]
-    }
-    fn warm_up(&self) -> usize {
-        1
-    }
-    fn reset(&mut self) {
-        self.k = 0;
-    }
-    fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, c: &mut [f64]) -> Result<WindowFit> {
-        self.k += 1;
-        if self.fail > 0 && self.k % self.fail == 0 {
-            return Err(Error::Singular { context: "test" });
-        }
-        let u = s.window(w.start - 1..w.end, 0, "test").unwrap().command;
-        let y = s.window(w.start - 1..w.end, 0, "test").unwrap().position;
-        let du = u[u.len() - 1] - u[0];
-        c[0] = if du != 0.0 {
-            (y[y.len() - 1] - y[0]) / du
-        } else {
-            1.0
-        };
-        Ok(WindowFit::identified(0.0, 0, Termination::Exact))
-    }
-    fn predict(
-        &mut self,
-        s: &Signals<'_>,
-        w: Range<usize>,
-        h: Range<usize>,
-        out: &mut [f64],
-    ) -> Result<PredictStatus> {
-        let y0 = s.window(w.end - 1..w.end, 0, "test").unwrap().position[0];
-        let u0 = s.window(w.end - 1..w.end, 0, "test").unwrap().command[0];
-        for (o, &u) in out.iter_mut().zip(s.window(h, 0, "test").unwrap().command) {
-            *o = y0 + (u - u0);
-        }
-        Ok(PredictStatus::Predicted)
-    }
-}
 
 /// How samples are fed.
 #[derive(Debug, Clone, Copy)]

@@ -16,7 +16,10 @@
 //! gain, W rows); `#` starts a comment. The CSV has per member and
 //! configuration the rms over the predicted samples, the coverage, the rms
 //! of the configuration and of `arx220` on the samples both predict, and
-//! the largest ratio to a baseline (command, hold, arx220). `oe` takes
+//! the largest ratio to a baseline (command, hold, arx220), and the rms
+//! over the samples that every configuration of the file predicts
+//! (`rms_common`, `common_samples`: settings compared on the same
+//! samples). `oe` takes
 //! `poles=`, `zeros=`, `prior=` (the sliding prior's weight) and `iters=`
 //! (LM iterations per window).
 //!
@@ -27,7 +30,7 @@
 //! every member converted to that unit and back (the baselines and the
 //! scores keep the metre values); `ZOO_SWEEP_DUMP=PREFIX` writes
 //! `PREFIX-N.csv` per member (k, u, y, prediction, flag, arx220, chosen
-//! candidate).
+//! candidate, scored flag, arx220 flag).
 
 use std::time::Instant;
 
@@ -291,6 +294,7 @@ fn main() {
             }
             let (bv, bh) = arx220(&m.command, y);
             let mut rows = Vec::new();
+            let mut outs: Vec<(Vec<f64>, Vec<bool>)> = Vec::new();
             for c in &configs {
                 let t = Instant::now();
                 let mut cand = vec![f64::NAN; n];
@@ -324,11 +328,18 @@ fn main() {
                 };
                 let secs = t.elapsed().as_secs_f64();
                 if let Ok(d) = std::env::var("ZOO_SWEEP_DUMP") {
-                    let mut text = String::from("k,u,y,p,has,arx220,cand\n");
+                    let mut text = String::from("k,u,y,p,has,arx220,cand,scored,arxhas\n");
                     for k in 0..n {
                         text += &format!(
-                            "{k},{},{},{},{},{},{}\n",
-                            m.command[k], y[k], p[k], has[k] as u8, bv[k], cand[k]
+                            "{k},{},{},{},{},{},{},{},{}\n",
+                            m.command[k],
+                            y[k],
+                            p[k],
+                            has[k] as u8,
+                            bv[k],
+                            cand[k],
+                            scored[k] as u8,
+                            bh[k] as u8
                         );
                     }
                     std::fs::write(format!("{d}-{i}.csv"), text).unwrap();
@@ -403,12 +414,30 @@ fn main() {
                     n,
                     m.spec.plant.name()
                 ));
+                outs.push((p, has));
+            }
+            // every configuration scored on the samples all of them predict
+            let common: Vec<bool> = (0..n)
+                .map(|k| scored[k] && outs.iter().all(|(_, h)| h[k]))
+                .collect();
+            let shared = common.iter().filter(|&&c| c).count();
+            for (row, (p, _)) in rows.iter_mut().zip(&outs) {
+                let se: f64 = (0..n)
+                    .filter(|&k| common[k])
+                    .map(|k| (y[k] - p[k]).powi(2))
+                    .sum();
+                let rms = if shared > 0 {
+                    (se / shared as f64).sqrt()
+                } else {
+                    f64::NAN
+                };
+                *row += &format!(",{rms},{shared}");
             }
             rows
         })
         .collect();
     let mut text =
-        String::from("member,config,rms,coverage,rms_shared_arx220,arx220_rms,n,secs,plant,worst_baseline_ratio\n");
+        String::from("member,config,rms,coverage,rms_shared_arx220,arx220_rms,n,secs,plant,worst_baseline_ratio,rms_common,common_samples\n");
     for r in rows {
         text += &r;
         text += "\n";

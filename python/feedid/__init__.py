@@ -249,7 +249,11 @@ class Identification:
         ``identify`` was given, a checked copy of them)."""
         if self._recording is None:
             self._recording = Recording(
-                self.time, self.command, self.position, jitter_tol=self._jitter_tol
+                self.time,
+                self.command,
+                self.position,
+                jitter_tol=self._jitter_tol,
+                allow_gaps=True,
             )
         return self._recording
 
@@ -324,7 +328,9 @@ def identify(
     ----------
     time : Recording or array_like
         A :class:`Recording`, or the sample times [s] (strictly increasing,
-        uniformly sampled within ``jitter_tol``).
+        uniformly sampled within ``jitter_tol``). Dropped samples (an
+        interval of a whole number of typical ones) are gaps: the windows
+        restart after each, as ``feedid identify`` does (``summary["gaps"]``).
     command, position : array_like
         Position command [m] and measured position [m] (with ``time`` as
         arrays). Contiguous float64 arrays are checked and read in place,

@@ -19,7 +19,11 @@ class Recording:
         position: npt.NDArray[np.float64],
         *,
         jitter_tol: float = 0.01,
+        allow_gaps: bool = False,
     ) -> None: ...
+    @property
+    def gaps(self) -> List[Tuple[int, int]]:
+        """Gaps of dropped samples as (index of the first sample after it, samples missing)."""
     @property
     def time(self) -> npt.NDArray[np.float64]:
         """Sample times [s] (read-only view)."""

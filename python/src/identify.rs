@@ -99,7 +99,8 @@ pub fn identify<'py>(
                 slice(&y, "position")?,
             );
             py.detach(|| {
-                let rec = RecordingRef::borrowed(t, u, y, jitter_tol)?;
+                // dropped samples are gaps, as for `feedid identify`
+                let rec = RecordingRef::borrowed_allowing_gaps(t, u, y, jitter_tol)?;
                 pipeline.run(&rec)
             })
         }

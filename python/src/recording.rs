@@ -43,15 +43,18 @@ pub fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [
 #[pymethods]
 impl PyRecording {
     /// Check and store time [s], command [m] and measured position [m]
-    /// (copied once into the library's recording).
+    /// (copied once into the library's recording); `allow_gaps` accepts
+    /// dropped samples (an interval of a whole number ≥ 2 of typical ones)
+    /// as gaps between segments.
     #[new]
-    #[pyo3(signature = (time, command, position, *, jitter_tol = 0.01))]
+    #[pyo3(signature = (time, command, position, *, jitter_tol = 0.01, allow_gaps = false))]
     fn new(
         py: Python<'_>,
         time: PyReadonlyArray1<'_, f64>,
         command: PyReadonlyArray1<'_, f64>,
         position: PyReadonlyArray1<'_, f64>,
         jitter_tol: f64,
+        allow_gaps: bool,
     ) -> PyResult<Self> {
         let (t, u, y) = (
             slice(&time, "time")?,
@@ -59,9 +62,27 @@ impl PyRecording {
             slice(&position, "position")?,
         );
         let inner = py
-            .detach(|| Recording::with_tolerance(t.to_vec(), u.to_vec(), y.to_vec(), jitter_tol))
+            .detach(|| {
+                let (t, u, y) = (t.to_vec(), u.to_vec(), y.to_vec());
+                if allow_gaps {
+                    Recording::allowing_gaps(t, u, y, jitter_tol)
+                } else {
+                    Recording::with_tolerance(t, u, y, jitter_tol)
+                }
+            })
             .py_err()?;
         Ok(Self { inner })
+    }
+
+    /// Gaps of dropped samples as `(index, missing)`: the first sample after
+    /// each gap and how many samples look missing there (empty without).
+    #[getter]
+    fn gaps(&self) -> Vec<(usize, usize)> {
+        self.inner
+            .gaps()
+            .iter()
+            .map(|g| (g.index, g.missing))
+            .collect()
     }
 
     /// Sample times [s] (read-only view).
@@ -191,6 +212,7 @@ pub fn read(
         jitter_tolerance: jitter_tol,
         // the Python recording exposes the extra channels
         signals_only: false,
+        allow_gaps: false,
     };
     opts.validate().py_err()?;
     let path = std::path::PathBuf::from(path);

@@ -71,6 +71,21 @@ def test_recording_arrays_are_read_only_views_and_identify_reads_them_in_place()
     assert run.summary["samples"] == 1000
 
 
+def test_dropped_samples_are_gaps_as_in_the_cli():
+    rec = feedid.simulate("ramp", seed=1)
+    keep = np.ones(len(rec), dtype=bool)
+    keep[300:303] = False
+    t, u, y = (np.array(v)[keep] for v in (rec.time, rec.command, rec.position))
+    run = feedid.identify(t, u, y, method="arx")
+    assert (run.summary["gaps"], run.summary["missing_samples"]) == (1, 3)
+    assert any("missing in 1 gap" in w for w in run.summary["warnings"])
+    # no prediction reaches across the gap: the windows restart after it
+    assert np.all(np.isnan(run.predicted[300:310]))
+    assert run.recording.gaps == [(300, 3)]
+    with pytest.raises(ValueError, match="3 samples look missing"):
+        feedid.Recording(t, u, y)
+
+
 def test_identification_has_its_arrays_and_frames():
     pd = pytest.importorskip("pandas")
     rec = feedid.simulate("multisine", seed=2)

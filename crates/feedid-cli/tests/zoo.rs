@@ -73,7 +73,7 @@ fn zoo_members_are_files_identify_reads_with_no_options() {
 }
 
 #[test]
-fn a_member_with_dropped_rows_is_written_marked_and_refused_by_identify() {
+fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("gaps");
     let o = feedid(&["zoo", "--out", out.to_str().unwrap(), "--members", "215"]);
@@ -81,12 +81,40 @@ fn a_member_with_dropped_rows_is_written_marked_and_refused_by_identify() {
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(v[0]["readable"], false);
-    assert!(!v[0]["dropped_rows"].as_array().unwrap().is_empty());
+    let dropped = v[0]["dropped_rows"].as_array().unwrap().len();
+    assert!(dropped > 0);
     let f = out.join("zoo-215.csv");
-    let p = dir.path().join("p.csv");
-    let o = feedid(&["identify", f.to_str().unwrap(), "-o", p.to_str().unwrap()]);
-    assert_fails(&o, &["zoo-215.csv"]);
-    assert!(!p.exists());
+    let (p, s) = (dir.path().join("p.csv"), dir.path().join("s.json"));
+    let o = feedid(&[
+        "identify",
+        f.to_str().unwrap(),
+        "-o",
+        p.to_str().unwrap(),
+        "--summary",
+        s.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // the warning names the gaps and what they cost
+    let err = stderr(&o);
+    assert!(
+        err.contains("missing in 2 gaps") && err.contains("restarted"),
+        "{err}"
+    );
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&s).unwrap()).unwrap();
+    assert_eq!(j["gaps"].as_u64(), Some(2));
+    assert_eq!(j["missing_samples"].as_u64(), Some(dropped as u64));
+    let samples = j["samples"].as_u64().unwrap() as usize;
+    // one row per measured sample; none predicted across a gap's first window
+    let rows = std::fs::read_to_string(&p).unwrap().lines().count() - 1;
+    assert_eq!(rows, samples);
+    assert!(j["coverage_percent"].as_f64().unwrap() > 80.0, "{j}");
+    // `info` names the gaps; a command that needs uniform sampling refuses
+    // the file and says where to go
+    let o = feedid(&["info", f.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("gaps        2"), "{}", stdout(&o));
+    let o = feedid(&["order", f.to_str().unwrap()]);
+    assert_fails(&o, &["zoo-215.csv", "missing", "`feedid identify`"]);
 }
 
 #[test]

@@ -378,8 +378,8 @@ fn missing_note(missing: usize) -> String {
         0 => String::new(),
         m => format!(
             "; the interval spans {} sampling intervals: {m} sample{} missing (dropped by the \
-             acquisition?); the sliding engine needs uniform sampling — cut the recording \
-             there, or stream it (`feedid stream`), which restarts its windows at a gap",
+             acquisition?); this needs uniform sampling — cut the recording there; `feedid \
+             identify` and `feedid stream` restart their windows at such a gap",
             m + 1,
             if m == 1 { " looks" } else { "s look" }
         ),

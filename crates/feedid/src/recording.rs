@@ -8,6 +8,19 @@
 //! uniform sampling — every interval within `jitter_tolerance` (relative) of
 //! the mean interval. Nothing is dropped or reordered.
 //!
+//! **Dropped samples.** A recording built with gaps allowed
+//! ([`Recording::allowing_gaps`], [`RecordingRef::borrowed_allowing_gaps`];
+//! the reader's [`crate::io::ReadOptions::allow_gaps`], which `feedid
+//! identify` sets) accepts an interval that spans a whole number `m + 1 ≥ 2`
+//! of typical (median) intervals, within a quarter of one: `m` samples
+//! missing, dropped by the acquisition. The sample after it starts a new
+//! *segment* ([`Recording::gaps`]); the sliding engine restarts its windows
+//! there, as `feedid stream` does, instead of pairing samples that are not
+//! consecutive. The nominal interval is then the mean of the intervals
+//! within the segments, and every one of them must still lie within the
+//! jitter tolerance of it. Without gaps allowed, such an interval is a
+//! [`Error::SamplingJitter`] that names the missing samples.
+//!
 //! ```
 //! use feedid::Recording;
 //! let t: Vec<f64> = (0..5).map(|k| k as f64 * 2e-4).collect();
@@ -45,6 +58,17 @@ pub struct Recording<S = Vec<f64>> {
     dt: f64,
     max_jitter: f64,
     notes: Vec<String>,
+    gaps: Vec<Gap>,
+}
+
+/// Samples missing before sample `index` of a recording (see the module
+/// doc, *Dropped samples*).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Gap {
+    /// Zero-based index of the first sample after the gap (it starts a new segment).
+    pub index: usize,
+    /// Whole samples that look missing (the interval spans `missing + 1` typical ones).
+    pub missing: usize,
 }
 
 impl Recording {
@@ -73,7 +97,30 @@ impl Recording {
         position: Vec<f64>,
         jitter_tolerance: f64,
     ) -> Result<Self> {
-        Self::checked(time, command, position, jitter_tolerance)
+        Self::checked(time, command, position, jitter_tolerance, false)
+    }
+
+    /// Build with the jitter tolerance `jitter_tolerance`, accepting dropped
+    /// samples as gaps between segments (see the module doc).
+    ///
+    /// ```
+    /// use feedid::Recording;
+    /// // 1 kHz with sample 3 missing
+    /// let t = vec![0.0, 1e-3, 2e-3, 4e-3, 5e-3, 6e-3];
+    /// let r = Recording::allowing_gaps(t.clone(), vec![0.0; 6], vec![0.0; 6], 0.01).unwrap();
+    /// assert_eq!(r.gaps()[0].index, 3);
+    /// assert_eq!(r.gaps()[0].missing, 1);
+    /// assert!((r.dt() - 1e-3).abs() < 1e-12);
+    /// assert_eq!(r.segments(), vec![0..3, 3..6]);
+    /// assert!(Recording::new(t, vec![0.0; 6], vec![0.0; 6]).is_err());
+    /// ```
+    pub fn allowing_gaps(
+        time: Vec<f64>,
+        command: Vec<f64>,
+        position: Vec<f64>,
+        jitter_tolerance: f64,
+    ) -> Result<Self> {
+        Self::checked(time, command, position, jitter_tolerance, true)
     }
 }
 
@@ -100,18 +147,36 @@ impl<'a> Recording<&'a [f64]> {
         position: &'a [f64],
         jitter_tolerance: f64,
     ) -> Result<Self> {
-        Self::checked(time, command, position, jitter_tolerance)
+        Self::checked(time, command, position, jitter_tolerance, false)
+    }
+
+    /// [`RecordingRef::borrowed`], accepting dropped samples as gaps
+    /// (see [`Recording::allowing_gaps`]).
+    pub fn borrowed_allowing_gaps(
+        time: &'a [f64],
+        command: &'a [f64],
+        position: &'a [f64],
+        jitter_tolerance: f64,
+    ) -> Result<Self> {
+        Self::checked(time, command, position, jitter_tolerance, true)
     }
 }
 
 impl<S: AsRef<[f64]>> Recording<S> {
     /// Check the signals (see the module docs) and wrap them, owned or borrowed.
-    fn checked(time: S, command: S, position: S, jitter_tolerance: f64) -> Result<Self> {
-        let (dt, max_jitter) = check(
+    fn checked(
+        time: S,
+        command: S,
+        position: S,
+        jitter_tolerance: f64,
+        allow_gaps: bool,
+    ) -> Result<Self> {
+        let (dt, max_jitter, gaps) = check(
             time.as_ref(),
             command.as_ref(),
             position.as_ref(),
             jitter_tolerance,
+            allow_gaps,
         )?;
         Ok(Self {
             time,
@@ -121,6 +186,7 @@ impl<S: AsRef<[f64]>> Recording<S> {
             dt,
             max_jitter,
             notes: Vec::new(),
+            gaps,
         })
     }
 
@@ -153,15 +219,80 @@ impl<S: AsRef<[f64]>> Recording<S> {
     /// The first `n` samples (all of them if `n` is larger) as a recording
     /// of its own, without the further channels; the sampling was checked
     /// when this recording was built, so no jitter tolerance applies again.
-    /// Errors: `n < 2`.
+    /// Its gaps before sample `n` are kept. Errors: `n < 2`.
     pub fn head(&self, n: usize) -> Result<Recording> {
         let n = n.min(self.len());
-        Recording::with_tolerance(
+        let mut head = Recording::with_tolerance(
             self.time()[..n].to_vec(),
             self.command()[..n].to_vec(),
             self.position()[..n].to_vec(),
             f64::INFINITY,
-        )
+        )?;
+        head.gaps = self.gaps.iter().copied().filter(|g| g.index < n).collect();
+        if !head.gaps.is_empty() {
+            head.dt = self.dt;
+            head.max_jitter = self.max_jitter;
+        }
+        Ok(head)
+    }
+
+    /// Samples `range` (clamped to the recording) as a recording of its own,
+    /// without the further channels, with the nominal interval of this one
+    /// (one segment between gaps is a regular recording). Errors: fewer than
+    /// 2 samples.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> Result<Recording> {
+        let end = range.end.min(self.len());
+        let start = range.start.min(end);
+        let mut part = Recording::with_tolerance(
+            self.time()[start..end].to_vec(),
+            self.command()[start..end].to_vec(),
+            self.position()[start..end].to_vec(),
+            f64::INFINITY,
+        )?;
+        part.gaps = self
+            .gaps
+            .iter()
+            .filter(|g| g.index > start && g.index < end)
+            .map(|g| Gap {
+                index: g.index - start,
+                missing: g.missing,
+            })
+            .collect();
+        if !part.gaps.is_empty() {
+            part.dt = self.dt;
+        }
+        Ok(part)
+    }
+
+    /// The gaps (dropped samples) between segments, ascending; empty for a
+    /// regular recording (see the module doc).
+    pub fn gaps(&self) -> &[Gap] {
+        &self.gaps
+    }
+
+    /// The index of the first sample of every segment after the first
+    /// (the gaps' `index`), ascending.
+    pub fn gap_starts(&self) -> impl Iterator<Item = usize> + '_ {
+        self.gaps.iter().map(|g| g.index)
+    }
+
+    /// Samples that look missing in all gaps.
+    pub fn missing_samples(&self) -> usize {
+        self.gaps.iter().map(|g| g.missing).sum()
+    }
+
+    /// The segments between gaps as sample ranges (one range, the whole
+    /// recording, without gaps).
+    pub fn segments(&self) -> Vec<std::ops::Range<usize>> {
+        segments(self.len(), self.gap_starts())
+    }
+
+    /// The longest segment (the first of equal ones).
+    pub fn longest_segment(&self) -> std::ops::Range<usize> {
+        self.segments()
+            .into_iter()
+            .reduce(|a, b| if b.len() > a.len() { b } else { a })
+            .unwrap_or(0..0)
     }
 
     /// Number of samples.
@@ -301,14 +432,16 @@ pub struct MotionSegment {
 /// Command change that counts as motion \[m\] (1 nm).
 pub const MOTION_THRESHOLD: f64 = 1e-9;
 
-/// The checks of a recording (see the module docs); returns the mean
-/// interval \[s\] and the largest relative interval deviation.
+/// The checks of a recording (see the module docs); returns the nominal
+/// interval \[s\], the largest relative interval deviation and, with
+/// `allow_gaps`, the gaps (dropped samples).
 fn check(
     time: &[f64],
     command: &[f64],
     position: &[f64],
     jitter_tolerance: f64,
-) -> Result<(f64, f64)> {
+    allow_gaps: bool,
+) -> Result<(f64, f64, Vec<Gap>)> {
     if command.len() != time.len() {
         return Err(Error::LengthMismatch {
             what: "command vs time",
@@ -350,39 +483,96 @@ fn check(
             max_rate: 1.0 / MIN_INTERVAL,
         });
     }
-    let mut max_jitter = 0.0_f64;
-    let mut worst = 0;
+    let (worst, max_jitter) = largest_deviation(time, dt, &[]);
+    if max_jitter <= jitter_tolerance {
+        return Ok((dt, max_jitter, Vec::new()));
+    }
+    // a whole number of typical (median) intervals, within a quarter:
+    // samples dropped (the mean is stretched by the gaps themselves)
+    let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = steps.len() / 2;
+    let (_, median, _) = steps.select_nth_unstable_by(mid, f64::total_cmp);
+    let median = *median;
+    let missing_at = |k: usize| {
+        let ratio = (time[k] - time[k - 1]) / median;
+        let whole = ratio.round();
+        if whole >= 2.0 && (ratio - whole).abs() <= 0.25 {
+            whole as usize - 1
+        } else {
+            0
+        }
+    };
+    let jitter_error = |worst: usize, dt: f64, max_jitter: f64| Error::SamplingJitter {
+        index: worst,
+        interval: time[worst] - time[worst - 1],
+        nominal: dt,
+        relative_percent: 100.0 * max_jitter,
+        tolerance_percent: 100.0 * jitter_tolerance,
+        missing: missing_at(worst),
+    };
+    if !allow_gaps {
+        return Err(jitter_error(worst, dt, max_jitter));
+    }
+    let gaps: Vec<Gap> = (1..time.len())
+        .filter_map(|k| {
+            let missing = missing_at(k);
+            (missing > 0).then_some(Gap { index: k, missing })
+        })
+        .collect();
+    // the nominal interval within the segments (each is uniformly sampled)
+    let (mut span, mut intervals) = (0.0, 0usize);
+    for r in segments(time.len(), gaps.iter().map(|g| g.index)) {
+        if r.len() >= 2 {
+            span += time[r.end - 1] - time[r.start];
+            intervals += r.len() - 1;
+        }
+    }
+    if intervals == 0 {
+        return Err(jitter_error(worst, dt, max_jitter));
+    }
+    let dt = span / intervals as f64;
+    let (worst, max_jitter) = largest_deviation(time, dt, &gaps);
+    if max_jitter > jitter_tolerance {
+        return Err(jitter_error(worst, dt, max_jitter));
+    }
+    Ok((dt, max_jitter, gaps))
+}
+
+/// The interval (by the index of the sample ending it) that deviates most
+/// from `dt`, and its relative deviation; the intervals ending at a gap's
+/// sample are skipped.
+fn largest_deviation(time: &[f64], dt: f64, gaps: &[Gap]) -> (usize, f64) {
+    let mut next_gap = gaps.iter().map(|g| g.index).peekable();
+    let (mut worst, mut max_jitter) = (1, 0.0_f64);
     for k in 1..time.len() {
+        if next_gap.peek() == Some(&k) {
+            next_gap.next();
+            continue;
+        }
         let rel = ((time[k] - time[k - 1]) - dt).abs() / dt;
         if rel > max_jitter {
             max_jitter = rel;
             worst = k;
         }
     }
-    if max_jitter > jitter_tolerance {
-        let interval = time[worst] - time[worst - 1];
-        // a whole number of typical (median) intervals, within a quarter:
-        // samples dropped (the mean is stretched by the gaps themselves)
-        let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
-        let mid = steps.len() / 2;
-        let (_, median, _) = steps.select_nth_unstable_by(mid, f64::total_cmp);
-        let ratio = interval / *median;
-        let whole = ratio.round();
-        let missing = if whole >= 2.0 && (ratio - whole).abs() <= 0.25 {
-            whole as usize - 1
-        } else {
-            0
-        };
-        return Err(Error::SamplingJitter {
-            index: worst,
-            interval,
-            nominal: dt,
-            relative_percent: 100.0 * max_jitter,
-            tolerance_percent: 100.0 * jitter_tolerance,
-            missing,
-        });
+    (worst, max_jitter)
+}
+
+/// The segments of `n` samples split before each of `starts` (ascending
+/// indices in `1..n`; others are ignored): `0..s₁, s₁..s₂, …, sₘ..n`.
+pub fn segments(n: usize, starts: impl Iterator<Item = usize>) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::new();
+    let mut from = 0;
+    for s in starts {
+        if s > from && s < n {
+            out.push(from..s);
+            from = s;
+        }
     }
-    Ok((dt, max_jitter))
+    if from < n {
+        out.push(from..n);
+    }
+    out
 }
 
 fn check_finite(channel: &str, v: &[f64]) -> Result<()> {
@@ -534,6 +724,57 @@ mod tests {
                 assert!(text.contains("1 sample looks missing"), "{text}");
             }
         }
+    }
+
+    #[test]
+    fn dropped_samples_are_gaps_between_segments_when_allowed() {
+        // 60 samples at 1 ms from t = 5 s; sample 21 and samples 40..43 missing
+        let tt: Vec<f64> = (0..60)
+            .filter(|&k| k != 21 && !(40..43).contains(&k))
+            .map(|k| 5.0 + k as f64 * 1e-3)
+            .collect();
+        let n = tt.len();
+        let u: Vec<f64> = (0..n).map(|k| k as f64 * 1e-6).collect();
+        let r = Recording::allowing_gaps(tt.clone(), u.clone(), u.clone(), 0.01).unwrap();
+        let g: Vec<(usize, usize)> = r.gaps().iter().map(|g| (g.index, g.missing)).collect();
+        assert_eq!(g, [(21, 1), (39, 3)]);
+        assert_eq!(r.missing_samples(), 4);
+        assert_eq!(r.segments(), vec![0..21, 21..39, 39..n]);
+        assert_eq!(r.longest_segment(), 0..21);
+        // the nominal interval is that of the segments, not stretched by the gaps
+        assert!((r.dt() - 1e-3).abs() < 1e-12, "{}", r.dt());
+        assert!(r.max_jitter() < 1e-9);
+        // borrowed alike; head and slice keep the gaps they contain
+        let b = RecordingRef::borrowed_allowing_gaps(&tt, &u, &u, 0.01).unwrap();
+        assert_eq!((b.gaps(), b.dt()), (r.gaps(), r.dt()));
+        assert_eq!(r.head(30).unwrap().gaps(), &r.gaps()[..1]);
+        let s = r.slice(10..45).unwrap();
+        let g: Vec<(usize, usize)> = s.gaps().iter().map(|g| (g.index, g.missing)).collect();
+        assert_eq!(g, [(11, 1), (29, 3)]);
+        assert_eq!(r.slice(21..39).unwrap().gaps(), &[]);
+        // without gaps allowed: the jitter error names the missing sample
+        let e = Recording::new(tt.clone(), u.clone(), u.clone()).unwrap_err();
+        assert!(
+            matches!(e, Error::SamplingJitter { missing: 1 | 3, .. }),
+            "{e}"
+        );
+        // an interval that is not a whole number of intervals stays an error,
+        // and so does jitter within a segment
+        for (k, dt) in [(30, 0.5e-3), (10, 0.05e-3)] {
+            let mut bad = tt.clone();
+            for v in &mut bad[k..] {
+                *v += dt;
+            }
+            let e = Recording::allowing_gaps(bad, u.clone(), u.clone(), 0.01).unwrap_err();
+            assert!(
+                matches!(e, Error::SamplingJitter { index, missing: 0, .. } if index == k),
+                "{e}"
+            );
+        }
+        // a regular recording has one segment and no gaps
+        let r = Recording::allowing_gaps(t(10), vec![0.0; 10], vec![0.0; 10], 0.01).unwrap();
+        assert!(r.gaps().is_empty());
+        assert_eq!(r.segments(), vec![0..10]);
     }
 
     #[test]

@@ -44,15 +44,18 @@ pub fn read_options(a: &RecordingArgs) -> Result<ReadOptions> {
         time_unit: a.time_unit.parse()?,
         jitter_tolerance: a.jitter_tol,
         signals_only: false,
+        allow_gaps: false,
     };
     opts.validate()?;
     Ok(opts)
 }
 
 /// Read and check the time, command and position only (no extra channels:
-/// three `f64` per sample in memory), reporting `progress(bytes read, file size)`,
-/// without printing its plausibility warnings (for commands whose library
-/// call reports them, as the pipeline does).
+/// three `f64` per sample in memory), dropped samples accepted as gaps
+/// (the sliding engine restarts its windows after each), reporting
+/// `progress(bytes read, file size)`, without printing its plausibility
+/// warnings (for commands whose library call reports them, as the pipeline
+/// does).
 pub fn read_signals(
     path: &Path,
     a: &RecordingArgs,
@@ -60,6 +63,7 @@ pub fn read_signals(
 ) -> Result<Recording> {
     let opts = ReadOptions {
         signals_only: true,
+        allow_gaps: true,
         ..read_options(a)?
     };
     Ok(read_recording_with_progress(path, &opts, Some(progress))?)
@@ -68,6 +72,20 @@ pub fn read_signals(
 /// Read and check a recording; its plausibility warnings go to standard error.
 pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
     Ok(load_checked(path, a)?.0)
+}
+
+/// [`load`], with dropped samples accepted as gaps (for a description of
+/// the recording, which names them).
+pub fn load_allowing_gaps(path: &Path, a: &RecordingArgs) -> Result<Recording> {
+    let opts = ReadOptions {
+        allow_gaps: true,
+        ..read_options(a)?
+    };
+    let rec = read_recording(path, &opts)?;
+    for w in check_recording(&rec) {
+        eprintln!("warning: {}: {}", path.display(), w.message);
+    }
+    Ok(rec)
 }
 
 /// Read and check a recording; its plausibility warnings

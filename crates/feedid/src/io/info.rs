@@ -33,7 +33,7 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::plausibility::check_recording;
-use crate::recording::{MotionSegment, Recording, MOTION_THRESHOLD};
+use crate::recording::{Gap, MotionSegment, Recording, MOTION_THRESHOLD};
 
 /// Motion threshold per step, relative to the command range.
 pub const SEGMENT_STEP_RELATIVE: f64 = 1e-6;
@@ -74,6 +74,11 @@ pub struct RecordingInfo {
     pub jitter_max_relative: f64,
     /// Largest interval deviation \[s\].
     pub jitter_max_abs_s: f64,
+    /// Gaps of dropped samples (read with gaps allowed; empty otherwise):
+    /// `feedid identify` and `feedid stream` restart their windows there.
+    pub gaps: Vec<Gap>,
+    /// Samples that look missing in those gaps.
+    pub missing_samples: usize,
     /// Command, position, then the extra channels.
     pub channels: Vec<ChannelStats>,
     /// RMS of command − position \[m\].
@@ -125,6 +130,8 @@ pub fn recording_info(rec: &Recording) -> RecordingInfo {
         dt_s: rec.dt(),
         jitter_max_relative: rec.max_jitter(),
         jitter_max_abs_s: rec.max_jitter() * rec.dt(),
+        gaps: rec.gaps().to_vec(),
+        missing_samples: rec.missing_samples(),
         channels,
         tracking_error_rms_m: e_rms,
         tracking_error_max_m: emax,
@@ -190,6 +197,16 @@ impl fmt::Display for RecordingInfo {
             100.0 * self.jitter_max_relative,
             fmt_num(self.jitter_max_abs_s * 1e6)
         )?;
+        if let Some(g) = self.gaps.first() {
+            writeln!(
+                f,
+                "gaps        {} ({} sample(s) missing; the first before sample {}): identify \
+                 and stream restart their windows after each",
+                self.gaps.len(),
+                self.missing_samples,
+                g.index
+            )?;
+        }
         writeln!(
             f,
             "{:<12} {:>14} {:>14} {:>14} {:>14}",

@@ -232,6 +232,12 @@ pub struct ReadOptions {
     /// `f64` per sample whatever the file's width. Default: false (every
     /// other all-numeric column or vector is kept as an extra channel).
     pub signals_only: bool,
+    /// Accept dropped samples — an interval of a whole number (≥ 2) of
+    /// typical intervals — as gaps between segments
+    /// ([`crate::Recording::gaps`]; the sliding engine restarts its windows
+    /// after each), as `feedid identify` does. Default: false (such an
+    /// interval is a sampling-jitter error naming the missing samples).
+    pub allow_gaps: bool,
 }
 
 impl Default for ReadOptions {
@@ -248,6 +254,7 @@ impl Default for ReadOptions {
             time_unit: TimeUnit::S,
             jitter_tolerance: DEFAULT_JITTER_TOLERANCE,
             signals_only: false,
+            allow_gaps: false,
         }
     }
 }

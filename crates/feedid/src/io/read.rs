@@ -175,7 +175,11 @@ pub(crate) fn build_recording(
             })
         }
     };
-    Recording::with_tolerance(time, command, position, opts.jitter_tolerance)
+    if opts.allow_gaps {
+        Recording::allowing_gaps(time, command, position, opts.jitter_tolerance)
+    } else {
+        Recording::with_tolerance(time, command, position, opts.jitter_tolerance)
+    }
 }
 
 /// The zero-based sample and the signal a [`Recording`] check error points at.

@@ -219,9 +219,11 @@ impl<'a> Pipeline<'a> {
                         applies_to: "arx, rls, auto",
                     });
                 }
+                // on the longest stretch without dropped samples
+                let part = recording.longest_segment();
                 let sel = select_order(
-                    recording.command(),
-                    recording.position(),
+                    &recording.command()[part.clone()],
+                    &recording.position()[part],
                     recording.dt(),
                     search,
                 )
@@ -283,6 +285,26 @@ impl<'a> Pipeline<'a> {
                 )?
             }
         };
+        if let Some(g) = recording.gaps().first() {
+            let segments = recording.segments();
+            let unpredicted = segments
+                .iter()
+                .skip(1)
+                .map(|r| {
+                    r.clone()
+                        .take_while(|&k| !sliding.has_prediction[k])
+                        .count()
+                })
+                .sum();
+            warnings.push(Warning::DroppedSamples {
+                gaps: recording.gaps().len(),
+                missing: recording.missing_samples(),
+                first: g.index,
+                first_time_s: recording.time()[g.index],
+                unpredicted,
+                longest: recording.longest_segment().len(),
+            });
+        }
         if sliding.stats.samples == 0 {
             warnings.push(Warning::NothingPredicted {
                 windows: sliding.windows.len(),
@@ -298,14 +320,10 @@ impl<'a> Pipeline<'a> {
         }
 
         let simulated = match &self.nominal {
-            Some(p) => Some(
-                simulate_nominal(p, recording.command(), recording.dt()).map_err(|e| {
-                    Error::Stage {
-                        stage: "nominal simulation",
-                        source: Box::new(e),
-                    }
-                })?,
-            ),
+            Some(p) => Some(simulate_measured(p, recording).map_err(|e| Error::Stage {
+                stage: "nominal simulation",
+                source: Box::new(e),
+            })?),
             None => None,
         };
         // over the predicted samples (all samples if nothing was predicted)
@@ -332,9 +350,19 @@ impl<'a> Pipeline<'a> {
             .global_model()
             .map(GlobalModelKind::for_summary)
             .filter(|_| self.method_global_model);
+        // global models on the longest stretch without dropped samples
+        let gapped = if recording.gaps().is_empty() {
+            None
+        } else {
+            Some(recording.slice(recording.longest_segment())?)
+        };
+        let fit_global = |kind: &GlobalModelKind| match &gapped {
+            Some(part) => fit_global_model(part, kind),
+            None => fit_global_model(recording, kind),
+        };
         let (global, global_note) = match &method_kind {
             None => (None, None),
-            Some(kind) => match fit_global_model(recording, kind) {
+            Some(kind) => match fit_global(kind) {
                 Ok(g) => (Some(g), None),
                 Err(e) => (None, Some(format!("not fitted ({e})"))),
             },
@@ -342,7 +370,7 @@ impl<'a> Pipeline<'a> {
         let model = match &self.extra_model {
             None => None,
             Some(kind) if Some(kind) == method_kind.as_ref() && global.is_some() => global.clone(),
-            Some(kind) => Some(fit_global_model(recording, kind).map_err(|e| Error::Stage {
+            Some(kind) => Some(fit_global(kind).map_err(|e| Error::Stage {
                 stage: "global model",
                 source: Box::new(e),
             })?),
@@ -352,6 +380,8 @@ impl<'a> Pipeline<'a> {
             config,
             samples: recording.len(),
             rate_hz: recording.rate_hz(),
+            gaps: recording.gaps().len(),
+            missing_samples: recording.missing_samples(),
             order_choice,
             sliding,
             simulated,
@@ -363,6 +393,33 @@ impl<'a> Pipeline<'a> {
             warnings,
         })
     }
+}
+
+/// The nominal rig driven by the recording's command, at its measured
+/// samples. Across a gap the rig runs on: the command at the missing
+/// samples is interpolated linearly (a planned trajectory), and only the
+/// measured samples are returned.
+fn simulate_measured<S: AsRef<[f64]>>(p: &RigParams, rec: &Recording<S>) -> Result<Vec<f64>> {
+    let c = rec.command();
+    if rec.gaps().is_empty() {
+        return simulate_nominal(p, c, rec.dt());
+    }
+    let mut grid = Vec::with_capacity(c.len() + rec.missing_samples());
+    let mut measured = Vec::with_capacity(c.len());
+    let mut gaps = rec.gaps().iter().peekable();
+    for (k, &v) in c.iter().enumerate() {
+        if let Some(g) = gaps.next_if(|g| g.index == k) {
+            let before = c[k - 1];
+            for i in 1..=g.missing {
+                let f = i as f64 / (g.missing + 1) as f64;
+                grid.push(before + f * (v - before));
+            }
+        }
+        measured.push(grid.len());
+        grid.push(v);
+    }
+    let sim = simulate_nominal(p, &grid, rec.dt())?;
+    Ok(measured.into_iter().map(|i| sim[i]).collect())
 }
 
 #[cfg(test)]
@@ -489,6 +546,67 @@ mod tests {
         assert!(s
             .to_string()
             .contains("global model of the method (arx 3,3,0)"));
+    }
+
+    #[test]
+    fn dropped_samples_restart_the_windows_and_the_rig_runs_through_the_gaps() {
+        let full = ramp();
+        let keep: Vec<usize> = (0..full.len())
+            .filter(|&k| !(300..303).contains(&k) && k != 520)
+            .collect();
+        let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+        let rec = Recording::allowing_gaps(
+            pick(full.time()),
+            pick(full.command()),
+            pick(full.position()),
+            DEFAULT_JITTER_TOLERANCE,
+        )
+        .unwrap();
+        let p = Pipeline::new("arx".parse().unwrap()).nominal(RigParams::default());
+        let a = p.run(&rec).unwrap();
+        // the engine's segments, the summary and the warning
+        let b = engine::run(
+            &mut Method::Arx(Default::default()).build().unwrap(),
+            &rec.signals(),
+            &a.config,
+        )
+        .unwrap();
+        assert_eq!(a.sliding.predicted, b.predicted);
+        assert!(!a.sliding.has_prediction[300..310].iter().any(|&h| h));
+        let s = a.summary();
+        assert_eq!((s.gaps, s.missing_samples), (2, 4));
+        assert!(s
+            .to_string()
+            .contains("2 gap(s) of dropped samples (4 missing)"));
+        assert!(
+            s.to_string()
+                .contains("on 300 samples of the longest stretch without dropped samples"),
+            "{s}"
+        );
+        assert!(a.warnings.iter().any(|w| matches!(
+            w,
+            Warning::DroppedSamples {
+                gaps: 2,
+                missing: 4,
+                first: 300,
+                ..
+            }
+        )));
+        // the nominal rig simulated on the full grid (the ramp's command is
+        // linear in time, so interpolating it at the missing samples is exact)
+        let sim = a.simulated.as_ref().unwrap();
+        let whole = simulate_nominal(&RigParams::default(), full.command(), full.dt()).unwrap();
+        for (i, &k) in keep.iter().enumerate() {
+            assert!(
+                (sim[i] - whole[k]).abs() <= 1e-12,
+                "{k}: {} vs {}",
+                sim[i],
+                whole[k]
+            );
+        }
+        // the global model: on the longest segment, as said
+        assert_eq!(rec.longest_segment(), 0..300);
+        assert_eq!(s.global_model_samples, Some(300));
     }
 
     #[test]

@@ -28,6 +28,10 @@ pub struct Identification {
     pub samples: usize,
     /// Sampling rate \[Hz\].
     pub rate_hz: f64,
+    /// Gaps of dropped samples in the recording (the windows restarted after each).
+    pub gaps: usize,
+    /// Samples that look missing in those gaps.
+    pub missing_samples: usize,
     /// Orders chosen from the recording, if asked.
     pub order_choice: Option<OrderChoice>,
     /// The sliding-window predictions (per sample) and the per-window
@@ -71,6 +75,8 @@ impl Identification {
             failed_windows: s.failed_windows(),
             fallback_windows: fallback,
             withheld_windows: s.withheld_windows(),
+            gaps: self.gaps,
+            missing_samples: self.missing_samples,
             samples_predicted: s.stats.samples,
             coverage_percent: if self.samples > 0 {
                 100.0 * s.stats.samples as f64 / self.samples as f64

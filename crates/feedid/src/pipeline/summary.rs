@@ -38,6 +38,11 @@ pub struct IdentifySummary {
     /// motion the recording has shown (the estimator then restarts; see
     /// [`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility)).
     pub withheld_windows: usize,
+    /// Gaps in the recording: dropped samples, after each of which the
+    /// windows restarted ([`crate::Recording::gaps`]; 0 for a regular recording).
+    pub gaps: usize,
+    /// Samples that look missing in those gaps (not in `samples`).
+    pub missing_samples: usize,
     /// Samples with a prediction.
     pub samples_predicted: usize,
     /// Share of the recording's samples with a prediction \[%\].
@@ -176,6 +181,13 @@ impl fmt::Display for IdentifySummary {
                 "  prediction error: none (no sample was predicted, coverage 0 %; see the warnings)"
             )?,
         }
+        if self.gaps > 0 {
+            writeln!(
+                f,
+                "  {} gap(s) of dropped samples ({} missing): the windows restarted after each",
+                self.gaps, self.missing_samples
+            )?;
+        }
         if self.outliers > 0 {
             writeln!(
                 f,
@@ -185,6 +197,9 @@ impl fmt::Display for IdentifySummary {
         }
         if let (Some(m), Some(fit)) = (&self.global_model, self.global_fit_percent) {
             let share = match self.global_model_samples {
+                Some(n) if self.gaps > 0 => {
+                    format!(" on {n} samples of the longest stretch without dropped samples")
+                }
                 Some(n) if n < self.samples => format!(
                     " on the first {n} samples ({:.1} %)",
                     100.0 * n as f64 / self.samples as f64

@@ -42,6 +42,26 @@ pub enum Warning {
         /// The plausibility factor.
         factor: f64,
     },
+    /// The recording has gaps of dropped samples
+    /// ([`crate::Recording::gaps`]): the windows restarted after each, so
+    /// the samples at the start of every later segment are not predicted;
+    /// order selection and global models use the longest stretch without
+    /// gaps.
+    DroppedSamples {
+        /// Gaps.
+        gaps: usize,
+        /// Samples that look missing in all gaps.
+        missing: usize,
+        /// Zero-based index of the first sample after the first gap.
+        first: usize,
+        /// Its time stamp \[s\].
+        first_time_s: f64,
+        /// Samples of the later segments before their first prediction
+        /// (not predicted because of the restarts).
+        unpredicted: usize,
+        /// Samples in the longest stretch without gaps.
+        longest: usize,
+    },
     /// Paper method with the window time origin: the output model
     /// `P5·τ⁵ + P6·τ⁶ + P7·τ⁷` is zero with its first four derivatives at each
     /// window's first sample, so it cannot represent an axis that is away from
@@ -106,6 +126,23 @@ impl fmt::Display for Warning {
                  the motion the recording has shown, away from the last measured position: a \
                  model that wound up or diverged); those predictions were withheld, are not in \
                  the error figures, and the method restarted after each"
+            ),
+            Warning::DroppedSamples {
+                gaps,
+                missing,
+                first,
+                first_time_s,
+                unpredicted,
+                longest,
+            } => write!(
+                f,
+                "{missing} sample{} missing in {gaps} gap{} (dropped by the acquisition?; the \
+                 first before sample {first}, t = {first_time_s} s): the windows restarted after \
+                 each gap, as `feedid stream` does, so {unpredicted} samples at the start of the \
+                 later segments are not predicted; order selection and global models use the \
+                 longest stretch without gaps ({longest} samples)",
+                if *missing == 1 { " looks" } else { "s look" },
+                if *gaps == 1 { "" } else { "s" },
             ),
             Warning::PaperWindowOrigin => write!(
                 f,

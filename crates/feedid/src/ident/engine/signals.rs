@@ -9,6 +9,11 @@
 //! path passes a moving buffer with a growing offset
 //! ([`Signals::with_offset`]).
 //!
+//! A recording with dropped samples ([`Recording::gaps`]) gives a view that
+//! knows its gaps ([`Signals::gaps`], [`Signals::segments`]): the sliding
+//! engine runs each segment between gaps on its own, and an estimator only
+//! ever sees a view of one segment (no gaps).
+//!
 //! ```
 //! use feedid::ident::Signals;
 //! let t = [0.0, 1e-3, 2e-3, 3e-3];
@@ -24,7 +29,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::recording::{segments, Gap, Recording, MOTION_THRESHOLD};
 
 /// Read-only view of the signals an estimator may use (see the module doc).
 #[derive(Debug, Clone, Copy)]
@@ -35,6 +40,7 @@ pub struct Signals<'a> {
     position: &'a [f64],
     dt: f64,
     motion_start: f64,
+    gaps: &'a [Gap],
 }
 
 /// The samples of one checked range (from [`Signals::window`]).
@@ -81,6 +87,66 @@ impl<'a> Signals<'a> {
             position,
             dt,
             motion_start,
+            gaps: &[],
+        }
+    }
+
+    /// This view with the gaps `gaps` (absolute indices of the samples
+    /// after them, ascending; see the module doc).
+    pub fn with_gaps(self, gaps: &'a [Gap]) -> Self {
+        Self { gaps, ..self }
+    }
+
+    /// The gaps between segments (empty for a regular recording).
+    pub fn gaps(&self) -> &'a [Gap] {
+        self.gaps
+    }
+
+    /// The segments between gaps as absolute sample ranges (one range, all
+    /// visible samples, without gaps).
+    pub fn segments(&self) -> Vec<Range<usize>> {
+        segments(
+            self.len(),
+            self.gaps.iter().map(|g| g.index - self.offset.min(g.index)),
+        )
+        .into_iter()
+        .map(|r| r.start + self.offset..r.end + self.offset)
+        .collect()
+    }
+
+    /// The view of the samples `range` (absolute, within the visible data),
+    /// without gaps: one segment as the estimators see it.
+    pub fn part(&self, range: Range<usize>) -> Self {
+        let end = range.end.clamp(self.offset, self.end());
+        let start = range.start.clamp(self.offset, end);
+        let (a, b) = (start - self.offset, end - self.offset);
+        Self {
+            offset: start,
+            time: &self.time[a..b],
+            command: &self.command[a..b],
+            position: &self.position[a..b],
+            dt: self.dt,
+            motion_start: self.motion_start,
+            gaps: &[],
+        }
+    }
+
+    /// [`Signals::part`] for one segment between gaps, as a recording of
+    /// its own: its motion start is the last sample of the segment before
+    /// its command first moves (by more than 1 nm), else its first sample.
+    pub fn segment(&self, range: Range<usize>) -> Self {
+        let part = self.part(range);
+        let (t, c) = (part.time, part.command);
+        let motion_start = match (c.first(), t.first()) {
+            (Some(&c0), Some(&t0)) => c
+                .iter()
+                .position(|&v| (v - c0).abs() > MOTION_THRESHOLD)
+                .map_or(t0, |k| t[k.saturating_sub(1)]),
+            _ => part.motion_start,
+        };
+        Self {
+            motion_start,
+            ..part
         }
     }
 
@@ -184,6 +250,7 @@ impl<S: AsRef<[f64]>> Recording<S> {
             self.dt(),
             self.motion_start_time(),
         )
+        .with_gaps(self.gaps())
     }
 }
 

@@ -293,10 +293,30 @@ pub fn run_with<E: Estimator + ?Sized>(
     signals.check_lengths()?;
     let n = signals.len();
     let est_warm = estimator.warm_up();
-    config.validate(n, est_warm)?;
+    // each segment between dropped samples on its own (one without gaps)
+    let segments = signals.segments();
+    if segments.len() <= 1 {
+        config.validate(n, est_warm)?;
+    } else {
+        let longest = segments.iter().map(|r| r.len()).max().unwrap_or(0);
+        config.validate(longest, est_warm).map_err(|e| match e {
+            Error::TooFewSamples { needed, actual, .. } => Error::TooFewSamples {
+                what: "warm-up + window + horizon in the longest stretch between dropped samples",
+                needed,
+                actual,
+            },
+            other => other,
+        })?;
+    }
     let names = estimator.coefficient_names();
     let nc = names.len();
-    let windows_expected = config.windows(n, est_warm).count();
+    let segment_windows = |r: &Range<usize>| {
+        let a = r.start;
+        config
+            .windows(r.len(), est_warm)
+            .map(move |(w, h)| (w.start + a..w.end + a, h.start + a..h.end + a))
+    };
+    let windows_expected: usize = segments.iter().map(|r| segment_windows(r).count()).sum();
 
     let mut coefficients = vec![0.0; windows_expected * nc];
     let mut windows = Vec::with_capacity(windows_expected);
@@ -322,59 +342,74 @@ pub fn run_with<E: Estimator + ?Sized>(
         p(0, total);
     }
     let start = Instant::now();
-    for (w, (window, horizon)) in config.windows(n, est_warm).enumerate() {
-        if let Some(p) = progress {
-            if horizon.start >= next_report {
-                p(horizon.start as u64, total);
-                next_report = horizon.start.saturating_add(step);
+    let mut w = 0;
+    for (s, segment) in segments.iter().enumerate() {
+        if s > 0 {
+            // a gap: start again, as the stream does (module `stream`, *Gaps*)
+            estimator.reset();
+            guard.reset_segment();
+        }
+        for (window, horizon) in segment_windows(segment) {
+            if let Some(p) = progress {
+                if horizon.start >= next_report {
+                    p(horizon.start as u64, total);
+                    next_report = horizon.start.saturating_add(step);
+                }
             }
+            guard.observe(
+                window.end,
+                |k| raw.position[k],
+                |k, v| {
+                    cleaned.get_or_insert_with(|| raw.position.to_vec())[k] = v;
+                    outliers.push(k);
+                },
+            );
+            let whole = match &cleaned {
+                Some(c) => Signals::new(
+                    raw.time,
+                    raw.command,
+                    c,
+                    signals.dt(),
+                    signals.motion_start(),
+                ),
+                None => *signals,
+            };
+            // (after a gap, the segment is a recording of its own)
+            let seen = if segments.len() > 1 {
+                whole.segment(segment.clone())
+            } else {
+                whole.part(segment.clone())
+            };
+            let coef = &mut coefficients[w * nc..(w + 1) * nc];
+            w += 1;
+            let h = horizon.len();
+            let out = &mut buf[..h];
+            let mut record = fit_and_predict(estimator, &seen, window.clone(), horizon, coef, out);
+            let all = whole.all();
+            let spread = range(&all.position[window.clone()]);
+            let last = all.position[window.end - 1];
+            if record.outcome.predicted()
+                && estimator.checks_plausibility()
+                && !guard.plausible(
+                    out,
+                    last,
+                    spread,
+                    range(&all.command[window.start..record.horizon.end]),
+                )
+            {
+                record.outcome = WindowOutcome::Withheld;
+                estimator.restart();
+            }
+            if record.outcome.predicted() {
+                let (lo, hi) = (&mut lo[..h], &mut hi[..h]);
+                guard.predicted(record.horizon.start, out, last, spread, lo, hi);
+                predicted[record.horizon.clone()].copy_from_slice(out);
+                has_prediction[record.horizon.clone()].fill(true);
+                lower[record.horizon.clone()].copy_from_slice(lo);
+                upper[record.horizon.clone()].copy_from_slice(hi);
+            }
+            windows.push(record);
         }
-        guard.observe(
-            window.end,
-            |k| raw.position[k],
-            |k, v| {
-                cleaned.get_or_insert_with(|| raw.position.to_vec())[k] = v;
-                outliers.push(k);
-            },
-        );
-        let seen = match &cleaned {
-            Some(c) => Signals::new(
-                raw.time,
-                raw.command,
-                c,
-                signals.dt(),
-                signals.motion_start(),
-            ),
-            None => *signals,
-        };
-        let coef = &mut coefficients[w * nc..(w + 1) * nc];
-        let h = horizon.len();
-        let out = &mut buf[..h];
-        let mut record = fit_and_predict(estimator, &seen, window.clone(), horizon, coef, out);
-        let all = seen.all();
-        let spread = range(&all.position[window.clone()]);
-        let last = all.position[window.end - 1];
-        if record.outcome.predicted()
-            && estimator.checks_plausibility()
-            && !guard.plausible(
-                out,
-                last,
-                spread,
-                range(&all.command[window.start..record.horizon.end]),
-            )
-        {
-            record.outcome = WindowOutcome::Withheld;
-            estimator.restart();
-        }
-        if record.outcome.predicted() {
-            let (lo, hi) = (&mut lo[..h], &mut hi[..h]);
-            guard.predicted(record.horizon.start, out, last, spread, lo, hi);
-            predicted[record.horizon.clone()].copy_from_slice(out);
-            has_prediction[record.horizon.clone()].fill(true);
-            lower[record.horizon.clone()].copy_from_slice(lo);
-            upper[record.horizon.clone()].copy_from_slice(hi);
-        }
-        windows.push(record);
     }
     let elapsed = start.elapsed();
     if let Some(p) = progress {

@@ -681,6 +681,86 @@ fn a_gap_restarts_the_windows_as_if_a_new_recording_began() {
 }
 
 #[test]
+fn the_batch_engine_restarts_after_dropped_samples_as_if_a_new_recording_began() {
+    // the same gaps as above, now in one recording that allows them: the
+    // batch engine runs each segment on its own, as the stream does
+    let full = rig_recording(Scenario::Ramp, 0.16);
+    let keep: Vec<usize> = (0..full.len())
+        .filter(|k| !(220..227).contains(k))
+        .collect();
+    let mut t: Vec<f64> = keep.iter().map(|&k| full.time()[k]).collect();
+    let u: Vec<f64> = keep.iter().map(|&k| full.command()[k]).collect();
+    let y: Vec<f64> = keep.iter().map(|&k| full.position()[k]).collect();
+    for v in &mut t[498..] {
+        *v += 0.01;
+    }
+    let rec = Recording::allowing_gaps(t, u, y, 1e-6).unwrap();
+    let gaps: Vec<(usize, usize)> = rec.gaps().iter().map(|g| (g.index, g.missing)).collect();
+    assert_eq!(gaps, [(220, 7), (498, 50)]);
+    assert!((rec.dt() - 2e-4).abs() < 1e-12, "{}", rec.dt());
+    let cuts = [220, 498];
+    let cfg = EngineConfig::default();
+    let scale = rec.position().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let check = |b: &SlidingResult, want: &[Option<f64>], scored: usize, what: &str| {
+        for k in 0..rec.len() {
+            match (b.prediction(k), want[k]) {
+                // (absolute sample indices change the last bits)
+                (Some(a), Some(w)) => {
+                    assert!((a - w).abs() <= 1e-12 * scale, "{what}: {k}: {a} vs {w}")
+                }
+                (a, w) => assert_eq!(a, w, "{what}: sample {k}"),
+            }
+        }
+        assert_eq!(b.stats.samples, scored, "{what}");
+        // no window reaches across a gap
+        for w in &b.windows {
+            for c in cuts {
+                assert!(w.window.end <= c || w.window.start >= c, "{what}: {w:?}");
+                assert!(w.horizon.end <= c || w.horizon.start >= c, "{what}: {w:?}");
+            }
+        }
+    };
+    let b = run(&mut paper(Solver::Qr), &rec.signals(), &cfg).unwrap();
+    let (want, scored) = batch_by_segments(|| paper(Solver::Qr), &rec, &cuts, &cfg);
+    check(&b, &want, scored, "paper");
+    assert!(b.windows.iter().any(|w| w.window == (220..240)));
+    let auto = || {
+        crate::ident::Method::Auto(Default::default())
+            .build()
+            .unwrap()
+    };
+    let cfg = EngineConfig { window: 50, ..cfg };
+    let b = run(&mut auto(), &rec.signals(), &cfg).unwrap();
+    let (want, scored) = batch_by_segments(auto, &rec, &cuts, &cfg);
+    check(&b, &want, scored, "auto");
+    // the stream of the same lines predicts the same samples
+    let c = stream(follow7(), cfg, &rec, Feed::Lines(0), Wait);
+    let b = run(&mut follow7(), &rec.signals(), &cfg).unwrap();
+    for k in 0..rec.len() {
+        assert_eq!(c.has[k], b.has_prediction[k], "{k}");
+        if c.has[k] {
+            assert_eq!(c.predicted[k], b.predicted[k], "{k}");
+        }
+    }
+    // a segment too short for one window is skipped; none long enough is an error
+    let short = rec.head(260).unwrap();
+    assert_eq!(short.gaps().len(), 1);
+    let b = run(&mut follow7(), &short.signals(), &cfg).unwrap();
+    assert!(b.windows.iter().all(|w| w.window.end <= 220));
+    let e = run(
+        &mut follow7(),
+        &short.signals(),
+        &EngineConfig { window: 250, ..cfg },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, Error::TooFewSamples { actual: 220, .. })
+            && e.to_string().contains("between dropped samples"),
+        "{e}"
+    );
+}
+
+#[test]
 fn a_gap_with_a_command_lead_leaves_the_next_lead_positions_unused() {
     let rec = rig_recording(Scenario::Ramp, 0.08);
     let (t, u, y) = (rec.time(), rec.command(), rec.position());
@@ -946,4 +1026,40 @@ fn an_implausible_prediction_is_withheld_in_the_stream_as_in_batch() {
         .map(|(i, _)| i)
         .collect();
     assert_eq!(withheld, [11]);
+}
+
+#[test]
+fn a_reset_returns_every_method_to_its_fresh_state() {
+    // what a gap does to an estimator (stream and batch): after a reset it
+    // predicts the next segment exactly as a new one would
+    let full = rig_recording(Scenario::Ramp, 0.16);
+    let first = full.slice(0..223).unwrap(); // its last horizon cut short
+    let second = full.slice(227..498).unwrap();
+    for method in crate::ident::Method::all() {
+        let cfg = EngineConfig {
+            window: 50,
+            ..EngineConfig::default()
+        };
+        let fresh = run(&mut method.build().unwrap(), &second.signals(), &cfg).unwrap();
+        let mut used = method.build().unwrap();
+        run(&mut used, &first.signals(), &cfg).unwrap();
+        let again = run(&mut used, &second.signals(), &cfg).unwrap();
+        assert!(fresh.stats.samples > 0, "{}", method.name());
+        // (the paper's method reuses its basis while the time grid repeats
+        // to rounding: the last bits may differ)
+        let scale = second
+            .position()
+            .iter()
+            .fold(0.0_f64, |m, v| m.max(v.abs()));
+        for k in 0..second.len() {
+            match (fresh.prediction(k), again.prediction(k)) {
+                (Some(a), Some(b)) => assert!(
+                    (a - b).abs() <= 1e-12 * scale,
+                    "{}: {k}: {a} vs {b}",
+                    method.name()
+                ),
+                (a, b) => assert_eq!(a, b, "{}: {k}", method.name()),
+            }
+        }
+    }
 }

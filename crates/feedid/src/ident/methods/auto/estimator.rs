@@ -530,6 +530,8 @@ impl Estimator for AutoEstimator {
         self.selected = None;
         self.start = None;
         self.regime = 2;
+        // (a stream's last horizon before a gap may have been cut short)
+        self.horizon = 10;
         self.experience = 0.0;
         self.experienced_to = 0;
         self.first = First::Chosen;

@@ -58,8 +58,11 @@
 //! far the predictions depend on them (a unit-invariant method changes
 //! nothing beyond rounding).
 //!
-//! Members with dropped rows are refused by the reader (as by
-//! `feedid identify`): they are listed as `refused` and left out of the summary.
+//! Members with dropped rows are read with their gaps (as by `feedid
+//! identify`): every method restarts its windows after a gap, and so do the
+//! baselines. They are scored apart from the regular members, in a table of
+//! their own (coverage after each segment's first window, losses, and the
+//! rms against the same method on the member they were cut from).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -247,6 +250,48 @@ fn baseline_arx220(u: &[f64], y: &[f64], phase: usize) -> Predictions {
     }
 }
 
+/// A baseline run on each segment between gaps on its own (`f(u, y)` of
+/// the segment), stitched into the recording's samples.
+fn per_segment(
+    segments: &[std::ops::Range<usize>],
+    name: &'static str,
+    f: impl Fn(&[f64], &[f64]) -> Predictions,
+    u: &[f64],
+    y: &[f64],
+) -> Predictions {
+    let n = y.len();
+    let mut out = Predictions {
+        name,
+        value: vec![0.0; n],
+        has: vec![false; n],
+        interval: None,
+        first: n,
+        seconds: 0.0,
+        error: None,
+    };
+    for r in segments {
+        let p = f(&u[r.clone()], &y[r.clone()]);
+        out.value[r.clone()].copy_from_slice(&p.value);
+        out.has[r.clone()].copy_from_slice(&p.has);
+        out.first = out.first.min(r.start + p.first);
+        out.seconds += p.seconds;
+    }
+    out
+}
+
+/// Share of the samples after the method's first window in each segment
+/// between gaps (the first window's length counted from the segment's
+/// start) that the method predicts \[%\].
+fn coverage_after(p: &Predictions, segments: &[std::ops::Range<usize>]) -> f64 {
+    let (mut predicted, mut total) = (0usize, 0usize);
+    for r in segments {
+        let from = (r.start + p.first).min(r.end);
+        total += r.end - from;
+        predicted += p.has[from..r.end].iter().filter(|&&h| h).count();
+    }
+    100.0 * predicted as f64 / total.max(1) as f64
+}
+
 /// rms and max of `y − ŷ` over the samples where `mask` holds.
 fn stats(y: &[f64], p: &Predictions, mask: impl Fn(usize) -> bool) -> Option<(f64, f64, usize)> {
     let (mut sse, mut max, mut n) = (0.0, 0.0f64, 0usize);
@@ -290,6 +335,10 @@ struct Row {
     interval_coverage: Option<f64>,
     seconds: f64,
     note: String,
+    /// Gaps of dropped samples in the member (0 for a regular one).
+    gaps: usize,
+    /// The regular member it was cut from, if it has dropped rows.
+    source: Option<usize>,
     /// Whether it loses to a baseline when the baselines' blocks start
     /// `q` = 0 … H − 1 samples later (library methods only).
     loses_by_phase: [bool; H],
@@ -316,9 +365,11 @@ fn score(m: &ZooMember) -> Vec<Row> {
         interval_coverage: None,
         seconds: 0.0,
         note: String::new(),
+        gaps: 0,
+        source: s.gap_source,
         loses_by_phase: [false; H],
     };
-    let rec = match m.recording() {
+    let rec = match m.recording_with_gaps() {
         Ok(r) => r,
         Err(e) => {
             return LIBRARY
@@ -344,16 +395,24 @@ fn score(m: &ZooMember) -> Vec<Row> {
     let rec = if offset == 0.0 && via == 1.0 {
         rec
     } else {
-        match Recording::new(rec.time().to_vec(), u.clone(), y.clone()) {
+        match Recording::allowing_gaps(rec.time().to_vec(), u.clone(), y.clone(), 0.01) {
             Ok(r) => r,
             Err(e) => panic!("member {}: shifted recording: {e}", s.index),
         }
     };
+    let segments = rec.segments();
+    let base = Row {
+        gaps: rec.gaps().len(),
+        ..base
+    };
     let mut all = run_library_methods(&rec);
     all.push(baseline_command(u));
     let phase = PHASE.get().copied().unwrap_or(0);
-    all.push(baseline_hold(y, phase));
-    all.push(baseline_arx220(u, y, phase));
+    // the baselines restart after a gap, as the methods do
+    let hold = |q: usize| per_segment(&segments, "hold", |_, y| baseline_hold(y, q), u, y);
+    let arx220 = |q: usize| per_segment(&segments, "arx220", |u, y| baseline_arx220(u, y, q), u, y);
+    all.push(hold(phase));
+    all.push(arx220(phase));
     let n = y.len();
     let mut scored = vec![true; n];
     for g in &s.glitches {
@@ -361,9 +420,7 @@ fn score(m: &ZooMember) -> Vec<Row> {
     }
     let by_name: BTreeMap<&str, &Predictions> = all.iter().map(|p| (p.name, p)).collect();
     // the baselines at every phase of their blocks (command has none)
-    let phased: Vec<[Predictions; 2]> = (0..H)
-        .map(|q| [baseline_hold(y, q), baseline_arx220(u, y, q)])
-        .collect();
+    let phased: Vec<[Predictions; 2]> = (0..H).map(|q| [hold(q), arx220(q)]).collect();
     let loses_to = |p: &Predictions, b: &Predictions| {
         // (as the table: a baseline without error beats any error)
         shared_rms(y, p, b, &scored).is_some_and(|(a, r)| a > r)
@@ -407,9 +464,7 @@ fn score(m: &ZooMember) -> Vec<Row> {
                 rms: own.map(|o| o.0),
                 max: own.map(|o| o.1),
                 coverage: 100.0 * predicted as f64 / n as f64,
-                coverage_after: 100.0
-                    * p.has[p.first.min(n)..].iter().filter(|&&h| h).count() as f64
-                    / (n - p.first.min(n)).max(1) as f64,
+                coverage_after: coverage_after(p, &segments),
                 ratio,
                 beaten_by: worst.filter(|w| w.1 > 1.0).map(|w| w.0),
                 baseline_ratio: worst.map(|w| w.1),
@@ -571,7 +626,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let scored: Vec<&Row> = rows
         .iter()
-        .filter(|r| !r.note.starts_with("refused"))
+        .filter(|r| !r.note.starts_with("refused") && r.gaps == 0)
+        .collect();
+    let gapped: Vec<&Row> = rows
+        .iter()
+        .filter(|r| !r.note.starts_with("refused") && r.gaps > 0)
         .collect();
     let recordings = scored
         .iter()
@@ -582,9 +641,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter(|r| r.note.starts_with("refused"))
         .map(|r| r.member)
         .collect::<std::collections::BTreeSet<_>>();
+    let gapped_members = gapped
+        .iter()
+        .map(|r| r.member)
+        .collect::<std::collections::BTreeSet<_>>();
     println!(
-        "Drive zoo benchmark: {} recordings scored ({} refused by the reader: dropped rows), H = {H}, {:.1} s wall on {} threads\n",
+        "Drive zoo benchmark: {} recordings scored (and {} with dropped rows, apart below; {} refused by the reader), H = {H}, {:.1} s wall on {} threads\n",
         recordings.len(),
+        gapped_members.len(),
         refused.len(),
         wall,
         rayon::current_num_threads()
@@ -696,6 +760,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
         println!("| {method} | {} |", cells.join(" | "));
     }
+    if !gapped.is_empty() {
+        gapped_table(&gapped, &rows);
+    }
     println!(
         "\ncompared: recordings where the method shares ≥ {MIN_SHARED} predicted samples with a \
          fixed method; ratio: rms of the method / rms of the best fixed method (paper, arx, rls, oe \
@@ -707,6 +774,48 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          prediction interval (median over the recordings)."
     );
     Ok(())
+}
+
+/// The members with dropped rows: what the gaps cost each method.
+fn gapped_table(gapped: &[&Row], rows: &[Row]) {
+    println!(
+        "\nMembers with dropped rows ({}): every method and baseline restarts its windows \
+         after each gap.\n",
+        gapped
+            .iter()
+            .map(|r| r.member)
+            .collect::<std::collections::BTreeSet<_>>()
+            .len()
+    );
+    println!("| method | coverage, min / median [%] | coverage after each segment's first window, min / median [%] | loses to a baseline | own rms / own rms on the member without the gaps, median / max |");
+    println!("|---|---:|---:|---:|---:|");
+    for method in LIBRARY {
+        let mine: Vec<&&Row> = gapped.iter().filter(|r| r.method == method).collect();
+        let cov: Vec<f64> = mine.iter().map(|r| r.coverage).collect();
+        let after: Vec<f64> = mine.iter().map(|r| r.coverage_after).collect();
+        let losses = mine.iter().filter(|r| r.beaten_by.is_some()).count();
+        let cost: Vec<f64> = mine
+            .iter()
+            .filter_map(|r| {
+                let src = rows
+                    .iter()
+                    .find(|s| Some(s.member) == r.source && s.method == method)?;
+                Some(r.rms? / src.rms?)
+            })
+            .filter(|v| v.is_finite())
+            .collect();
+        println!(
+            "| {method} | {} / {} | {} / {} | {losses} of {} | {} / {} ({} compared) |",
+            fmt(quantile(&cov, 0.0), 1),
+            fmt(quantile(&cov, 0.5), 1),
+            fmt(quantile(&after, 0.0), 1),
+            fmt(quantile(&after, 0.5), 1),
+            mine.len(),
+            fmt(quantile(&cost, 0.5), 3),
+            fmt(quantile(&cost, 1.0), 3),
+            cost.len(),
+        );
+    }
 }
 
 #[cfg(test)]

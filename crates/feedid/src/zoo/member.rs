@@ -5,7 +5,7 @@ use std::io::Write;
 
 use super::spec::MemberSpec;
 use crate::error::Result;
-use crate::recording::Recording;
+use crate::recording::{Recording, DEFAULT_JITTER_TOLERANCE};
 
 /// One recording of the zoo.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,13 +33,25 @@ impl ZooMember {
         self.time.is_empty()
     }
 
-    /// The member as a checked [`Recording`], as `feedid identify` would read
-    /// it; an error for members with dropped rows (non-uniform sampling).
+    /// The member as a checked, uniformly sampled [`Recording`]; an error for
+    /// members with dropped rows (see [`ZooMember::recording_with_gaps`]).
     pub fn recording(&self) -> Result<Recording> {
         Recording::new(
             self.time.clone(),
             self.command.clone(),
             self.position.clone(),
+        )
+    }
+
+    /// The member as a checked [`Recording`] with its dropped rows as gaps
+    /// ([`Recording::allowing_gaps`]), as `feedid identify` reads it; the
+    /// same as [`ZooMember::recording`] for a member without dropped rows.
+    pub fn recording_with_gaps(&self) -> Result<Recording> {
+        Recording::allowing_gaps(
+            self.time.clone(),
+            self.command.clone(),
+            self.position.clone(),
+            DEFAULT_JITTER_TOLERANCE,
         )
     }
 

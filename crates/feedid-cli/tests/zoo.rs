@@ -115,6 +115,18 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
     assert!(stdout(&o).contains("gaps        2"), "{}", stdout(&o));
     let o = feedid(&["order", f.to_str().unwrap()]);
     assert_fails(&o, &["zoo-215.csv", "missing", "`feedid identify`"]);
+    // the report identifies it as `identify` does, and says so
+    let html = dir.path().join("r.html");
+    let o = feedid(&["report", f.to_str().unwrap(), "-o", html.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("5 sample(s) missing in 2 gap(s)"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(std::fs::read_to_string(&html)
+        .unwrap()
+        .contains("dropped samples"));
 }
 
 #[test]

@@ -77,22 +77,27 @@ pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
 /// [`load`], with dropped samples accepted as gaps (for a description of
 /// the recording, which names them).
 pub fn load_allowing_gaps(path: &Path, a: &RecordingArgs) -> Result<Recording> {
-    let opts = ReadOptions {
-        allow_gaps: true,
-        ..read_options(a)?
-    };
-    let rec = read_recording(path, &opts)?;
-    for w in check_recording(&rec) {
-        eprintln!("warning: {}: {}", path.display(), w.message);
-    }
-    Ok(rec)
+    Ok(load_checked_with(path, a, true)?.0)
 }
 
 /// Read and check a recording; its plausibility warnings
 /// (`feedid::plausibility`) go to standard error and are returned for the
 /// summaries.
 pub fn load_checked(path: &Path, a: &RecordingArgs) -> Result<(Recording, Vec<String>)> {
-    let opts = read_options(a)?;
+    load_checked_with(path, a, false)
+}
+
+/// [`load_checked`]; `allow_gaps`: dropped samples accepted as gaps (for the
+/// commands that restart their windows after a gap).
+pub fn load_checked_with(
+    path: &Path,
+    a: &RecordingArgs,
+    allow_gaps: bool,
+) -> Result<(Recording, Vec<String>)> {
+    let opts = ReadOptions {
+        allow_gaps,
+        ..read_options(a)?
+    };
     let rec = read_recording(path, &opts)?;
     let warnings: Vec<String> = check_recording(&rec)
         .into_iter()

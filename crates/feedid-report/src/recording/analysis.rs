@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use crate::error::Result;
 use crate::html::{Figure, HtmlReport, Section};
 use crate::plot::{decimate_minmax, LineChart, Series};
-use feedid::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
+use feedid::drive::{closed_loop_coefficients, simulate_nominal_recording, D1Variant, RigParams};
 use feedid::ident::{
     fit_global_model, prediction_errors, EngineConfig, GlobalModelKind, LinearModel, Method,
     OeConfig, ResidualAnalysis, GLOBAL_FIT_SAMPLES,
@@ -154,8 +154,8 @@ impl RecordingAnalysis {
                 p(sum.min(total), total);
             }
         };
-        let dt = recording.dt();
-        let simulated = simulate_nominal(&opts.params, recording.command(), dt)?;
+        // (through the gaps of dropped samples, if any, at the measured ones)
+        let simulated = simulate_nominal_recording(&opts.params, &recording)?;
         let nominal =
             closed_loop_coefficients(&opts.params, D1Variant::Corrected).transfer_function()?;
         let motion_start = recording.motion_start_time();
@@ -213,11 +213,38 @@ impl RecordingAnalysis {
                 .filter(|&k| in_zoom(k))
                 .map(|k| (y[k], simulated[k])),
         );
-        let (global, notes) = if opts.global_models {
-            global_models(&recording, opts)
+        let (global, mut notes) = if opts.global_models {
+            match recording.gaps() {
+                [] => global_models(&recording, opts),
+                _ => {
+                    // on the longest stretch without dropped samples
+                    let part = recording.longest_segment();
+                    let (global, mut notes) = global_models(&recording.slice(part.clone())?, opts);
+                    notes.push(format!(
+                        "Global models: fitted and simulated on samples {} … {} only, the longest \
+                         stretch without dropped samples.",
+                        part.start,
+                        part.end - 1
+                    ));
+                    (global, notes)
+                }
+            }
         } else {
             (Vec::new(), Vec::new())
         };
+        if let Some(g) = recording.gaps().first() {
+            notes.insert(
+                0,
+                format!(
+                    "{} sample(s) missing in {} gap(s) (the first before sample {}): every method \
+                     restarts its windows after each gap, so the start of every later segment is \
+                     not predicted; the nominal model runs through the gaps.",
+                    recording.missing_samples(),
+                    recording.gaps().len(),
+                    g.index
+                ),
+            );
+        }
         if let Some(p) = progress {
             p(total, total);
         }
@@ -245,7 +272,7 @@ impl RecordingAnalysis {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
                 (a.min(v), b.max(v))
             });
-        vec![
+        let mut facts: Vec<(String, String)> = vec![
             ("recording".into(), self.name.clone()),
             ("samples".into(), format!("{}", r.len())),
             (
@@ -280,7 +307,21 @@ impl RecordingAnalysis {
                 }),
             ),
             ("nominal model".into(), self.options.params_source.clone()),
-        ]
+        ];
+        if !r.gaps().is_empty() {
+            facts.insert(
+                2,
+                (
+                    "dropped samples".into(),
+                    format!(
+                        "{} missing in {} gap(s); the windows restart after each",
+                        r.missing_samples(),
+                        r.gaps().len()
+                    ),
+                ),
+            );
+        }
+        facts
     }
 
     /// The report's sections for this recording; element ids start with `prefix`.

@@ -180,3 +180,46 @@ fn report_opens_with_the_answer_and_folds_the_diagnostics() {
     let first_figure = html.find("<figure").unwrap();
     assert!(answer < first_figure);
 }
+
+#[test]
+fn a_recording_with_dropped_samples_is_reported_segment_by_segment() {
+    let full = ramp();
+    let keep: Vec<usize> = (0..full.len())
+        .filter(|&k| !(400..403).contains(&k))
+        .collect();
+    let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+    let rec = Recording::allowing_gaps(
+        pick(full.time()),
+        pick(full.command()),
+        pick(full.position()),
+        0.01,
+    )
+    .unwrap();
+    let a = RecordingAnalysis::run("gapped.csv", rec, &opts()).unwrap();
+    // the nominal model ran through the gap: as on the full recording
+    let whole = RecordingAnalysis::run("full.csv", full, &opts()).unwrap();
+    for (i, &k) in keep.iter().enumerate() {
+        assert!((a.simulated[i] - whole.simulated[k]).abs() < 1e-12, "{k}");
+    }
+    // no method predicts the first window after the gap
+    for run in &a.runs {
+        let s = &run.identification.sliding;
+        assert!(!s.has_prediction[400..400 + 20].iter().any(|&h| h));
+        assert!(s.stats.samples > 0);
+    }
+    assert!(
+        a.notes[0].contains("3 sample(s) missing in 1 gap(s)"),
+        "{:?}",
+        a.notes
+    );
+    assert!(a
+        .notes
+        .iter()
+        .any(|n| n.contains("the longest stretch without dropped samples")));
+    assert!(a
+        .facts()
+        .iter()
+        .any(|(k, v)| k == "dropped samples" && v.starts_with("3 missing in 1 gap")));
+    let html = recording_report(&a).unwrap().to_html();
+    assert!(!html.contains("NaN"));
+}

@@ -13,7 +13,7 @@ pub use closed_loop::{
     closed_loop_coefficients, closed_loop_coefficients_with_stiffness, closed_loop_state_space,
     closed_loop_state_space_with_stiffness, reference_inputs, ClosedLoopCoefficients, D1Variant,
 };
-pub use nominal::simulate_nominal;
+pub use nominal::{simulate_nominal, simulate_nominal_recording};
 pub use params::{
     equivalent_stiffness, screw_inertia, screw_stiffness, total_inertia, Control, Damping,
     Geometry, Inertia, Material, Motor, RigParams, Stiffness, Table,

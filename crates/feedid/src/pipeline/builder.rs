@@ -1,6 +1,6 @@
 //! The pipeline's settings (a builder) and the run itself.
 
-use crate::drive::{simulate_nominal, RigParams};
+use crate::drive::{simulate_nominal_recording, RigParams};
 use crate::error::{Error, Result};
 use crate::ident::engine::{run_with, Progress};
 use crate::ident::{
@@ -320,10 +320,14 @@ impl<'a> Pipeline<'a> {
         }
 
         let simulated = match &self.nominal {
-            Some(p) => Some(simulate_measured(p, recording).map_err(|e| Error::Stage {
-                stage: "nominal simulation",
-                source: Box::new(e),
-            })?),
+            Some(p) => {
+                Some(
+                    simulate_nominal_recording(p, recording).map_err(|e| Error::Stage {
+                        stage: "nominal simulation",
+                        source: Box::new(e),
+                    })?,
+                )
+            }
             None => None,
         };
         // over the predicted samples (all samples if nothing was predicted)
@@ -393,33 +397,6 @@ impl<'a> Pipeline<'a> {
             warnings,
         })
     }
-}
-
-/// The nominal rig driven by the recording's command, at its measured
-/// samples. Across a gap the rig runs on: the command at the missing
-/// samples is interpolated linearly (a planned trajectory), and only the
-/// measured samples are returned.
-fn simulate_measured<S: AsRef<[f64]>>(p: &RigParams, rec: &Recording<S>) -> Result<Vec<f64>> {
-    let c = rec.command();
-    if rec.gaps().is_empty() {
-        return simulate_nominal(p, c, rec.dt());
-    }
-    let mut grid = Vec::with_capacity(c.len() + rec.missing_samples());
-    let mut measured = Vec::with_capacity(c.len());
-    let mut gaps = rec.gaps().iter().peekable();
-    for (k, &v) in c.iter().enumerate() {
-        if let Some(g) = gaps.next_if(|g| g.index == k) {
-            let before = c[k - 1];
-            for i in 1..=g.missing {
-                let f = i as f64 / (g.missing + 1) as f64;
-                grid.push(before + f * (v - before));
-            }
-        }
-        measured.push(grid.len());
-        grid.push(v);
-    }
-    let sim = simulate_nominal(p, &grid, rec.dt())?;
-    Ok(measured.into_iter().map(|i| sim[i]).collect())
 }
 
 #[cfg(test)]
@@ -595,7 +572,9 @@ mod tests {
         // the nominal rig simulated on the full grid (the ramp's command is
         // linear in time, so interpolating it at the missing samples is exact)
         let sim = a.simulated.as_ref().unwrap();
-        let whole = simulate_nominal(&RigParams::default(), full.command(), full.dt()).unwrap();
+        let whole =
+            crate::drive::simulate_nominal(&RigParams::default(), full.command(), full.dt())
+                .unwrap();
         for (i, &k) in keep.iter().enumerate() {
             assert!(
                 (sim[i] - whole[k]).abs() <= 1e-12,

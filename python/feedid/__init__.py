@@ -117,6 +117,7 @@ def read(
     scale: Optional[float] = None,
     time_unit: str = "s",
     jitter_tol: float = 0.01,
+    allow_gaps: bool = False,
 ) -> Recording:
     """Read a recording from a CSV/text file or a MATLAB MAT-file, as
     ``feedid identify`` reads it (same options, same defaults, same messages).
@@ -146,6 +147,11 @@ def read(
     jitter_tol : float
         Largest relative deviation of a sampling interval from the mean
         (default 0.01).
+    allow_gaps : bool
+        Accept dropped samples (an interval of a whole number of typical
+        ones) as gaps between segments (``.gaps``), as ``feedid identify``
+        does; :func:`identify` restarts its windows after each. Default
+        False: such an interval is an error naming the missing samples.
 
     Returns
     -------
@@ -173,6 +179,7 @@ def read(
         scale=scale,
         time_unit=time_unit,
         jitter_tol=jitter_tol,
+        allow_gaps=allow_gaps,
     )
 
 

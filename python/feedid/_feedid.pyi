@@ -97,6 +97,7 @@ def read(
     scale: Optional[float] = None,
     time_unit: str = "s",
     jitter_tol: float = 0.01,
+    allow_gaps: bool = False,
 ) -> Recording: ...
 def identify(
     recording: Optional[Recording] = None,

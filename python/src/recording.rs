@@ -168,7 +168,8 @@ impl PyRecording {
 /// Read a recording (CSV or MAT) with the options of `feedid identify`.
 #[pyfunction]
 #[pyo3(signature = (path, *, time = None, command = None, position = None, rate = None,
-    delimiter = None, header = None, unit = "m", scale = None, time_unit = "s", jitter_tol = 0.01))]
+    delimiter = None, header = None, unit = "m", scale = None, time_unit = "s", jitter_tol = 0.01,
+    allow_gaps = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn read(
     py: Python<'_>,
@@ -183,6 +184,7 @@ pub fn read(
     scale: Option<f64>,
     time_unit: &str,
     jitter_tol: f64,
+    allow_gaps: bool,
 ) -> PyResult<PyRecording> {
     let channel = |s: Option<String>| -> PyResult<Option<ChannelRef>> {
         s.map(|s| ChannelRef::parse(&s)).transpose().py_err()
@@ -212,7 +214,7 @@ pub fn read(
         jitter_tolerance: jitter_tol,
         // the Python recording exposes the extra channels
         signals_only: false,
-        allow_gaps: false,
+        allow_gaps,
     };
     opts.validate().py_err()?;
     let path = std::path::PathBuf::from(path);

@@ -71,7 +71,7 @@ def test_recording_arrays_are_read_only_views_and_identify_reads_them_in_place()
     assert run.summary["samples"] == 1000
 
 
-def test_dropped_samples_are_gaps_as_in_the_cli():
+def test_dropped_samples_are_gaps_as_in_the_cli(tmp_path):
     rec = feedid.simulate("ramp", seed=1)
     keep = np.ones(len(rec), dtype=bool)
     keep[300:303] = False
@@ -84,6 +84,15 @@ def test_dropped_samples_are_gaps_as_in_the_cli():
     assert run.recording.gaps == [(300, 3)]
     with pytest.raises(ValueError, match="3 samples look missing"):
         feedid.Recording(t, u, y)
+    # a file read with gaps allowed identifies the same
+    path = tmp_path / "gapped.csv"
+    np.savetxt(path, np.c_[t, u, y], delimiter=",", header="time_s,command_m,position_m", comments="")
+    with pytest.raises(ValueError, match="missing"):
+        feedid.read(path)
+    rec = feedid.read(path, allow_gaps=True)
+    assert rec.gaps == [(300, 3)]
+    again = feedid.identify(rec, method="arx")
+    np.testing.assert_array_equal(again.predicted, run.predicted)
 
 
 def test_identification_has_its_arrays_and_frames():

@@ -59,6 +59,8 @@ pub struct Recording<S = Vec<f64>> {
     max_jitter: f64,
     notes: Vec<String>,
     gaps: Vec<Gap>,
+    /// The jitter tolerance it was checked with (relative).
+    tolerance: f64,
 }
 
 /// Samples missing before sample `index` of a recording (see the module
@@ -187,6 +189,7 @@ impl<S: AsRef<[f64]>> Recording<S> {
             max_jitter,
             notes: Vec::new(),
             gaps,
+            tolerance: jitter_tolerance,
         })
     }
 
@@ -229,6 +232,7 @@ impl<S: AsRef<[f64]>> Recording<S> {
             f64::INFINITY,
         )?;
         head.gaps = self.gaps.iter().copied().filter(|g| g.index < n).collect();
+        head.tolerance = self.tolerance;
         if !head.gaps.is_empty() {
             head.dt = self.dt;
             head.max_jitter = self.max_jitter;
@@ -261,7 +265,30 @@ impl<S: AsRef<[f64]>> Recording<S> {
         if !part.gaps.is_empty() {
             part.dt = self.dt;
         }
+        part.tolerance = self.tolerance;
         Ok(part)
+    }
+
+    /// An error unless the recording is uniformly sampled (no gaps): the
+    /// [`Error::SamplingJitter`] its first gap would have raised without
+    /// gaps allowed, for the computations that need one time grid (free-run
+    /// simulation of a model, a check of a model against the recording).
+    pub fn require_uniform(&self) -> Result<()> {
+        match self.gaps.first() {
+            None => Ok(()),
+            Some(g) => {
+                let t = self.time();
+                let interval = t[g.index] - t[g.index - 1];
+                Err(Error::SamplingJitter {
+                    index: g.index,
+                    interval,
+                    nominal: self.dt,
+                    relative_percent: 100.0 * (interval - self.dt).abs() / self.dt,
+                    tolerance_percent: 100.0 * self.tolerance,
+                    missing: g.missing,
+                })
+            }
+        }
     }
 
     /// The gaps (dropped samples) between segments, ascending; empty for a
@@ -771,9 +798,25 @@ mod tests {
                 "{e}"
             );
         }
+        // what needs one time grid refuses the gaps, naming the first
+        let e = Recording::allowing_gaps(tt.clone(), u.clone(), u.clone(), 0.01)
+            .unwrap()
+            .require_uniform()
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::SamplingJitter {
+                    index: 21,
+                    missing: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         // a regular recording has one segment and no gaps
         let r = Recording::allowing_gaps(t(10), vec![0.0; 10], vec![0.0; 10], 0.01).unwrap();
-        assert!(r.gaps().is_empty());
+        assert!(r.gaps().is_empty() && r.require_uniform().is_ok());
         assert_eq!(r.segments(), vec![0..10]);
     }
 

@@ -56,6 +56,7 @@ impl ModelQuality {
         model: &LinearModel,
         check: &Recording<S>,
     ) -> Result<Self> {
+        check.require_uniform()?;
         if let LinearModel::Discrete { dt, .. } = model {
             if (check.dt() - dt).abs() > 1e-6 * dt {
                 return Err(Error::SampleTimeMismatch {

@@ -259,13 +259,15 @@ pub const GLOBAL_FIT_SAMPLES: usize = 200_000;
 /// [`GLOBAL_FIT_SAMPLES`] samples at most): the one path of every global
 /// model.
 ///
-/// Errors: those of [`fit_arx`] / [`fit_oe`] (too few samples, no
-/// excitation, no stable model); with `auto`, the last candidate's error
-/// when none succeeds.
+/// Errors: a recording with gaps of dropped samples (a free-run fit needs
+/// uniform sampling: fit one segment, [`Recording::slice`]); those of
+/// [`fit_arx`] / [`fit_oe`] (too few samples, no excitation, no stable
+/// model); with `auto`, the last candidate's error when none succeeds.
 pub fn fit_global_model<S: AsRef<[f64]>>(
     rec: &Recording<S>,
     kind: &GlobalModelKind,
 ) -> Result<ModelFile> {
+    rec.require_uniform()?;
     if rec.len() <= GLOBAL_FIT_SAMPLES {
         return fit_kind(rec, kind);
     }

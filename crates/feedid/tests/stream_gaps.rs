@@ -1,6 +1,8 @@
-//! The drive zoo's members with dropped rows, which a file reader refuses,
-//! stream with every gap reported at the sample after it and no window
-//! spanning one.
+//! The drive zoo's members with dropped rows, which the strict reader
+//! refuses, stream with every gap reported at the sample after it and no
+//! window spanning one; read with their gaps, the batch engine restarts at
+//! the same samples and `auto` predicts every sample after each segment's
+//! first window.
 
 use feedid::ident::stream::{Interval, StreamOptions, Streamer};
 use feedid::ident::{EngineConfig, Method};
@@ -58,5 +60,50 @@ fn every_dropped_run_of_a_gapped_zoo_member_is_one_gap_and_no_window_spans_it() 
             );
         }
         assert!(!windows.is_empty());
+    }
+}
+
+#[test]
+fn the_batch_engine_restarts_at_the_streams_gaps_and_auto_predicts_every_segment() {
+    let zoo = Zoo::standard();
+    let idx: Vec<usize> = zoo.gapped().collect();
+    for (i, m) in idx.iter().zip(zoo.members(&idx)) {
+        let m = m.unwrap();
+        let rec = m.recording_with_gaps().unwrap();
+        // the gaps are the stream's (the sample after each run of dropped rows)
+        let rows = &m.spec.dropped_rows;
+        let after: Vec<usize> = (0..rows.len())
+            .filter(|&j| j + 1 == rows.len() || rows[j + 1] != rows[j] + 1)
+            .map(|j| rows[j] + 1 - (j + 1))
+            .collect();
+        assert_eq!(rec.gap_starts().collect::<Vec<_>>(), after, "#{i}");
+        assert_eq!(rec.missing_samples(), rows.len(), "#{i}");
+        let method = Method::default();
+        let cfg = EngineConfig {
+            window: method.default_window(),
+            ..EngineConfig::default()
+        };
+        let r =
+            feedid::ident::engine::run(&mut method.build().unwrap(), &rec.signals(), &cfg).unwrap();
+        for seg in rec.segments() {
+            // no window or horizon reaches across a gap
+            for w in r.windows.iter().filter(|w| seg.contains(&w.window.start)) {
+                assert!(
+                    w.window.end <= seg.end && w.horizon.end <= seg.end,
+                    "#{i}: {w:?}"
+                );
+            }
+            // every sample after the segment's first window (warm-up and
+            // window, as in the first segment) is predicted
+            let first = seg.start + r.windows[0].horizon.start;
+            if first < seg.end {
+                let missed = (first..seg.end).filter(|&k| !r.has_prediction[k]).count();
+                assert_eq!(missed, 0, "#{i}: segment {seg:?}");
+            }
+            assert!(!r.has_prediction[seg.start..first.min(seg.end)]
+                .iter()
+                .any(|&h| h));
+        }
+        assert!(r.predicted.iter().all(|v| v.is_finite()));
     }
 }

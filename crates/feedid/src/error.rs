@@ -379,7 +379,8 @@ fn missing_note(missing: usize) -> String {
         m => format!(
             "; the interval spans {} sampling intervals: {m} sample{} missing (dropped by the \
              acquisition?); this needs uniform sampling — cut the recording there; `feedid \
-             identify` and `feedid stream` restart their windows at such a gap",
+             identify`, `feedid report` and `feedid stream` restart their windows at such a \
+             gap",
             m + 1,
             if m == 1 { " looks" } else { "s look" }
         ),

@@ -132,6 +132,26 @@ pub enum Error {
         missing: usize,
     },
 
+    /// With gaps allowed: more intervals look like dropped samples than a
+    /// data acquisition drops ([`crate::recording::MAX_GAP_SHARE`]) — the
+    /// sampling is irregular or changes its rate.
+    #[error(
+        "{gaps} of the {intervals} sampling intervals span a whole number of intervals, the \
+         first at sample {index} (more than {max_percent} % of them): not a few dropped \
+         samples but irregular sampling or a change of the rate — resample the recording or \
+         cut it where the rate changes"
+    )]
+    TooManyGaps {
+        /// Zero-based index of the sample after the first such interval.
+        index: usize,
+        /// Intervals that look like dropped samples.
+        gaps: usize,
+        /// All intervals.
+        intervals: usize,
+        /// The largest share accepted \[%\].
+        max_percent: f64,
+    },
+
     // ------------------------------------------------------------------- I/O
     /// A file could not be read or written.
     #[error("{}: {source}", path.display())]

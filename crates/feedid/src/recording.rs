@@ -18,8 +18,11 @@
 //! there, as `feedid stream` does, instead of pairing samples that are not
 //! consecutive. The nominal interval is then the mean of the intervals
 //! within the segments, and every one of them must still lie within the
-//! jitter tolerance of it. Without gaps allowed, such an interval is a
-//! [`Error::SamplingJitter`] that names the missing samples.
+//! jitter tolerance of it. More than [`MAX_GAPS_ANY_LENGTH`] gaps in more
+//! than [`MAX_GAP_SHARE`] of the intervals are not a few dropped samples
+//! but irregular sampling or a change of the rate ([`Error::TooManyGaps`]).
+//! Without gaps allowed, such an interval is a [`Error::SamplingJitter`]
+//! that names the missing samples.
 //!
 //! ```
 //! use feedid::Recording;
@@ -38,6 +41,17 @@ use crate::error::{Error, Result};
 
 /// Default relative tolerance on sampling-interval deviation (1 %).
 pub const DEFAULT_JITTER_TOLERANCE: f64 = 0.01;
+
+/// Largest share of a recording's intervals that may be gaps of dropped
+/// samples when gaps are allowed (1 %; [`MAX_GAPS_ANY_LENGTH`] gaps are
+/// accepted whatever the length): a data acquisition drops a sample now
+/// and then; a recording where more intervals span whole numbers of
+/// intervals is sampled irregularly or changes its rate
+/// ([`Error::TooManyGaps`]).
+pub const MAX_GAP_SHARE: f64 = 0.01;
+
+/// Gaps accepted in a recording of any length (see [`MAX_GAP_SHARE`]).
+pub const MAX_GAPS_ANY_LENGTH: usize = 3;
 
 /// Largest magnitude of any value of a recording (1e100): its square summed
 /// over 1e9 samples is still finite.
@@ -546,6 +560,15 @@ fn check(
             (missing > 0).then_some(Gap { index: k, missing })
         })
         .collect();
+    let intervals = time.len() - 1;
+    if gaps.len() > MAX_GAPS_ANY_LENGTH && gaps.len() as f64 > MAX_GAP_SHARE * intervals as f64 {
+        return Err(Error::TooManyGaps {
+            index: gaps[0].index,
+            gaps: gaps.len(),
+            intervals,
+            max_percent: 100.0 * MAX_GAP_SHARE,
+        });
+    }
     // the nominal interval within the segments (each is uniformly sampled)
     let (mut span, mut intervals) = (0.0, 0usize);
     for r in segments(time.len(), gaps.iter().map(|g| g.index)) {
@@ -809,6 +832,23 @@ mod tests {
                 Error::SamplingJitter {
                     index: 21,
                     missing: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // a change of the rate halfway is not a few dropped samples
+        let halved: Vec<f64> = (0..60)
+            .map(|k| if k < 40 { k as f64 } else { 40.0 + 2.0 * (k - 40) as f64 } * 1e-3)
+            .collect();
+        let e = Recording::allowing_gaps(halved, vec![0.0; 60], vec![0.0; 60], 0.01).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::TooManyGaps {
+                    index: 41,
+                    gaps: 19,
+                    intervals: 59,
                     ..
                 }
             ),

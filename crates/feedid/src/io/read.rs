@@ -195,7 +195,9 @@ pub(crate) fn failing_sample(err: &Error) -> Option<(usize, Option<Role>)> {
             Some((*index, role))
         }
         Error::NonMonotoneTime { index, .. } => Some((*index, Some(Role::Time))),
-        Error::SamplingJitter { index, .. } => Some((*index, Some(Role::Time))),
+        Error::SamplingJitter { index, .. } | Error::TooManyGaps { index, .. } => {
+            Some((*index, Some(Role::Time)))
+        }
         Error::SamplingInterval { .. } => Some((1, Some(Role::Time))),
         _ => None,
     }

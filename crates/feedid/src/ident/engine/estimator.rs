@@ -147,6 +147,20 @@ pub trait Estimator {
         self.reset()
     }
 
+    /// A gap of dropped samples: the samples after it are not consecutive
+    /// with those before ([`crate::Recording::gaps`]), so nothing may pair
+    /// them (no regressor, no window across the gap), but the drive is the
+    /// same. The engine calls this at the start of every segment after the
+    /// first, and the stream at a gap. Default: [`Estimator::reset`]; `arx`,
+    /// `rls` and `oe` keep the model they learnt (and predict from it until
+    /// the new segment has informed a better one) and forget only what
+    /// pairs samples — unless the sample interval changed (a stream's gap
+    /// may be a change of the rate, by more than 5 %: a discrete model then
+    /// no longer holds and they reset).
+    fn gap(&mut self) {
+        self.reset()
+    }
+
     /// Whether the engine withholds this method's implausible predictions
     /// ([`GuardConfig::plausibility`](crate::ident::GuardConfig::plausibility);
     /// default `true`). The paper's method answers `false`: it is
@@ -197,6 +211,9 @@ impl<E: Estimator + ?Sized> Estimator for Box<E> {
     fn restart(&mut self) {
         (**self).restart()
     }
+    fn gap(&mut self) {
+        (**self).gap()
+    }
     fn checks_plausibility(&self) -> bool {
         (**self).checks_plausibility()
     }
@@ -217,4 +234,11 @@ impl<E: Estimator + ?Sized> Estimator for Box<E> {
     ) -> Result<PredictStatus> {
         (**self).predict(signals, window, horizon, out)
     }
+}
+
+/// Whether the sample interval `dt` differs from the one a model was
+/// learnt at (`learnt`, 0 = none yet) by more than 5 %: a discrete-time
+/// model does not carry over (a stream's gap may be a change of the rate).
+pub(crate) fn rate_changed(learnt: f64, dt: f64) -> bool {
+    learnt > 0.0 && ((dt - learnt).abs() > 0.05 * learnt || dt.is_nan())
 }

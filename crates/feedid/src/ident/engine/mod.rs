@@ -11,6 +11,7 @@ pub mod stream;
 #[cfg(test)]
 mod test_estimators;
 
+pub(crate) use estimator::rate_changed;
 pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
 pub use guard::{Guard, GuardConfig, MIN_HISTORY};
 pub use signals::{Samples, Signals};

@@ -15,6 +15,14 @@
 //! non-finite result) gives no prediction and is recorded as
 //! [`WindowOutcome::Failed`]; no NaN ever reaches the prediction series.
 //!
+//! A recording with gaps of dropped samples ([`Signals::gaps`]) is run one
+//! segment at a time: the windows of each segment start at its own first
+//! sample (warm-up and window counted from there), no window or horizon
+//! reaches across a gap, the estimator sees a view of its segment only and
+//! is told of the gap ([`Estimator::gap`]: `arx`, `rls` and `oe` keep their
+//! model, the others start afresh), and the guard's error history starts
+//! again — as the stream does at a gap.
+//!
 //! ```
 //! # use feedid::ident::{engine::{run, EngineConfig}, Estimator, PredictStatus, Signals, WindowFit};
 //! # use feedid::solve::Termination;
@@ -345,8 +353,9 @@ pub fn run_with<E: Estimator + ?Sized>(
     let mut w = 0;
     for (s, segment) in segments.iter().enumerate() {
         if s > 0 {
-            // a gap: start again, as the stream does (module `stream`, *Gaps*)
-            estimator.reset();
+            // a gap: nothing pairs samples across it, as in the stream
+            // (module `stream`, *Gaps*)
+            estimator.gap();
             guard.reset_segment();
         }
         for (window, horizon) in segment_windows(segment) {

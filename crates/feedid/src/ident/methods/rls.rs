@@ -84,6 +84,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
+use crate::ident::engine::rate_changed;
 use crate::ident::methods::regressor::{poles_inside, predict_horizon};
 use crate::ident::{ArxOrders, Estimator, PredictStatus, Signals, WindowFit};
 use crate::solve::Termination;
@@ -224,6 +225,8 @@ pub struct RlsEstimator {
     cursor: Option<usize>,
     /// Absolute index of the first processed sample since the reset.
     start: Option<usize>,
+    /// Sample interval the model was learnt at \[s\] (0 before the first fit).
+    dt: f64,
     updates: usize,
     max_trace: f64,
     /// Whether the CPU has AVX2 (selects the vectorised update).
@@ -248,6 +251,7 @@ impl RlsEstimator {
             s: 0.0,
             cursor: None,
             start: None,
+            dt: 0.0,
             updates: 0,
             max_trace: config.max_trace.unwrap_or(n as f64 * config.p0),
             avx: crate::solve::rows::avx2(),
@@ -674,6 +678,15 @@ impl Estimator for RlsEstimator {
         self.cursor = None;
         self.start = None;
         self.updates = 0;
+        self.dt = 0.0;
+    }
+
+    /// The estimate and its covariance are kept; the samples are taken up
+    /// again from the first window after the gap (no regressor pairs
+    /// samples across it).
+    fn gap(&mut self) {
+        self.cursor = None;
+        self.start = None;
     }
 
     fn fit(
@@ -682,6 +695,10 @@ impl Estimator for RlsEstimator {
         window: Range<usize>,
         coef: &mut [f64],
     ) -> Result<WindowFit> {
+        if rate_changed(self.dt, signals.dt()) {
+            self.reset();
+        }
+        self.dt = signals.dt();
         let lag = self.config.orders.lag().max(1);
         signals.window(window.clone(), lag, "ARX window (past samples + window)")?;
         let first = signals.offset() + lag;

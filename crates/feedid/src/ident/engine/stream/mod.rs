@@ -62,13 +62,16 @@
 //! and kept: the windows go on across it. An interval off by more than
 //! [`StreamOptions::gap_deviation`] (50 %: one missing sample doubles it) is
 //! an [`Interval::Gap`] — samples missing, a pause, a change of the sampling
-//! — and the window state is **reset**, not bridged: windows spanning a gap
+//! — and the windows **restart**, not bridged: windows spanning a gap
 //! would fit a model to samples that are not consecutive (an ARX regressor
 //! would pair the wrong lags) and predict at the wrong times. A gap ends the
 //! current *segment*: its windows still waiting for their command are
 //! processed with the horizon cut at the last sample before the gap (polled
-//! first), then the estimator is reset and a new segment starts with the
-//! sample after the gap, whose first window ends `warm-up + W` samples later.
+//! first), then the estimator is told of the gap ([`crate::ident::Estimator::gap`]: `arx`,
+//! `rls` and `oe` keep their model unless the sample interval changed, the
+//! others start afresh) and a new segment starts with the sample after the
+//! gap, whose first window ends `warm-up + W` samples later — as the batch
+//! engine does at a recording's gaps.
 //! Pushed lines also drop the commands received ahead of the positions (with
 //! lines missing, their pairing by line count is lost; the next `N` positions
 //! are unused again); [`Streamer::push_command`]'s commands are kept (they

@@ -326,6 +326,7 @@ impl<E: Estimator> Streamer<E> {
         self.acc = ErrorAccumulator::default();
         self.acc_hold = ErrorAccumulator::default();
         self.inside = 0;
+        self.est.reset();
         self.begin_segment();
         self.guard.reset_outliers();
     }
@@ -333,7 +334,8 @@ impl<E: Estimator> Streamer<E> {
     /// Start a segment at sample `np` (commands already stored from there on
     /// are kept; see [`Streamer::restart_segment`]).
     fn begin_segment(&mut self) {
-        self.est.reset();
+        // (after a gap the estimator keeps what does not pair samples)
+        self.est.gap();
         self.guard.reset_segment();
         self.has.fill(false);
         self.top = self.np;

@@ -17,6 +17,7 @@ use serde::Serialize;
 use super::config::ArxConfig;
 use super::factor::SlidingFactor;
 use crate::error::{Error, Result};
+use crate::ident::engine::rate_changed;
 use crate::ident::methods::regressor::{dc_gain, poles_inside, predict_horizon, MAX_ARX_ORDER};
 use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
 use crate::solve::{
@@ -66,6 +67,8 @@ pub struct ArxEstimator {
     checked: Range<usize>,
     /// The last window was solved without a condition estimate; the factor still holds it.
     condition_pending: bool,
+    /// Sample interval the model was learnt at \[s\] (0 before the first fit).
+    dt: f64,
 }
 
 impl ArxEstimator {
@@ -89,6 +92,7 @@ impl ArxEstimator {
             diagnostics: None,
             checked: 0..0,
             condition_pending: false,
+            dt: 0.0,
         }
     }
 
@@ -315,6 +319,15 @@ impl Estimator for ArxEstimator {
         self.diagnostics = None;
         self.checked = 0..0;
         self.condition_pending = false;
+        self.dt = 0.0;
+    }
+
+    /// The window's factor pairs samples: it is rebuilt after the gap; the
+    /// model (the fallback of an uninformative window) is kept.
+    fn gap(&mut self) {
+        self.factor.invalidate();
+        self.checked = 0..0;
+        self.condition_pending = false;
     }
 
     fn fit(
@@ -323,6 +336,10 @@ impl Estimator for ArxEstimator {
         window: Range<usize>,
         coef: &mut [f64],
     ) -> Result<WindowFit> {
+        if rate_changed(self.dt, signals.dt()) {
+            self.reset();
+        }
+        self.dt = signals.dt();
         let orders = self.config.orders;
         let n = orders.n_params();
         let lag = orders.lag();

@@ -673,6 +673,12 @@ impl Estimator for OeEstimator {
         self.restart_pending = false;
     }
 
+    /// Each window's fit reads that window only (its initial state is
+    /// estimated in it): the model and its prior are kept across the gap.
+    fn gap(&mut self) {
+        self.last_window = None;
+    }
+
     /// The model is fitted again from the initial estimate at the next
     /// window with a moving command; windows before it keep the model (a
     /// reset would leave a recording that no longer moves without any).

@@ -361,3 +361,92 @@ fn a_reset_returns_every_method_to_its_fresh_state() {
         }
     }
 }
+
+#[test]
+fn after_a_gap_arx_rls_and_oe_predict_a_still_axis_from_the_model_learnt_before() {
+    // a step, then rest, read by a coarse encoder that stands still from 300
+    // samples after the step on; 3 samples dropped while it does
+    let full = rig_recording(Scenario::Step, 0.2);
+    let c = full.command();
+    let last_move = (1..c.len()).rev().find(|&k| c[k] != c[k - 1]).unwrap();
+    let (rest, g) = (last_move + 300, last_move + 400);
+    assert!(g + 400 < full.len(), "{last_move}");
+    let mut y = full.position().to_vec();
+    let y_rest = y[rest];
+    y[rest..].fill(y_rest);
+    let keep: Vec<usize> = (0..full.len())
+        .filter(|k| !(g..g + 3).contains(k))
+        .collect();
+    let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+    let rec = Recording::allowing_gaps(pick(full.time()), pick(c), pick(&y), 1e-6).unwrap();
+    assert_eq!(rec.gap_starts().collect::<Vec<_>>(), [g]);
+    let still = rec.slice(g..rec.len()).unwrap();
+    for name in ["arx", "rls", "oe"] {
+        let method: crate::ident::Method = name.parse().unwrap();
+        let cfg = EngineConfig {
+            window: method.default_window(),
+            ..EngineConfig::default()
+        };
+        // alone, the still segment teaches nothing: no prediction
+        let alone = run(&mut method.build().unwrap(), &still.signals(), &cfg).unwrap();
+        assert_eq!(alone.stats.samples, 0, "{name}");
+        // after the gap, the model learnt before predicts it
+        let b = run(&mut method.build().unwrap(), &rec.signals(), &cfg).unwrap();
+        let after = b.has_prediction[g..].iter().filter(|&&h| h).count();
+        assert!(
+            after > (rec.len() - g) / 2,
+            "{name}: {after} of {}",
+            rec.len() - g
+        );
+        // no window across the gap, and the stream does the same
+        assert!(b
+            .windows
+            .iter()
+            .all(|w| w.window.end <= g || w.window.start >= g));
+        let s = stream(method.build().unwrap(), cfg, &rec, Feed::Lines(0), Wait);
+        for k in 0..rec.len() {
+            assert_eq!(s.has[k], b.has_prediction[k], "{name}: {k}");
+        }
+    }
+}
+
+#[test]
+fn a_change_of_the_rate_makes_arx_and_rls_start_afresh() {
+    use crate::ident::Estimator;
+    let full = rig_recording(Scenario::Ramp, 0.1);
+    let half = |v: &[f64]| v.iter().step_by(2).copied().collect::<Vec<f64>>();
+    let slow = Recording::new(
+        half(full.time()),
+        half(full.command()),
+        half(full.position()),
+    )
+    .unwrap();
+    for name in ["arx", "rls"] {
+        let method: crate::ident::Method = name.parse().unwrap();
+        let cfg = EngineConfig {
+            window: method.default_window(),
+            ..EngineConfig::default()
+        };
+        let fresh = run(&mut method.build().unwrap(), &slow.signals(), &cfg).unwrap();
+        let mut used = method.build().unwrap();
+        run(&mut used, &full.signals(), &cfg).unwrap();
+        // what a stream does at a gap that is a change of the rate
+        used.gap();
+        let (mut coef, mut out) = (vec![0.0; used.coefficient_names().len()], vec![0.0; 10]);
+        for (w, h) in cfg.windows(slow.len(), used.warm_up()) {
+            let a = crate::ident::engine::fit_and_predict(
+                &mut used,
+                &slow.signals(),
+                w.clone(),
+                h.clone(),
+                &mut coef,
+                &mut out[..h.len()],
+            );
+            match (a.outcome.predicted(), fresh.prediction(h.start)) {
+                (true, Some(p)) => assert!((out[0] - p).abs() <= 1e-12, "{name}: {w:?}"),
+                (false, None) => {}
+                (x, y) => panic!("{name}: {w:?}: {x} vs {y:?}"),
+            }
+        }
+    }
+}

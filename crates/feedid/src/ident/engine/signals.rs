@@ -97,6 +97,14 @@ impl<'a> Signals<'a> {
         Self { gaps, ..self }
     }
 
+    /// This view with the motion start `t` \[s\].
+    pub fn with_motion_start(self, t: f64) -> Self {
+        Self {
+            motion_start: t,
+            ..self
+        }
+    }
+
     /// The gaps between segments (empty for a regular recording).
     pub fn gaps(&self) -> &'a [Gap] {
         self.gaps

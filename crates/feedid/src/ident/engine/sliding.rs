@@ -358,6 +358,12 @@ pub fn run_with<E: Estimator + ?Sized>(
             estimator.gap();
             guard.reset_segment();
         }
+        // after a gap, the segment is a recording of its own (its motion start)
+        let motion_start = if segments.len() > 1 {
+            signals.segment(segment.clone()).motion_start()
+        } else {
+            signals.motion_start()
+        };
         for (window, horizon) in segment_windows(segment) {
             if let Some(p) = progress {
                 if horizon.start >= next_report {
@@ -383,12 +389,7 @@ pub fn run_with<E: Estimator + ?Sized>(
                 ),
                 None => *signals,
             };
-            // (after a gap, the segment is a recording of its own)
-            let seen = if segments.len() > 1 {
-                whole.segment(segment.clone())
-            } else {
-                whole.part(segment.clone())
-            };
+            let seen = whole.part(segment.clone()).with_motion_start(motion_start);
             let coef = &mut coefficients[w * nc..(w + 1) * nc];
             w += 1;
             let h = horizon.len();

@@ -18,13 +18,13 @@ pub struct Cli {
 pub enum Command {
     /// Simulate a scenario on the virtual rig and write a recording.
     Simulate(SimulateArgs),
-    /// Identify over sliding windows and predict the next samples.
+    /// Identify over sliding windows and predict the next samples (restarting after dropped samples).
     Identify(Box<IdentifyArgs>),
     /// Select ARX orders: FPE, AIC, AICc, BIC over a grid, and FROLS term selection.
     Order(Box<OrderArgs>),
     /// Run the paper's experiments (ramp and step) end to end on the virtual rig.
     Reproduce(ReproduceArgs),
-    /// Summarise a recording: samples, rate and jitter, channel ranges, motion segments.
+    /// Summarise a recording: samples, rate and jitter, gaps, channel ranges, motion segments.
     Info(Box<InfoArgs>),
     /// Print the nominal model: stiffness, inertia, N and D, poles, bandwidth, following error.
     Model(ModelArgs),

@@ -337,15 +337,17 @@ struct Row {
     note: String,
     /// Gaps of dropped samples in the member (0 for a regular one).
     gaps: usize,
-    /// The regular member it was cut from, if it has dropped rows.
-    source: Option<usize>,
+    /// With dropped rows: rms over the samples this method predicts both
+    /// here and on the member without the gaps, divided by the rms of its
+    /// predictions there on the same samples.
+    gap_cost: Option<f64>,
     /// Whether it loses to a baseline when the baselines' blocks start
     /// `q` = 0 … H − 1 samples later (library methods only).
     loses_by_phase: [bool; H],
 }
 
 /// Score every method on one member.
-fn score(m: &ZooMember) -> Vec<Row> {
+fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
     let s = &m.spec;
     let base = Row {
         member: s.index,
@@ -366,7 +368,7 @@ fn score(m: &ZooMember) -> Vec<Row> {
         seconds: 0.0,
         note: String::new(),
         gaps: 0,
-        source: s.gap_source,
+        gap_cost: None,
         loses_by_phase: [false; H],
     };
     let rec = match m.recording_with_gaps() {
@@ -406,6 +408,21 @@ fn score(m: &ZooMember) -> Vec<Row> {
         ..base
     };
     let mut all = run_library_methods(&rec);
+    // the same methods on the member the rows were dropped from, for the cost
+    // of the gaps on the samples both predict
+    let without_gaps: Option<(Vec<Predictions>, Vec<usize>)> = s.gap_source.and_then(|src| {
+        let full = zoo.member(src).ok()?;
+        let rec = Recording::new(
+            full.time.clone(),
+            shift(&full.command),
+            shift(&full.position),
+        )
+        .ok()?;
+        let kept = (0..full.len())
+            .filter(|k| !s.dropped_rows.contains(k))
+            .collect();
+        Some((run_library_methods(&rec), kept))
+    });
     all.push(baseline_command(u));
     let phase = PHASE.get().copied().unwrap_or(0);
     // the baselines restart after a gap, as the methods do
@@ -469,6 +486,18 @@ fn score(m: &ZooMember) -> Vec<Row> {
                 beaten_by: worst.filter(|w| w.1 > 1.0).map(|w| w.0),
                 baseline_ratio: worst.map(|w| w.1),
                 interval_coverage,
+                gap_cost: without_gaps.as_ref().and_then(|(full, kept)| {
+                    let q = full.iter().find(|q| q.name == p.name)?;
+                    let (mut a, mut b, mut n_shared) = (0.0, 0.0, 0usize);
+                    for (j, &k) in kept.iter().enumerate() {
+                        if p.has[j] && q.has[k] && scored[j] {
+                            a += (y[j] - p.value[j]).powi(2);
+                            b += (y[j] - q.value[k]).powi(2);
+                            n_shared += 1;
+                        }
+                    }
+                    (n_shared >= MIN_SHARED && b > 0.0).then(|| (a / b).sqrt())
+                }),
                 seconds: p.seconds,
                 note: p.error.clone().unwrap_or_default(),
                 loses_by_phase: std::array::from_fn(|q| {
@@ -585,7 +614,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t = Instant::now();
     let rows: Vec<Row> = members
         .par_iter()
-        .map(|&i| zoo.member(i).map(|m| score(&m)))
+        .map(|&i| zoo.member(i).map(|m| score(&m, &zoo)))
         .collect::<feedid::Result<Vec<_>>>()?
         .into_iter()
         .flatten()
@@ -761,7 +790,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("| {method} | {} |", cells.join(" | "));
     }
     if !gapped.is_empty() {
-        gapped_table(&gapped, &rows);
+        gapped_table(&gapped);
     }
     println!(
         "\ncompared: recordings where the method shares ≥ {MIN_SHARED} predicted samples with a \
@@ -777,7 +806,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// The members with dropped rows: what the gaps cost each method.
-fn gapped_table(gapped: &[&Row], rows: &[Row]) {
+fn gapped_table(gapped: &[&Row]) {
     println!(
         "\nMembers with dropped rows ({}): every method and baseline restarts its windows \
          after each gap.\n",
@@ -787,7 +816,7 @@ fn gapped_table(gapped: &[&Row], rows: &[Row]) {
             .collect::<std::collections::BTreeSet<_>>()
             .len()
     );
-    println!("| method | coverage, min / median [%] | coverage after each segment's first window, min / median [%] | loses to a baseline | own rms / own rms on the member without the gaps, median / max |");
+    println!("| method | coverage, min / median [%] | coverage after each segment's first window, min / median [%] | loses to a baseline | rms / rms on the member without the gaps, same samples, median / max |");
     println!("|---|---:|---:|---:|---:|");
     for method in LIBRARY {
         let mine: Vec<&&Row> = gapped.iter().filter(|r| r.method == method).collect();
@@ -796,12 +825,7 @@ fn gapped_table(gapped: &[&Row], rows: &[Row]) {
         let losses = mine.iter().filter(|r| r.beaten_by.is_some()).count();
         let cost: Vec<f64> = mine
             .iter()
-            .filter_map(|r| {
-                let src = rows
-                    .iter()
-                    .find(|s| Some(s.member) == r.source && s.method == method)?;
-                Some(r.rms? / src.rms?)
-            })
+            .filter_map(|r| r.gap_cost)
             .filter(|v| v.is_finite())
             .collect();
         println!(

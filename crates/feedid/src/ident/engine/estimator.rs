@@ -151,12 +151,13 @@ pub trait Estimator {
     /// with those before ([`crate::Recording::gaps`]), so nothing may pair
     /// them (no regressor, no window across the gap), but the drive is the
     /// same. The engine calls this at the start of every segment after the
-    /// first, and the stream at a gap. Default: [`Estimator::reset`]; `arx`,
-    /// `rls` and `oe` keep the model they learnt (and predict from it until
-    /// the new segment has informed a better one) and forget only what
-    /// pairs samples — unless the sample interval changed (a stream's gap
-    /// may be a change of the rate, by more than 5 %: a discrete model then
-    /// no longer holds and they reset).
+    /// first, and the stream at a gap. Default: [`Estimator::reset`] (the
+    /// paper's method, which needs a motion start); `arx`, `rls`, `oe` and
+    /// `auto` (its candidates and their scores) keep the model they learnt
+    /// (and predict from it until the new segment has informed a better
+    /// one) and forget only what pairs samples — unless the sample interval
+    /// changed (a stream's gap may be a change of the rate, by more than
+    /// 5 %: a discrete model then no longer holds and they reset).
     fn gap(&mut self) {
         self.reset()
     }

@@ -19,9 +19,9 @@
 //! segment at a time: the windows of each segment start at its own first
 //! sample (warm-up and window counted from there), no window or horizon
 //! reaches across a gap, the estimator sees a view of its segment only and
-//! is told of the gap ([`Estimator::gap`]: `arx`, `rls` and `oe` keep their
-//! model, the others start afresh), and the guard's error history starts
-//! again — as the stream does at a gap.
+//! is told of the gap ([`Estimator::gap`]: `arx`, `rls`, `oe` and `auto`
+//! keep their models, `paper` starts afresh), and the guard's error history
+//! starts again — as the stream does at a gap.
 //!
 //! ```
 //! # use feedid::ident::{engine::{run, EngineConfig}, Estimator, PredictStatus, Signals, WindowFit};

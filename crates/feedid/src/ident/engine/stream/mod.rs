@@ -67,11 +67,12 @@
 //! would pair the wrong lags) and predict at the wrong times. A gap ends the
 //! current *segment*: its windows still waiting for their command are
 //! processed with the horizon cut at the last sample before the gap (polled
-//! first), then the estimator is told of the gap ([`crate::ident::Estimator::gap`]: `arx`,
-//! `rls` and `oe` keep their model unless the sample interval changed, the
-//! others start afresh) and a new segment starts with the sample after the
-//! gap, whose first window ends `warm-up + W` samples later — as the batch
-//! engine does at a recording's gaps.
+//! first), then the estimator is told of the gap
+//! ([`crate::ident::Estimator::gap`]: `arx`, `rls`, `oe` and `auto` keep
+//! their models unless the sample interval changed, `paper` starts afresh)
+//! and a new segment starts with the sample after the gap, whose first
+//! window ends `warm-up + W` samples later — as the batch engine does at a
+//! recording's gaps.
 //! Pushed lines also drop the commands received ahead of the positions (with
 //! lines missing, their pairing by line count is lost; the next `N` positions
 //! are unused again); [`Streamer::push_command`]'s commands are kept (they

@@ -464,6 +464,24 @@ impl Predictor {
         }
     }
 
+    /// A gap of dropped samples: keep the model (and a recursive candidate
+    /// its covariance), forget what pairs samples — the recursive cursor,
+    /// the windowed factors of the rows before the gap.
+    pub(crate) fn gap(&mut self) {
+        match &mut self.state {
+            State::Recursive(r) => r.cursor = None,
+            State::Windowed(l) => {
+                l.cursor = None;
+                for f in &mut l.factors {
+                    f.fill(0.0);
+                }
+                l.merged.fill(0.0);
+                l.rows = [0, 0];
+            }
+            State::Plain => {}
+        }
+    }
+
     /// Learn from the samples up to `end` (exclusive); `start` is the first
     /// sample of the engine's first window (where a recursive candidate
     /// begins). Returns whether the model can predict.

@@ -9,6 +9,7 @@ use super::candidate::{Candidate, Predictor};
 use super::config::AutoConfig;
 use super::model;
 use crate::error::{Error, Result};
+use crate::ident::engine::rate_changed;
 use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
 use crate::solve::Termination;
 
@@ -131,6 +132,8 @@ pub struct AutoEstimator {
     first: First,
     /// Scratch for the pointwise median of the predictions.
     sorted: Vec<f64>,
+    /// Sample interval the candidates learnt at \[s\] (0 before the first fit).
+    dt: f64,
 }
 
 /// The first prediction after a reset: the best-backtested candidate when
@@ -181,6 +184,7 @@ impl AutoEstimator {
             experienced_to: 0,
             first: First::Chosen,
             sorted: Vec::new(),
+            dt: 0.0,
         }
     }
 
@@ -535,6 +539,22 @@ impl Estimator for AutoEstimator {
         self.experience = 0.0;
         self.experienced_to = 0;
         self.first = First::Chosen;
+        self.dt = 0.0;
+    }
+
+    /// The candidates keep their models and their scores (the drive is the
+    /// same) and forget what pairs samples; the chosen one predicts the
+    /// first horizon after the gap (no backtest: the scores are known). A
+    /// changed sample interval resets everything at the next fit.
+    fn gap(&mut self) {
+        for m in &mut self.members {
+            m.predictor.gap();
+            m.trial_predictor.gap();
+            m.pending_len = 0;
+        }
+        // (the last horizon before the gap may have been cut short)
+        self.horizon = 10;
+        self.first = First::Chosen;
     }
 
     fn fit(
@@ -550,6 +570,11 @@ impl Estimator for AutoEstimator {
                 actual: signals.end(),
             });
         }
+        if rate_changed(self.dt, signals.dt()) {
+            // (a stream's gap that changed the rate: discrete models do not carry over)
+            self.reset();
+        }
+        self.dt = signals.dt();
         self.score_pending(signals, window.end);
         self.learn_experience(signals, window.end);
         self.regime = regime(signals, window.start, window.end, self.horizon);

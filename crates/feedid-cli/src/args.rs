@@ -20,7 +20,7 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// Identify over sliding windows and predict the next samples (restarting after dropped samples).
     Identify(Box<IdentifyArgs>),
-    /// Select ARX orders: FPE, AIC, AICc, BIC over a grid, and FROLS term selection.
+    /// Select ARX orders: FPE, AIC, AICc, BIC over a grid, and FROLS term selection (on the longest stretch between dropped samples).
     Order(Box<OrderArgs>),
     /// Run the paper's experiments (ramp and step) end to end on the virtual rig.
     Reproduce(ReproduceArgs),
@@ -32,7 +32,7 @@ pub enum Command {
     Stream(Box<StreamArgs>),
     /// Write a self-contained HTML report of a recording: figures, residuals, Bode plot, summary.
     Report(Box<ReportArgs>),
-    /// Error of every window × horizon × method × order combination, heat map, best choice.
+    /// Error of every window × horizon × method × order combination, heat map, best choice (restarting after dropped samples).
     Sweep(Box<SweepArgs>),
     /// Estimate physical parameters (Kv, Kp, Ki, C2, M, K, ...) from a recording or identified N, D.
     Greybox(Box<GreyboxArgs>),

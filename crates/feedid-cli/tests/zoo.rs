@@ -113,8 +113,40 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
     let o = feedid(&["info", f.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("gaps        2"), "{}", stdout(&o));
-    let o = feedid(&["order", f.to_str().unwrap()]);
+    let o = feedid(&["greybox", f.to_str().unwrap(), "--estimate", "kv"]);
     assert_fails(&o, &["zoo-215.csv", "missing", "`feedid identify`"]);
+    // `order` chooses on the longest stretch between the gaps and says which
+    let o = feedid(&["order", f.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(j["gaps"].as_u64(), Some(2));
+    assert_eq!(j["samples"].as_u64(), Some(samples as u64));
+    let used = j["samples_used"].as_u64().unwrap() as usize;
+    assert!(used > 0 && used < samples, "{j}");
+    let o = feedid(&["order", f.to_str().unwrap()]);
+    assert!(
+        stdout(&o).contains("orders chosen on the longest stretch between dropped samples"),
+        "{}",
+        stdout(&o)
+    );
+    // `sweep` restarts every combination after each gap, as `identify`
+    let sw = dir.path().join("sw.csv");
+    let o = feedid(&[
+        "sweep",
+        f.to_str().unwrap(),
+        "-o",
+        sw.to_str().unwrap(),
+        "--windows",
+        "50,100",
+        "--methods",
+        "arx",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("of each of the 3 segments between the 2 gap(s)"),
+        "{}",
+        stdout(&o)
+    );
     // the report identifies it as `identify` does, and says so
     let html = dir.path().join("r.html");
     let o = feedid(&["report", f.to_str().unwrap(), "-o", html.to_str().unwrap()]);

@@ -28,7 +28,10 @@ fn range(name: &str, s: &str) -> Result<(usize, usize)> {
 
 /// Print the order table, the FROLS terms and the choice.
 pub fn run(a: &OrderArgs) -> Result<()> {
-    let rec = recording::load(&a.input, &a.recording)?;
+    // dropped samples: the orders are chosen on the longest stretch between
+    // them (the lagged regressors must not reach across a gap)
+    let rec = recording::load_allowing_gaps(&a.input, &a.recording)?;
+    let part = rec.longest_segment();
     let search = OrderSearch {
         na: range("na", &a.na)?,
         nb: range("nb", &a.nb)?,
@@ -37,13 +40,39 @@ pub fn run(a: &OrderArgs) -> Result<()> {
         validation_fraction: a.validation,
         ..OrderSearch::default()
     };
-    let sel = select_order(rec.command(), rec.position(), rec.dt(), &search)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?;
+    let (u, y) = (&rec.command()[part.clone()], &rec.position()[part.clone()]);
+    let stretch = if rec.gaps().is_empty() {
+        None
+    } else {
+        Some(format!(
+            "the longest stretch between dropped samples: samples {}..{} ({} of {}; {} gap(s), {} sample(s) missing)",
+            part.start,
+            part.end,
+            part.len(),
+            rec.len(),
+            rec.gaps().len(),
+            rec.missing_samples()
+        ))
+    };
+    let sel = select_order(u, y, rec.dt(), &search).map_err(|e| match &stretch {
+        Some(s) => anyhow::anyhow!("{}: on {s}: {e}", a.input.display()),
+        None => anyhow::anyhow!("{}: {e}", a.input.display()),
+    })?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&sel)?);
+        let mut v = serde_json::to_value(&sel)?;
+        if let Some(obj) = v.as_object_mut() {
+            obj.insert("first_sample".into(), part.start.into());
+            obj.insert("samples_used".into(), part.len().into());
+            obj.insert("samples".into(), rec.len().into());
+            obj.insert("gaps".into(), rec.gaps().len().into());
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
     println!("{}", a.input.display());
+    if let Some(s) = &stretch {
+        println!("orders chosen on {s}");
+    }
     println!("{}", sel.table);
     println!("FROLS terms in order of selection (error reduction ratio, cumulative):");
     let mut total = 0.0;

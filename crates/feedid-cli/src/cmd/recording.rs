@@ -69,13 +69,9 @@ pub fn read_signals(
     Ok(read_recording_with_progress(path, &opts, Some(progress))?)
 }
 
-/// Read and check a recording; its plausibility warnings go to standard error.
-pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
-    Ok(load_checked(path, a)?.0)
-}
-
-/// [`load`], with dropped samples accepted as gaps (for a description of
-/// the recording, which names them).
+/// Read and check a recording (plausibility warnings to standard error),
+/// with dropped samples accepted as gaps (for the commands that
+/// describe them, restart after them or use the longest stretch between them).
 pub fn load_allowing_gaps(path: &Path, a: &RecordingArgs) -> Result<Recording> {
     Ok(load_checked_with(path, a, true)?.0)
 }

@@ -85,7 +85,8 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     let mut outs = vec![a.output.as_path()];
     outs.extend(a.plot.as_deref());
     check_distinct(&[a.input.as_path()], &outs)?;
-    let rec = recording::load(&a.input, &a.recording)?;
+    // dropped samples: every combination restarts after each gap (as `identify`)
+    let rec = recording::load_allowing_gaps(&a.input, &a.recording)?;
     let cfg = SweepConfig {
         methods,
         windows,

@@ -11,7 +11,10 @@
 //! ```
 //!
 //! on, which every combination could predict; `rms_common_m` over them is
-//! what the best choice and the heat map use. Combinations that cannot run
+//! what the best choice and the heat map use. A recording with dropped
+//! samples ([`Recording::gaps`]) is run segment by segment (the engine
+//! restarts at every gap), a combination runs if it fits the longest
+//! segment, and the common samples are those from `k₀` on in each segment. Combinations that cannot run
 //! (a window longer than the recording) are rows with an error message and
 //! no numbers, never NaN.
 //!
@@ -123,8 +126,11 @@ impl SweepRow {
 pub struct SweepResult {
     /// One row per combination, in the order method, order, horizon, window.
     pub rows: Vec<SweepRow>,
-    /// First sample of the common samples, `k₀`.
+    /// First sample of the common samples, `k₀` (of each segment between
+    /// dropped samples: `k₀` samples after its start).
     pub common_start: usize,
+    /// Gaps of dropped samples in the recording (0 for a regular one).
+    pub gaps: usize,
     /// Samples in the recording.
     pub samples: usize,
     /// Sampling rate \[Hz\].
@@ -200,16 +206,25 @@ pub fn sweep(
             }
         }
     }
-    let n = recording.len();
+    // with dropped samples the engine restarts at every gap: a combination
+    // runs if it fits the longest segment, and the common samples are those
+    // from k₀ on in each segment
+    let longest = recording.longest_segment().len();
+    let segments = recording.segments();
     let signals = recording.signals();
     // k₀ over the runnable combinations
     let mut common_start = 0;
     for c in &combos {
         let warm = c.method.build()?.warm_up();
-        if c.engine.validate(n, warm).is_ok() {
+        if c.engine.validate(longest, warm).is_ok() {
             common_start = common_start.max(warm + c.engine.window);
         }
     }
+    let common: Vec<std::ops::Range<usize>> = segments
+        .iter()
+        .map(|s| (s.start + common_start).min(s.end)..s.end)
+        .filter(|r| !r.is_empty())
+        .collect();
     let total = combos.len();
     let done = AtomicUsize::new(0);
     progress(0, total);
@@ -239,9 +254,9 @@ pub fn sweep(
             match outcome {
                 Ok(res) => {
                     let mut acc = ErrorAccumulator::default();
-                    for (k, &yk) in y.iter().enumerate().skip(common_start) {
+                    for k in common.iter().flat_map(|r| r.clone()) {
                         if let Some(p) = res.prediction(k) {
-                            acc.push(yk, p);
+                            acc.push(y[k], p);
                         }
                     }
                     let common = acc.finish();
@@ -267,7 +282,8 @@ pub fn sweep(
     Ok(SweepResult {
         rows,
         common_start,
-        samples: n,
+        gaps: recording.gaps().len(),
+        samples: recording.len(),
         rate_hz: recording.rate_hz(),
     })
 }
@@ -379,12 +395,25 @@ impl SweepResult {
             0.0
         };
         let um = |v: f64| format!("{} µm", sig3(1e6 * v));
-        let _ = writeln!(
-            s,
-            "errors are rms over the samples every combination predicts (from sample {}, {:.1} ms)",
-            self.common_start,
-            self.common_start as f64 * dt_ms
-        );
+        if self.gaps == 0 {
+            let _ = writeln!(
+                s,
+                "errors are rms over the samples every combination predicts (from sample {}, {:.1} ms)",
+                self.common_start,
+                self.common_start as f64 * dt_ms
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "errors are rms over the samples every combination predicts (from sample {}, {:.1} ms, \
+                 of each of the {} segments between the {} gap(s) of dropped samples, where every \
+                 combination starts again)",
+                self.common_start,
+                self.common_start as f64 * dt_ms,
+                self.gaps + 1,
+                self.gaps
+            );
+        }
         for hz in self.horizon_list() {
             if let Some(b) = self.best_for_horizon(hz) {
                 let _ = writeln!(
@@ -481,6 +510,66 @@ mod tests {
             horizons: vec![5, 10],
             orders: vec![ArxOrders::new(2, 2, 1), ArxOrders::new(4, 4, 1)],
             hop: None,
+        }
+    }
+
+    #[test]
+    fn with_dropped_samples_every_combination_restarts_and_is_scored_in_each_segment() {
+        let full = ramp();
+        let keep: Vec<usize> = (0..full.len())
+            .filter(|&k| k != 250 && !(400..403).contains(&k))
+            .collect();
+        let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+        let rec = Recording::allowing_gaps(
+            pick(full.time()),
+            pick(full.command()),
+            pick(full.position()),
+            0.05,
+        )
+        .unwrap();
+        assert_eq!(rec.gaps().len(), 2);
+        let cfg = SweepConfig {
+            methods: vec!["paper".parse().unwrap()],
+            windows: vec![20, 40],
+            horizons: vec![10],
+            orders: vec![],
+            hop: None,
+        };
+        let res = sweep(&rec, &cfg, &|_, _| {}).unwrap();
+        assert_eq!((res.gaps, res.samples), (2, rec.len()));
+        assert!(res
+            .summary_text()
+            .contains("3 segments between the 2 gap(s)"));
+        let k0 = res.common_start;
+        assert_eq!(k0, 40);
+        // each segment run as a recording of its own, scored from k₀ in it
+        for row in &res.rows {
+            let (mut sum, mut count) = (0.0, 0usize);
+            for seg in rec.segments() {
+                let part = rec.slice(seg).unwrap();
+                let mut est = cfg.methods[0].build().unwrap();
+                let engine = EngineConfig {
+                    window: row.window,
+                    horizon: 10,
+                    hop: None,
+                    warm_up: 0,
+                };
+                let r = run_engine(est.as_mut(), &part.signals(), &engine).unwrap();
+                for k in k0..part.len() {
+                    if let Some(p) = r.prediction(k) {
+                        sum += (part.position()[k] - p).powi(2);
+                        count += 1;
+                    }
+                }
+            }
+            assert!(count > 400, "{count}");
+            let want = (sum / count as f64).sqrt();
+            assert!(
+                (row.rms_common_m / want - 1.0).abs() < 1e-12,
+                "W={}: {} vs {want}",
+                row.window,
+                row.rms_common_m
+            );
         }
     }
 

@@ -414,16 +414,14 @@ fn check_signals(u: &[f64], y: &[f64], dt: f64, needed: usize) -> Result<()> {
     Ok(())
 }
 
+/// A start of the output-error refinement: the structure and its scaled parameters.
+type Start = (Structure, Vec<f64>);
+
 /// Starts of the output-error refinement: scaled parameters and their
 /// structure (SRIVC or the user model), stable and rescaled, the preferred
 /// one first (more than one only when SRIVC cycled: see
 /// [`super::srivc::SrivcEstimate::alternatives`]); and SRIVC's iterations.
-fn initial_estimate(
-    u: &[f64],
-    y: &[f64],
-    dt: f64,
-    cfg: &OeConfig,
-) -> Result<(Vec<(Structure, Vec<f64>)>, usize)> {
+fn initial_estimate(u: &[f64], y: &[f64], dt: f64, cfg: &OeConfig) -> Result<(Vec<Start>, usize)> {
     let omega0 = cfg.time_scale.unwrap_or(0.1 * std::f64::consts::PI / dt);
     let st0 = Structure {
         n: cfg.poles,

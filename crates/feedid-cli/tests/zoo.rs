@@ -108,13 +108,42 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
     let rows = std::fs::read_to_string(&p).unwrap().lines().count() - 1;
     assert_eq!(rows, samples);
     assert!(j["coverage_percent"].as_f64().unwrap() > 80.0, "{j}");
-    // `info` names the gaps; a command that needs uniform sampling refuses
-    // the file and says where to go
+    // `info` names the gaps
     let o = feedid(&["info", f.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("gaps        2"), "{}", stdout(&o));
-    let o = feedid(&["greybox", f.to_str().unwrap(), "--estimate", "kv"]);
-    assert_fails(&o, &["zoo-215.csv", "missing", "`feedid identify`"]);
+    // `greybox` simulates through the gaps and compares the measured samples
+    let gs = dir.path().join("g.json");
+    let o = feedid(&[
+        "greybox",
+        f.to_str().unwrap(),
+        "--estimate",
+        "kv",
+        "--summary",
+        gs.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("2 gap(s) of dropped samples (5 missing)"),
+        "{}",
+        stdout(&o)
+    );
+    let g: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&gs).unwrap()).unwrap();
+    assert_eq!(g["gaps"].as_u64(), Some(2));
+    assert_eq!(g["residuals"].as_u64(), Some(samples as u64));
+    // its tracking over windows does not, and says so
+    let o = feedid(&[
+        "greybox",
+        f.to_str().unwrap(),
+        "--estimate",
+        "kv",
+        "--track-window",
+        "0.05",
+        "--track-out",
+        dir.path().join("t.csv").to_str().unwrap(),
+    ]);
+    assert_fails(&o, &["zoo-215.csv", "--track-window", "dropped samples"]);
     // `order` chooses on the longest stretch between the gaps and says which
     let o = feedid(&["order", f.to_str().unwrap(), "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -399,8 +399,8 @@ fn missing_note(missing: usize) -> String {
         m => format!(
             "; the interval spans {} sampling intervals: {m} sample{} missing (dropped by the \
              acquisition?); this needs uniform sampling — cut the recording there; `feedid \
-             identify`, `feedid report`, `feedid sweep` and `feedid stream` restart their \
-             windows at such a gap, `feedid order` uses the longest stretch between gaps",
+             identify`, `report`, `sweep` and `stream` restart their windows at such a gap, \
+             `order` uses the longest stretch between gaps and `greybox` simulates through it",
             m + 1,
             if m == 1 { " looks" } else { "s look" }
         ),

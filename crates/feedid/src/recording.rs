@@ -328,6 +328,50 @@ impl<S: AsRef<[f64]>> Recording<S> {
         segments(self.len(), self.gap_starts())
     }
 
+    /// The index of every sample on the regular time grid through the gaps
+    /// (`k` itself without gaps; the samples after a gap of `m` dropped ones
+    /// move `m` on): the grid has `len() + missing_samples()` samples.
+    pub fn grid_indices(&self) -> Vec<usize> {
+        let mut out = Vec::with_capacity(self.len());
+        let mut shift = 0;
+        let mut gaps = self.gaps.iter().peekable();
+        for k in 0..self.len() {
+            if let Some(g) = gaps.next_if(|g| g.index == k) {
+                shift += g.missing;
+            }
+            out.push(k + shift);
+        }
+        out
+    }
+
+    /// `values` (one per sample of the recording: a channel) on the regular
+    /// time grid through the gaps ([`Recording::grid_indices`]), the dropped
+    /// samples interpolated linearly between their neighbours (for a planned
+    /// command, what it was there). [`Error::LengthMismatch`] if `values`
+    /// has not one value per sample.
+    pub fn fill_gaps(&self, values: &[f64]) -> Result<Vec<f64>> {
+        if values.len() != self.len() {
+            return Err(Error::LengthMismatch {
+                what: "channel to place on the regular grid",
+                expected: self.len(),
+                actual: values.len(),
+            });
+        }
+        let mut grid = Vec::with_capacity(values.len() + self.missing_samples());
+        let mut gaps = self.gaps.iter().peekable();
+        for (k, &v) in values.iter().enumerate() {
+            if let Some(g) = gaps.next_if(|g| g.index == k) {
+                let before = values[k - 1];
+                for i in 1..=g.missing {
+                    let f = i as f64 / (g.missing + 1) as f64;
+                    grid.push(before + f * (v - before));
+                }
+            }
+            grid.push(v);
+        }
+        Ok(grid)
+    }
+
     /// The longest segment (the first of equal ones).
     pub fn longest_segment(&self) -> std::ops::Range<usize> {
         self.segments()
@@ -769,7 +813,7 @@ mod tests {
                 other => panic!("unexpected {other}"),
             }
             let text = e.to_string();
-            assert_eq!(text.contains("feedid stream"), missing > 0, "{text}");
+            assert_eq!(text.contains("`stream` restart"), missing > 0, "{text}");
             if missing == 1 {
                 assert!(text.contains("1 sample looks missing"), "{text}");
             }
@@ -802,12 +846,36 @@ mod tests {
         let g: Vec<(usize, usize)> = s.gaps().iter().map(|g| (g.index, g.missing)).collect();
         assert_eq!(g, [(11, 1), (29, 3)]);
         assert_eq!(r.slice(21..39).unwrap().gaps(), &[]);
+        // the regular grid through the gaps: each sample where its time puts
+        // it, a channel linear across the gaps (the time itself, here)
+        let grid = r.grid_indices();
+        assert_eq!(grid.len(), n);
+        for (k, &i) in grid.iter().enumerate() {
+            assert!((tt[k] - (5.0 + i as f64 * 1e-3)).abs() < 1e-9, "{k} {i}");
+        }
+        let full = r.fill_gaps(&tt).unwrap();
+        assert_eq!(full.len(), 60);
+        for (i, &t) in full.iter().enumerate() {
+            assert!((t - (5.0 + i as f64 * 1e-3)).abs() < 1e-9, "{i}");
+        }
+        assert!(r.fill_gaps(&tt[1..]).is_err());
+        assert_eq!(
+            r.slice(0..21).unwrap().grid_indices(),
+            (0..21).collect::<Vec<_>>()
+        );
         // without gaps allowed: the jitter error names the missing sample
         let e = Recording::new(tt.clone(), u.clone(), u.clone()).unwrap_err();
         assert!(
             matches!(e, Error::SamplingJitter { missing: 1 | 3, .. }),
             "{e}"
         );
+        // and says which commands read it anyway
+        let m = e.to_string();
+        assert!(
+            m.contains("`feedid identify`, `report`, `sweep` and `stream` restart"),
+            "{m}"
+        );
+        assert!(m.contains("`greybox` simulates through it"), "{m}");
         // an interval that is not a whole number of intervals stays an error,
         // and so does jitter within a segment
         for (k, dt) in [(30, 0.5e-3), (10, 0.05e-3)] {

@@ -80,7 +80,18 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             (fit, None)
         }
         (None, Some(input)) => {
+            // dropped samples: the simulation runs through them on the
+            // regular grid (the command interpolated there) and only the
+            // measured samples are compared
             let (rec, warnings) = recording::load_checked(input, &a.recording)?;
+            if !rec.gaps().is_empty() && a.track_window.is_some() {
+                bail!(
+                    "{}: --track-window needs a recording without dropped samples ({} gap(s), the first before sample {}); fit the whole recording without it",
+                    input.display(),
+                    rec.gaps().len(),
+                    rec.gaps()[0].index
+                );
+            }
             context.insert("warnings".into(), warnings.into());
             let current = match &a.current {
                 Some(name) => Some(
@@ -100,9 +111,31 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                 ),
                 None => None,
             };
-            let mut data = Measurements::new(rec.command(), rec.position(), rec.dt());
+            let gapped = !rec.gaps().is_empty();
+            let fill = |v: &[f64]| -> Result<Vec<f64>> {
+                Ok(if gapped {
+                    rec.fill_gaps(v)?
+                } else {
+                    Vec::new()
+                })
+            };
+            let (command, position) = (fill(rec.command())?, fill(rec.position())?);
+            let current_grid = current.map(fill).transpose()?;
+            let measured = if gapped {
+                rec.grid_indices()
+            } else {
+                Vec::new()
+            };
+            let mut data = if gapped {
+                Measurements::new(&command, &position, rec.dt()).with_measured(&measured)
+            } else {
+                Measurements::new(rec.command(), rec.position(), rec.dt())
+            };
             if let Some(c) = current {
-                data = data.with_current(c);
+                data = data.with_current(match &current_grid {
+                    Some(g) if gapped => g,
+                    _ => c,
+                });
             }
             let bar = ProgressBar::new("greybox", "fits");
             let update = |done: u64, total: u64| bar.update(done, total);
@@ -123,8 +156,19 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                 position_loop.name(),
                 if current.is_some() { ", current" } else { "" }
             );
+            if gapped {
+                let _ = writeln!(
+                    text,
+                    "{} gap(s) of dropped samples ({} missing): the model runs through them on the command interpolated there; only the {} measured samples are compared",
+                    rec.gaps().len(),
+                    rec.missing_samples(),
+                    rec.len()
+                );
+            }
             context.insert("input".into(), input.display().to_string().into());
             context.insert("samples".into(), rec.len().into());
+            context.insert("gaps".into(), rec.gaps().len().into());
+            context.insert("missing_samples".into(), rec.missing_samples().into());
             context.insert("rate_hz".into(), rec.rate_hz().into());
             context.insert(
                 "dynamics".into(),

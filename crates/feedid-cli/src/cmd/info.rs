@@ -9,7 +9,7 @@ use crate::cmd::recording;
 /// Print samples, duration, rate and jitter, channel ranges and motion segments.
 pub fn run(a: &InfoArgs) -> Result<()> {
     // the gaps of dropped samples are described, not refused
-    let rec = recording::load_allowing_gaps(&a.input, &a.recording)?;
+    let rec = recording::load(&a.input, &a.recording)?;
     let info = recording_info(&rec);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&info)?);

@@ -30,7 +30,7 @@ fn range(name: &str, s: &str) -> Result<(usize, usize)> {
 pub fn run(a: &OrderArgs) -> Result<()> {
     // dropped samples: the orders are chosen on the longest stretch between
     // them (the lagged regressors must not reach across a gap)
-    let rec = recording::load_allowing_gaps(&a.input, &a.recording)?;
+    let rec = recording::load(&a.input, &a.recording)?;
     let part = rec.longest_segment();
     let search = OrderSearch {
         na: range("na", &a.na)?,

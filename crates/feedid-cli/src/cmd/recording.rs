@@ -69,29 +69,19 @@ pub fn read_signals(
     Ok(read_recording_with_progress(path, &opts, Some(progress))?)
 }
 
-/// Read and check a recording (plausibility warnings to standard error),
-/// with dropped samples accepted as gaps (for the commands that
-/// describe them, restart after them or use the longest stretch between them).
-pub fn load_allowing_gaps(path: &Path, a: &RecordingArgs) -> Result<Recording> {
-    Ok(load_checked_with(path, a, true)?.0)
+/// [`load_checked`] without the warnings.
+pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
+    Ok(load_checked(path, a)?.0)
 }
 
 /// Read and check a recording; its plausibility warnings
 /// (`feedid::plausibility`) go to standard error and are returned for the
-/// summaries.
+/// summaries. Dropped samples are accepted as gaps ([`Recording::gaps`]):
+/// every command that reads a recording handles them (restarting its
+/// windows, using the longest stretch, or simulating through them).
 pub fn load_checked(path: &Path, a: &RecordingArgs) -> Result<(Recording, Vec<String>)> {
-    load_checked_with(path, a, false)
-}
-
-/// [`load_checked`]; `allow_gaps`: dropped samples accepted as gaps (for the
-/// commands that restart their windows after a gap).
-pub fn load_checked_with(
-    path: &Path,
-    a: &RecordingArgs,
-    allow_gaps: bool,
-) -> Result<(Recording, Vec<String>)> {
     let opts = ReadOptions {
-        allow_gaps,
+        allow_gaps: true,
         ..read_options(a)?
     };
     let rec = read_recording(path, &opts)?;

@@ -28,7 +28,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     check_distinct(&ins, &[a.output.as_path()])?;
     let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     // dropped samples: the methods restart after each gap (as `identify`)
-    let (rec, warnings) = recording::load_checked_with(&a.input, &a.recording, true)?;
+    let (rec, warnings) = recording::load_checked(&a.input, &a.recording)?;
     let methods = methods
         .into_iter()
         .map(|m| {

@@ -86,7 +86,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     outs.extend(a.plot.as_deref());
     check_distinct(&[a.input.as_path()], &outs)?;
     // dropped samples: every combination restarts after each gap (as `identify`)
-    let rec = recording::load_allowing_gaps(&a.input, &a.recording)?;
+    let rec = recording::load(&a.input, &a.recording)?;
     let cfg = SweepConfig {
         methods,
         windows,

@@ -226,7 +226,8 @@ fn write_members(zoo: &Zoo, specs: &[MemberSpec], dir: &Path) -> Result<()> {
         outputs.add(&path, move |w| w.write_all(&text))?;
     }
     // every spec with `file` (its CSV, relative to the manifest) and
-    // `readable` (false for dropped rows: `feedid identify` refuses those)
+    // `readable` (false for dropped rows: not uniformly sampled; read with
+    // their gaps, see "Dropped samples" in the README)
     let entries = specs
         .iter()
         .map(|s| {

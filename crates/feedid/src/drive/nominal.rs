@@ -24,22 +24,8 @@ pub fn simulate_nominal_recording<S: AsRef<[f64]>>(
     if rec.gaps().is_empty() {
         return simulate_nominal(params, c, rec.dt());
     }
-    let mut grid = Vec::with_capacity(c.len() + rec.missing_samples());
-    let mut measured = Vec::with_capacity(c.len());
-    let mut gaps = rec.gaps().iter().peekable();
-    for (k, &v) in c.iter().enumerate() {
-        if let Some(g) = gaps.next_if(|g| g.index == k) {
-            let before = c[k - 1];
-            for i in 1..=g.missing {
-                let f = i as f64 / (g.missing + 1) as f64;
-                grid.push(before + f * (v - before));
-            }
-        }
-        measured.push(grid.len());
-        grid.push(v);
-    }
-    let sim = simulate_nominal(params, &grid, rec.dt())?;
-    Ok(measured.into_iter().map(|i| sim[i]).collect())
+    let sim = simulate_nominal(params, &rec.fill_gaps(c)?, rec.dt())?;
+    Ok(rec.grid_indices().into_iter().map(|i| sim[i]).collect())
 }
 
 /// Simulate the nominal linear closed loop on a sampled `command` \[m\] with

@@ -377,6 +377,11 @@ pub struct Measurements<'a> {
     pub current: Option<&'a [f64]>,
     /// Sample interval \[s\].
     pub dt: f64,
+    /// The samples that were measured, ascending (`None`: all). The others
+    /// were dropped by the acquisition: the simulation runs through them on
+    /// the command given there (interpolated, [`crate::Recording::fill_gaps`]),
+    /// and their position and current are not compared.
+    pub measured: Option<&'a [usize]>,
 }
 
 impl<'a> Measurements<'a> {
@@ -387,6 +392,22 @@ impl<'a> Measurements<'a> {
             position,
             current: None,
             dt,
+            measured: None,
+        }
+    }
+
+    /// Only the samples `measured` (ascending indices) are compared; the
+    /// others were dropped (see [`Measurements::measured`]).
+    pub fn with_measured(mut self, measured: &'a [usize]) -> Self {
+        self.measured = Some(measured);
+        self
+    }
+
+    /// The compared samples: [`Measurements::measured`] or all.
+    fn rows(&self) -> Vec<usize> {
+        match self.measured {
+            Some(m) => m.to_vec(),
+            None => (0..self.command.len()).collect(),
         }
     }
 
@@ -398,6 +419,24 @@ impl<'a> Measurements<'a> {
 
     fn check(&self, needed: usize) -> Result<()> {
         check_signals(self.command, self.position, self.dt, needed)?;
+        if let Some(m) = self.measured {
+            if m.len() < needed {
+                return Err(Error::TooFewSamples {
+                    what: "measured samples for the grey-box fit",
+                    needed,
+                    actual: m.len(),
+                });
+            }
+            if m.windows(2).any(|w| w[0] >= w[1])
+                || m.last().is_some_and(|&k| k >= self.command.len())
+            {
+                return Err(Error::InvalidParameter {
+                    name: "measured samples",
+                    value: m.len() as f64,
+                    reason: "must be ascending indices of the samples",
+                });
+            }
+        }
         if let Some(c) = self.current {
             check_signals(self.command, c, self.dt, needed).map_err(|e| match e {
                 Error::NonFinite { index, value, .. } => Error::NonFinite {
@@ -427,6 +466,8 @@ struct Problem<'a> {
     model: PhysicalModel,
     sim_position: Vec<f64>,
     sim_current: Vec<f64>,
+    /// The compared samples (all but the dropped ones).
+    rows: Vec<usize>,
     /// Weights of the position and current residuals.
     weights: (f64, f64),
     penalty: f64,
@@ -435,7 +476,7 @@ struct Problem<'a> {
 
 impl Problem<'_> {
     fn residuals(&self) -> usize {
-        self.data.command.len() * if self.data.current.is_some() { 2 } else { 1 }
+        self.rows.len() * if self.data.current.is_some() { 2 } else { 1 }
     }
 
     fn eval(&mut self, theta: &[f64], r: &mut [f64]) {
@@ -447,7 +488,7 @@ impl Problem<'_> {
             &mut self.model.params,
             &mut self.model.effects,
         );
-        let m = self.data.command.len();
+        let m = self.rows.len();
         let current = self.data.current.map(|_| &mut self.sim_current[..]);
         match self.model.simulate_channels(
             self.data.command,
@@ -457,12 +498,14 @@ impl Problem<'_> {
         ) {
             Ok(()) => {
                 let (wy, wi) = self.weights;
-                for ((ri, s), y) in r.iter_mut().zip(&self.sim_position).zip(self.data.position) {
-                    *ri = wy * (s - y);
+                let (sy, y) = (&self.sim_position, self.data.position);
+                for (ri, &k) in r.iter_mut().zip(&self.rows) {
+                    *ri = wy * (sy[k] - y[k]);
                 }
                 if let Some(c) = self.data.current {
-                    for ((ri, s), y) in r[m..].iter_mut().zip(&self.sim_current).zip(c) {
-                        *ri = wi * (s - y);
+                    let si = &self.sim_current;
+                    for (ri, &k) in r[m..].iter_mut().zip(&self.rows) {
+                        *ri = wi * (si[k] - c[k]);
                     }
                 }
             }
@@ -473,13 +516,16 @@ impl Problem<'_> {
     /// Unweighted rms of the position and current residuals at the last evaluation.
     fn channel_rms(&self) -> (f64, Option<f64>) {
         let e: Vec<f64> = self
-            .sim_position
+            .rows
             .iter()
-            .zip(self.data.position)
-            .map(|(s, y)| s - y)
+            .map(|&k| self.sim_position[k] - self.data.position[k])
             .collect();
         let ei = self.data.current.map(|c| {
-            let d: Vec<f64> = self.sim_current.iter().zip(c).map(|(s, y)| s - y).collect();
+            let d: Vec<f64> = self
+                .rows
+                .iter()
+                .map(|&k| self.sim_current[k] - c[k])
+                .collect();
             crate::stats::rms(&d)
         });
         (crate::stats::rms(&e), ei)
@@ -556,6 +602,7 @@ pub fn fit_greybox_with_progress(
         },
         sim_position: vec![0.0; len],
         sim_current: vec![0.0; if data.current.is_some() { len } else { 0 }],
+        rows: data.rows(),
         weights: if data.current.is_some() {
             (1.0 / y_scale, 1.0 / i_scale)
         } else {
@@ -683,13 +730,16 @@ pub fn fit_greybox_with_progress(
     // structure left in the residuals; not measured when the fit is exact to
     // within EXACT_FIT of the signal (integration or rounding differences,
     // which cannot bias an estimate by more than about that share)
+    // (with dropped samples: the residuals of the measured ones in a row,
+    // a lag off by the few dropped samples across each gap)
+    let rows = prob.rows.len();
     let mut structure = Vec::new();
     if rms_y > EXACT_FIT * y_scale {
-        structure.extend(residual_structure("position", &r[..len]));
+        structure.extend(residual_structure("position", &r[..rows]));
     }
     if let (Some(ri), true) = (rms_i, data.current.is_some()) {
         if ri > EXACT_FIT * i_scale {
-            structure.extend(residual_structure("current", &r[len..]));
+            structure.extend(residual_structure("current", &r[rows..]));
         }
     }
     // feed-forward left out? (only asked when the model has none)
@@ -698,13 +748,14 @@ pub fn fit_greybox_with_progress(
         && !estimate.iter().any(|p| p.is_feed_forward());
     let missing = if no_feed_forward && rms_y > EXACT_FIT * y_scale {
         let position_jacobian: Vec<f64> = (0..n)
-            .flat_map(|j| jac[j * m..j * m + len].iter().copied())
+            .flat_map(|j| jac[j * m..j * m + rows].iter().copied())
             .collect();
         missing_feed_forward(
             &prob.model,
             data.command,
             data.dt,
-            &r[..len],
+            &prob.rows,
+            &r[..rows],
             &position_jacobian,
             prob.weights.0,
         )?
@@ -737,10 +788,9 @@ pub fn fit_greybox_with_progress(
         }
     }
     let stats = ErrorStats::from_pairs(
-        data.position
+        prob.rows
             .iter()
-            .copied()
-            .zip(prob.sim_position.iter().copied()),
+            .map(|&k| (data.position[k], prob.sim_position[k])),
     );
     let mut params = *start;
     let mut effects = cfg.effects;
@@ -838,6 +888,67 @@ mod tests {
             .simulate(&u, DT)
             .unwrap();
         (u, y)
+    }
+
+    #[test]
+    fn dropped_samples_are_simulated_through_and_not_compared() {
+        // the samples 1200..1203 and 3000 dropped: whatever the position
+        // holds there (garbage here) the estimates are exact, and only the
+        // measured samples count
+        let set = [Kv, Kp, Ki, C2, M];
+        let truth = RigParams::default();
+        let (u, mut y) = linear_data(Scenario::Chirp, 1.0);
+        let dropped = [1200, 1201, 1202, 3000];
+        for &k in &dropped {
+            y[k] += 1.0;
+        }
+        let measured: Vec<usize> = (0..u.len()).filter(|k| !dropped.contains(k)).collect();
+        let start = perturbed(&set, &[1.2, 0.8, 1.25, 0.7, 1.3]);
+        let data = Measurements::new(&u, &y, DT).with_measured(&measured);
+        let fit = fit_greybox(&data, &start, &set, &GreyboxConfig::default()).unwrap();
+        let fx = RigEffects::default();
+        for (e, p) in fit.estimates.iter().zip(set) {
+            let want = p.get(&truth, &fx);
+            assert!(
+                (e.value / want - 1.0).abs() < 1e-6,
+                "{}: {} vs {want}",
+                e.name,
+                e.value
+            );
+        }
+        assert_eq!(fit.residuals, u.len() - dropped.len());
+        assert!(fit.residual_rms < 1e-12, "{}", fit.residual_rms);
+        // compared, the garbage would pull the estimates away
+        let all = fit_greybox(
+            &Measurements::new(&u, &y, DT),
+            &start,
+            &set,
+            &GreyboxConfig::default(),
+        )
+        .unwrap();
+        assert!(all.residual_rms > 1e-3, "{}", all.residual_rms);
+        // indices out of order or beyond the samples are refused
+        for bad in [vec![3, 2, 5], vec![0, u.len()]] {
+            let mut b = bad.clone();
+            b.extend(u.len() + 1..u.len() + 20);
+            let e = fit_greybox(
+                &Measurements::new(&u, &y, DT).with_measured(&b),
+                &start,
+                &set,
+                &GreyboxConfig::default(),
+            )
+            .unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    Error::InvalidParameter {
+                        name: "measured samples",
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+        }
     }
 
     #[test]

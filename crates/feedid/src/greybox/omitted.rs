@@ -73,12 +73,14 @@ fn residual_ss(a: &DMatrix<f64>, e: &DVector<f64>) -> f64 {
 /// The score test of the module doc for a fit of `model` (with the estimates
 /// in place and no feed-forward) to `command` sampled every `dt` \[s\]:
 /// `residual` the position residual (simulated − measured, any common
-/// weight), `jacobian` its derivatives by the estimated (log-)parameters,
-/// column-major, `residual.len()` rows. `None` when the residual is zero.
+/// weight) at the samples `rows` (the measured ones), `jacobian` its
+/// derivatives by the estimated (log-)parameters, column-major,
+/// `residual.len()` rows. `None` when the residual is zero.
 pub(crate) fn missing_feed_forward(
     model: &PhysicalModel,
     command: &[f64],
     dt: f64,
+    rows: &[usize],
     residual: &[f64],
     jacobian: &[f64],
     weight: f64,
@@ -94,7 +96,7 @@ pub(crate) fn missing_feed_forward(
         let mut with = *model;
         set(&mut with);
         let y = with.simulate(command, dt)?;
-        Ok(y.iter().zip(&base).map(|(a, b)| weight * (a - b)).collect())
+        Ok(rows.iter().map(|&k| weight * (y[k] - base[k])).collect())
     };
     let dv = direction(|p| p.params.control.kvff = 1.0)?;
     let da = direction(|p| p.params.control.kaff = 1.0)?;

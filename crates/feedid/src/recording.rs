@@ -254,6 +254,35 @@ impl<S: AsRef<[f64]>> Recording<S> {
         Ok(head)
     }
 
+    /// The recording without the samples `dropped` (indices, any order),
+    /// read with its gaps ([`Recording::allowing_gaps`], this recording's
+    /// jitter tolerance) as from an acquisition that lost them; without the
+    /// further channels. Errors: as [`Recording::allowing_gaps`] (e.g. more
+    /// gaps than a few dropped samples make).
+    ///
+    /// ```
+    /// use feedid::Recording;
+    /// let t: Vec<f64> = (0..100).map(|k| k as f64 * 1e-3).collect();
+    /// let rec = Recording::new(t.clone(), t.clone(), t).unwrap();
+    /// let lost = rec.dropping(&[40, 41]).unwrap();
+    /// assert_eq!((lost.len(), lost.gaps()[0].index, lost.gaps()[0].missing), (98, 40, 2));
+    /// ```
+    pub fn dropping(&self, dropped: &[usize]) -> Result<Recording> {
+        let keep = |v: &[f64]| -> Vec<f64> {
+            v.iter()
+                .enumerate()
+                .filter(|(k, _)| !dropped.contains(k))
+                .map(|(_, &x)| x)
+                .collect()
+        };
+        Recording::allowing_gaps(
+            keep(self.time()),
+            keep(self.command()),
+            keep(self.position()),
+            self.tolerance,
+        )
+    }
+
     /// Samples `range` (clamped to the recording) as a recording of its own,
     /// without the further channels, with the nominal interval of this one
     /// (one segment between gaps is a regular recording). Errors: fewer than

@@ -184,21 +184,12 @@ fn report_opens_with_the_answer_and_folds_the_diagnostics() {
 #[test]
 fn a_recording_with_dropped_samples_is_reported_segment_by_segment() {
     let full = ramp();
-    let keep: Vec<usize> = (0..full.len())
-        .filter(|&k| !(400..403).contains(&k))
-        .collect();
-    let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
-    let rec = Recording::allowing_gaps(
-        pick(full.time()),
-        pick(full.command()),
-        pick(full.position()),
-        0.01,
-    )
-    .unwrap();
+    let rec = full.dropping(&[400, 401, 402]).unwrap();
+    let grid = rec.grid_indices();
     let a = RecordingAnalysis::run("gapped.csv", rec, &opts()).unwrap();
     // the nominal model ran through the gap: as on the full recording
     let whole = RecordingAnalysis::run("full.csv", full, &opts()).unwrap();
-    for (i, &k) in keep.iter().enumerate() {
+    for (i, &k) in grid.iter().enumerate() {
         assert!((a.simulated[i] - whole.simulated[k]).abs() < 1e-12, "{k}");
     }
     // no method predicts the first window after the gap

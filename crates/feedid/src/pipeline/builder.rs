@@ -528,17 +528,7 @@ mod tests {
     #[test]
     fn dropped_samples_restart_the_windows_and_the_rig_runs_through_the_gaps() {
         let full = ramp();
-        let keep: Vec<usize> = (0..full.len())
-            .filter(|&k| !(300..303).contains(&k) && k != 520)
-            .collect();
-        let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
-        let rec = Recording::allowing_gaps(
-            pick(full.time()),
-            pick(full.command()),
-            pick(full.position()),
-            DEFAULT_JITTER_TOLERANCE,
-        )
-        .unwrap();
+        let rec = full.dropping(&[300, 301, 302, 520]).unwrap();
         let p = Pipeline::new("arx".parse().unwrap()).nominal(RigParams::default());
         let a = p.run(&rec).unwrap();
         // the engine's segments, the summary and the warning
@@ -575,7 +565,7 @@ mod tests {
         let whole =
             crate::drive::simulate_nominal(&RigParams::default(), full.command(), full.dt())
                 .unwrap();
-        for (i, &k) in keep.iter().enumerate() {
+        for (i, &k) in rec.grid_indices().iter().enumerate() {
             assert!(
                 (sim[i] - whole[k]).abs() <= 1e-12,
                 "{k}: {} vs {}",

@@ -515,18 +515,7 @@ mod tests {
 
     #[test]
     fn with_dropped_samples_every_combination_restarts_and_is_scored_in_each_segment() {
-        let full = ramp();
-        let keep: Vec<usize> = (0..full.len())
-            .filter(|&k| k != 250 && !(400..403).contains(&k))
-            .collect();
-        let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
-        let rec = Recording::allowing_gaps(
-            pick(full.time()),
-            pick(full.command()),
-            pick(full.position()),
-            0.05,
-        )
-        .unwrap();
+        let rec = ramp().dropping(&[250, 400, 401, 402]).unwrap();
         assert_eq!(rec.gaps().len(), 2);
         let cfg = SweepConfig {
             methods: vec!["paper".parse().unwrap()],

@@ -169,8 +169,13 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
         "50,100",
         "--methods",
         "arx",
+        "--plot",
+        dir.path().join("sw.svg").to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read_to_string(dir.path().join("sw.svg"))
+        .unwrap()
+        .contains("in each segment between dropped samples"));
     assert!(
         stdout(&o).contains("of each of the 3 segments between the 2 gap(s)"),
         "{}",

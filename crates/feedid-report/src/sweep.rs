@@ -20,8 +20,13 @@ pub fn sweep_heat_map(res: &SweepResult) -> HeatMap {
     };
     let mut h = HeatMap::new(
         &format!(
-            "Prediction rms error over the common samples (from {:.1} ms on)",
-            res.common_start as f64 * dt_ms
+            "Prediction rms error over the common samples (from {:.1} ms on{})",
+            res.common_start as f64 * dt_ms,
+            if res.gaps > 0 {
+                " in each segment between dropped samples"
+            } else {
+                ""
+            }
         ),
         "window W [samples]",
         "method",

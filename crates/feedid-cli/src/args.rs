@@ -20,7 +20,7 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// Identify over sliding windows and predict the next samples (restarting after dropped samples).
     Identify(Box<IdentifyArgs>),
-    /// Select ARX orders: FPE, AIC, AICc, BIC over a grid, and FROLS term selection (on the longest stretch between dropped samples).
+    /// Select ARX orders: FPE, AIC, AICc, BIC over a grid, and FROLS term selection (on the stretch between dropped samples where the command moves most).
     Order(Box<OrderArgs>),
     /// Run the paper's experiments (ramp and step) end to end on the virtual rig.
     Reproduce(ReproduceArgs),

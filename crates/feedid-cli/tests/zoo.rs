@@ -144,7 +144,9 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
         dir.path().join("t.csv").to_str().unwrap(),
     ]);
     assert_fails(&o, &["zoo-215.csv", "--track-window", "dropped samples"]);
-    // `order` chooses on the longest stretch between the gaps and says which
+    // `order` chooses on the stretch between the gaps where the command
+    // moves most (member 215 moves before its first gap and then stands)
+    // and says which
     let o = feedid(&["order", f.to_str().unwrap(), "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let j: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
@@ -154,7 +156,9 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
     assert!(used > 0 && used < samples, "{j}");
     let o = feedid(&["order", f.to_str().unwrap()]);
     assert!(
-        stdout(&o).contains("orders chosen on the longest stretch between dropped samples"),
+        stdout(&o).contains(
+            "orders chosen on the stretch between dropped samples where the command moves most: samples 0..409"
+        ),
         "{}",
         stdout(&o)
     );

@@ -400,7 +400,8 @@ fn missing_note(missing: usize) -> String {
             "; the interval spans {} sampling intervals: {m} sample{} missing (dropped by the \
              acquisition?); this needs uniform sampling — cut the recording there; `feedid \
              identify`, `report`, `sweep` and `stream` restart their windows at such a gap, \
-             `order` uses the longest stretch between gaps and `greybox` simulates through it",
+             `order` uses the stretch between gaps where the command moves most and `greybox` \
+             simulates through it",
             m + 1,
             if m == 1 { " looks" } else { "s look" }
         ),

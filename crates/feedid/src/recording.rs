@@ -409,6 +409,39 @@ impl<S: AsRef<[f64]>> Recording<S> {
             .unwrap_or(0..0)
     }
 
+    /// The segment in which the command moves the most (the largest range
+    /// of the command; of equal ranges the longest, then the first): the
+    /// stretch without gaps that order selection and the global models use
+    /// (the whole recording without gaps). A log that moves, loses a sample
+    /// and then dwells has its longest stretch at rest, where a model learns
+    /// nothing.
+    pub fn moving_segment(&self) -> std::ops::Range<usize> {
+        let c = self.command();
+        let range = |r: &std::ops::Range<usize>| {
+            let (lo, hi) = c[r.clone()]
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            if hi >= lo {
+                hi - lo
+            } else {
+                0.0
+            }
+        };
+        let mut best: Option<(std::ops::Range<usize>, f64)> = None;
+        for s in self.segments() {
+            let r = range(&s);
+            let better = best
+                .as_ref()
+                .map_or(true, |(b, br)| r > *br || (r == *br && s.len() > b.len()));
+            if better {
+                best = Some((s, r));
+            }
+        }
+        best.map_or(0..0, |(s, _)| s)
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.time().len()
@@ -864,6 +897,20 @@ mod tests {
         assert_eq!(r.missing_samples(), 4);
         assert_eq!(r.segments(), vec![0..21, 21..39, 39..n]);
         assert_eq!(r.longest_segment(), 0..21);
+        // a ramp moves most in its longest segment
+        assert_eq!(r.moving_segment(), 0..21);
+        let still = Recording::allowing_gaps(tt.clone(), vec![0.0; n], u.clone(), 0.01).unwrap();
+        assert_eq!(still.moving_segment(), 0..21, "no motion: the longest");
+        let mut step = vec![0.0; n];
+        for v in &mut step[21..25] {
+            *v = 1e-3;
+        }
+        let moved = Recording::allowing_gaps(tt.clone(), step, u.clone(), 0.01).unwrap();
+        assert_eq!(
+            moved.moving_segment(),
+            21..39,
+            "the short stretch that moves"
+        );
         // the nominal interval is that of the segments, not stretched by the gaps
         assert!((r.dt() - 1e-3).abs() < 1e-12, "{}", r.dt());
         assert!(r.max_jitter() < 1e-9);

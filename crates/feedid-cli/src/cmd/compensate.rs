@@ -81,7 +81,12 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             let file = crate::cmd::load_model_file(path)?;
             cfg.quality = match &a.check {
                 Some(check) => {
-                    let r = read_recording(check, &ReadOptions::default())?;
+                    // (dropped samples: the model runs through them)
+                    let opts = ReadOptions {
+                        allow_gaps: true,
+                        ..ReadOptions::default()
+                    };
+                    let r = read_recording(check, &opts)?;
                     ModelQuality::from_recording(&file.model, &r)
                         .map_err(|e| anyhow::anyhow!("{}: {e}", check.display()))?
                 }

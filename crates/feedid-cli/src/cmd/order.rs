@@ -28,10 +28,11 @@ fn range(name: &str, s: &str) -> Result<(usize, usize)> {
 
 /// Print the order table, the FROLS terms and the choice.
 pub fn run(a: &OrderArgs) -> Result<()> {
-    // dropped samples: the orders are chosen on the longest stretch between
-    // them (the lagged regressors must not reach across a gap)
+    // dropped samples: the orders are chosen on the stretch between them
+    // where the command moves most (lagged regressors must not reach across
+    // a gap, and a stretch at rest teaches nothing)
     let rec = recording::load(&a.input, &a.recording)?;
-    let part = rec.longest_segment();
+    let part = rec.moving_segment();
     let search = OrderSearch {
         na: range("na", &a.na)?,
         nb: range("nb", &a.nb)?,
@@ -45,7 +46,7 @@ pub fn run(a: &OrderArgs) -> Result<()> {
         None
     } else {
         Some(format!(
-            "the longest stretch between dropped samples: samples {}..{} ({} of {}; {} gap(s), {} sample(s) missing)",
+            "the stretch between dropped samples where the command moves most: samples {}..{} ({} of {}; {} gap(s), {} sample(s) missing)",
             part.start,
             part.end,
             part.len(),

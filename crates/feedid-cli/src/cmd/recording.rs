@@ -78,7 +78,7 @@ pub fn load(path: &Path, a: &RecordingArgs) -> Result<Recording> {
 /// (`feedid::plausibility`) go to standard error and are returned for the
 /// summaries. Dropped samples are accepted as gaps ([`Recording::gaps`]):
 /// every command that reads a recording handles them (restarting its
-/// windows, using the longest stretch, or simulating through them).
+/// windows, using one stretch between them, or simulating through them).
 pub fn load_checked(path: &Path, a: &RecordingArgs) -> Result<(Recording, Vec<String>)> {
     let opts = ReadOptions {
         allow_gaps: true,

@@ -217,12 +217,12 @@ impl RecordingAnalysis {
             match recording.gaps() {
                 [] => global_models(&recording, opts),
                 _ => {
-                    // on the longest stretch without dropped samples
-                    let part = recording.longest_segment();
+                    // on the stretch without dropped samples where the command moves most
+                    let part = recording.moving_segment();
                     let (global, mut notes) = global_models(&recording.slice(part.clone())?, opts);
                     notes.push(format!(
-                        "Global models: fitted and simulated on samples {} … {} only, the longest \
-                         stretch without dropped samples.",
+                        "Global models: fitted and simulated on samples {} … {} only, the stretch \
+                         without dropped samples where the command moves most.",
                         part.start,
                         part.end - 1
                     ));

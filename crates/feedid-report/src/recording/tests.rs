@@ -206,7 +206,7 @@ fn a_recording_with_dropped_samples_is_reported_segment_by_segment() {
     assert!(a
         .notes
         .iter()
-        .any(|n| n.contains("the longest stretch without dropped samples")));
+        .any(|n| n.contains("the stretch without dropped samples where the command moves most")));
     assert!(a
         .facts()
         .iter()

@@ -219,8 +219,8 @@ impl<'a> Pipeline<'a> {
                         applies_to: "arx, rls, auto",
                     });
                 }
-                // on the longest stretch without dropped samples
-                let part = recording.longest_segment();
+                // on the stretch without dropped samples where the command moves most
+                let part = recording.moving_segment();
                 let sel = select_order(
                     &recording.command()[part.clone()],
                     &recording.position()[part],
@@ -302,7 +302,7 @@ impl<'a> Pipeline<'a> {
                 first: g.index,
                 first_time_s: recording.time()[g.index],
                 unpredicted,
-                longest: recording.longest_segment().len(),
+                stretch: recording.moving_segment().len(),
             });
         }
         if sliding.stats.samples == 0 {
@@ -354,11 +354,12 @@ impl<'a> Pipeline<'a> {
             .global_model()
             .map(GlobalModelKind::for_summary)
             .filter(|_| self.method_global_model);
-        // global models on the longest stretch without dropped samples
+        // global models on the stretch without dropped samples where the
+        // command moves most
         let gapped = if recording.gaps().is_empty() {
             None
         } else {
-            Some(recording.slice(recording.longest_segment())?)
+            Some(recording.slice(recording.moving_segment())?)
         };
         let fit_global = |kind: &GlobalModelKind| match &gapped {
             Some(part) => fit_global_model(part, kind),
@@ -547,7 +548,7 @@ mod tests {
             .contains("2 gap(s) of dropped samples (4 missing)"));
         assert!(
             s.to_string()
-                .contains("on 300 samples of the longest stretch without dropped samples"),
+                .contains("on 300 samples of the stretch without dropped samples where"),
             "{s}"
         );
         assert!(a.warnings.iter().any(|w| matches!(
@@ -573,8 +574,8 @@ mod tests {
                 whole[k]
             );
         }
-        // the global model: on the longest segment, as said
-        assert_eq!(rec.longest_segment(), 0..300);
+        // the global model: on the segment where the command moves most, as said
+        assert_eq!(rec.moving_segment(), 0..300);
         assert_eq!(s.global_model_samples, Some(300));
     }
 

@@ -198,7 +198,10 @@ impl fmt::Display for IdentifySummary {
         if let (Some(m), Some(fit)) = (&self.global_model, self.global_fit_percent) {
             let share = match self.global_model_samples {
                 Some(n) if self.gaps > 0 => {
-                    format!(" on {n} samples of the longest stretch without dropped samples")
+                    format!(
+                        " on {n} samples of the stretch without dropped samples where the command \
+                         moves most"
+                    )
                 }
                 Some(n) if n < self.samples => format!(
                     " on the first {n} samples ({:.1} %)",

@@ -45,8 +45,8 @@ pub enum Warning {
     /// The recording has gaps of dropped samples
     /// ([`crate::Recording::gaps`]): the windows restarted after each, so
     /// the samples at the start of every later segment are not predicted;
-    /// order selection and global models use the longest stretch without
-    /// gaps.
+    /// order selection and global models use the stretch without gaps
+    /// where the command moves most ([`crate::Recording::moving_segment`]).
     DroppedSamples {
         /// Gaps.
         gaps: usize,
@@ -59,8 +59,9 @@ pub enum Warning {
         /// Samples of the later segments before their first prediction
         /// (not predicted because of the restarts).
         unpredicted: usize,
-        /// Samples in the longest stretch without gaps.
-        longest: usize,
+        /// Samples in the stretch without gaps that order selection and the
+        /// global models use.
+        stretch: usize,
     },
     /// Paper method with the window time origin: the output model
     /// `P5·τ⁵ + P6·τ⁶ + P7·τ⁷` is zero with its first four derivatives at each
@@ -133,14 +134,14 @@ impl fmt::Display for Warning {
                 first,
                 first_time_s,
                 unpredicted,
-                longest,
+                stretch,
             } => write!(
                 f,
                 "{missing} sample{} missing in {gaps} gap{} (dropped by the acquisition?; the \
                  first before sample {first}, t = {first_time_s} s): the windows restarted after \
                  each gap, as `feedid stream` does, so {unpredicted} samples at the start of the \
                  later segments are not predicted; order selection and global models use the \
-                 longest stretch without gaps ({longest} samples)",
+                 stretch without gaps where the command moves most ({stretch} samples)",
                 if *missing == 1 { " looks" } else { "s look" },
                 if *gaps == 1 { "" } else { "s" },
             ),

@@ -643,7 +643,8 @@ def compensate(
     check : Recording, Identification, path or (time, command, position), optional
         A recording of the axis on which the identified model's fits are
         measured for the fall-back (``--check``); default the model's own
-        fit. Identified models only.
+        fit. Identified models only. Dropped samples are read as gaps: the
+        model runs through them and only the measured samples are compared.
 
     Returns
     -------
@@ -676,10 +677,13 @@ def compensate(
     elif isinstance(check, Identification):
         check_rec = check.recording
     elif isinstance(check, (str, bytes, os.PathLike)):
-        check_rec = read(check)
+        # (dropped samples: the model runs through them, as ``--check``)
+        check_rec = read(check, allow_gaps=True)
     else:
         t, u, y = check
-        check_rec = Recording(_array(t, "time"), _array(u, "command"), _array(y, "position"))
+        check_rec = Recording(
+            _array(t, "time"), _array(u, "command"), _array(y, "position"), allow_gaps=True
+        )
     command, predicted, summary = _feedid.compensate(
         _array(time, "time"),
         _array(desired, "desired"),

@@ -183,3 +183,11 @@ def test_compensate_makes_the_model_follow_the_desired_trajectory():
     run = feedid.identify(rec, method="arx")
     out2 = feedid.compensate(t, desired, run)
     assert np.all(np.isfinite(out2["command"]))
+    # a check recording with dropped samples: the model runs through them
+    keep = np.ones(len(rec), dtype=bool)
+    keep[400:403] = False
+    gapped = tuple(np.array(v)[keep] for v in (rec.time, rec.command, rec.position))
+    full = feedid.compensate(t, desired, run, check=rec)
+    part = feedid.compensate(t, desired, run, check=gapped)
+    a, b = part["benefit"]["expected_benefit"], full["benefit"]["expected_benefit"]
+    assert abs(a / b - 1) < 0.02, (a, b)

@@ -132,7 +132,8 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
         serde_json::from_str(&std::fs::read_to_string(&gs).unwrap()).unwrap();
     assert_eq!(g["gaps"].as_u64(), Some(2));
     assert_eq!(g["residuals"].as_u64(), Some(samples as u64));
-    // its tracking over windows does not, and says so
+    // and tracks over windows between the gaps
+    let track = dir.path().join("t.csv");
     let o = feedid(&[
         "greybox",
         f.to_str().unwrap(),
@@ -141,9 +142,11 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
         "--track-window",
         "0.05",
         "--track-out",
-        dir.path().join("t.csv").to_str().unwrap(),
+        track.to_str().unwrap(),
     ]);
-    assert_fails(&o, &["zoo-215.csv", "--track-window", "dropped samples"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let windows = std::fs::read_to_string(&track).unwrap().lines().count() - 1;
+    assert!(windows > 10, "{windows}");
     // `order` chooses on the stretch between the gaps where the command
     // moves most (member 215 moves before its first gap and then stands)
     // and says which

@@ -84,14 +84,6 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
             // regular grid (the command interpolated there) and only the
             // measured samples are compared
             let (rec, warnings) = recording::load_checked(input, &a.recording)?;
-            if !rec.gaps().is_empty() && a.track_window.is_some() {
-                bail!(
-                    "{}: --track-window needs a recording without dropped samples ({} gap(s), the first before sample {}); fit the whole recording without it",
-                    input.display(),
-                    rec.gaps().len(),
-                    rec.gaps()[0].index
-                );
-            }
             context.insert("warnings".into(), warnings.into());
             let current = match &a.current {
                 Some(name) => Some(
@@ -201,9 +193,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                     let bar = ProgressBar::new("tracking", "windows");
                     let update = |done: u64, total: u64| bar.update(done, total);
                     let rows = track_greybox_with_progress(
-                        rec.command(),
-                        rec.position(),
-                        rec.dt(),
+                        &data,
                         &start_track,
                         &estimate,
                         &cfg,

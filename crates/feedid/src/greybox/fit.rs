@@ -404,7 +404,7 @@ impl<'a> Measurements<'a> {
     }
 
     /// The compared samples: [`Measurements::measured`] or all.
-    fn rows(&self) -> Vec<usize> {
+    pub(crate) fn rows(&self) -> Vec<usize> {
         match self.measured {
             Some(m) => m.to_vec(),
             None => (0..self.command.len()).collect(),
@@ -417,7 +417,7 @@ impl<'a> Measurements<'a> {
         self
     }
 
-    fn check(&self, needed: usize) -> Result<()> {
+    pub(crate) fn check(&self, needed: usize) -> Result<()> {
         check_signals(self.command, self.position, self.dt, needed)?;
         if let Some(m) = self.measured {
             if m.len() < needed {

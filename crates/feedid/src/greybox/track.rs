@@ -16,6 +16,11 @@
 //! the stiffness) keeps the previous window's estimates, reported as not
 //! excited and without standard errors.
 //!
+//! With dropped samples ([`super::Measurements::measured`]) the reference
+//! simulation runs on through them (on the command given there) and the
+//! windows lie between them: none contains a dropped sample; a window's
+//! `start`/`end` count the measured samples (the rows of the file).
+//!
 //! The nut position of a window is `geometry.nut_position` plus the mean
 //! measured position over the window (the virtual rig's convention: position
 //! 0 puts the nut at `geometry.nut_position`).
@@ -29,14 +34,15 @@
 //! let mut start = RigParams::default();
 //! start.control.kv = 650.0;
 //! let cfg = TrackConfig { window: 500, hop: 500, warm_up: 100, max_iterations: 30 };
-//! let rows = track_greybox(&u, &y, 2e-4, &start, &[PhysicalParameter::Kv], &Default::default(), &cfg).unwrap();
+//! let data = feedid::greybox::Measurements::new(&u, &y, 2e-4);
+//! let rows = track_greybox(&data, &start, &[PhysicalParameter::Kv], &Default::default(), &cfg).unwrap();
 //! assert_eq!(rows.len(), 4);
 //! assert!(rows.iter().all(|r| (r.values[0] - 700.0).abs() < 1e-6));
 //! ```
 
 use serde::Serialize;
 
-use super::fit::{apply, central_jacobian, check_set, check_signals, GreyboxConfig};
+use super::fit::{apply, central_jacobian, check_set, GreyboxConfig, Measurements};
 use super::identifiability::{analyse, Verdict};
 use super::model::{linear_discrete, Dynamics};
 use super::names::PhysicalParameter;
@@ -101,30 +107,26 @@ pub struct TrackWindow {
     pub iterations: usize,
 }
 
-/// Track `estimate` over sliding windows of `command` / `position` sampled
-/// every `dt` \[s\] (linear model only; see the module doc).
+/// Track `estimate` over sliding windows of the measurements `data` (its
+/// command and position; a measured current is not used; linear model
+/// only; see the module doc).
 ///
 /// Errors: as [`super::fit_greybox`], plus [`Error::InvalidParameter`] for a
 /// zero window or hop, [`Error::TooFewSamples`] when not one window fits,
 /// [`Error::InvalidChoice`] for the nonlinear model.
 pub fn track_greybox(
-    command: &[f64],
-    position: &[f64],
-    dt: f64,
+    data: &Measurements<'_>,
     start: &RigParams,
     estimate: &[PhysicalParameter],
     cfg: &GreyboxConfig,
     track: &TrackConfig,
 ) -> Result<Vec<TrackWindow>> {
-    track_greybox_with_progress(command, position, dt, start, estimate, cfg, track, None)
+    track_greybox_with_progress(data, start, estimate, cfg, track, None)
 }
 
 /// [`track_greybox`], reporting `progress(done, total)` in windows (a plain callback).
-#[allow(clippy::too_many_arguments)]
 pub fn track_greybox_with_progress(
-    command: &[f64],
-    position: &[f64],
-    dt: f64,
+    data: &Measurements<'_>,
     start: &RigParams,
     estimate: &[PhysicalParameter],
     cfg: &GreyboxConfig,
@@ -150,8 +152,19 @@ pub fn track_greybox_with_progress(
     }
     let n = estimate.len();
     let w = track.window;
-    check_signals(command, position, dt, w.max(2 * n + 2))?;
-    let len = command.len();
+    data.check(w.max(2 * n + 2))?;
+    let (command, position, dt) = (data.command, data.position, data.dt);
+    // the stretches of measured samples (grid indices), and each measured
+    // sample's row in the file
+    let rows_of = data.rows();
+    let mut stretches: Vec<std::ops::Range<usize>> = Vec::new();
+    for &k in &rows_of {
+        match stretches.last_mut() {
+            Some(r) if r.end == k => r.end = k + 1,
+            _ => stretches.push(k..k + 1),
+        }
+    }
+    let row_of = |k: usize| rows_of.partition_point(|&i| i < k);
     let u0 = command[0];
     let scale = crate::stats::rms(position).max(1e-9);
     let penalty = 1e3 * scale;
@@ -187,13 +200,18 @@ pub fn track_greybox_with_progress(
     let mut r = vec![0.0; w];
     let mut x = vec![0.0; order];
 
-    let mut s = 0usize;
-    let total = if len >= w {
-        ((len - w) / track.hop + 1) as u64
-    } else {
-        0
-    };
-    while s + w <= len {
+    let total: u64 = stretches
+        .iter()
+        .filter(|r| r.len() >= w)
+        .map(|r| ((r.len() - w) / track.hop + 1) as u64)
+        .sum();
+    let starts = stretches.iter().flat_map(|r| {
+        let last = r.end.saturating_sub(w);
+        (r.start..=last)
+            .step_by(track.hop)
+            .filter(move |&s| s + w <= r.end)
+    });
+    for s in starts {
         if let Some(p) = progress {
             p(rows.len() as u64, total);
         }
@@ -269,8 +287,8 @@ pub fn track_greybox_with_progress(
         let values: Vec<f64> = base.iter().zip(&theta).map(|(b, t)| b * t.exp()).collect();
         let mean = position[s..s + w].iter().sum::<f64>() / w as f64;
         rows.push(TrackWindow {
-            start: s,
-            end: s + w,
+            start: row_of(s),
+            end: row_of(s) + w,
             time_s: (s as f64 + 0.5 * (w as f64 - 1.0)) * dt,
             mean_position_m: mean,
             nut_position_m: start.geometry.nut_position + mean,
@@ -287,13 +305,12 @@ pub fn track_greybox_with_progress(
             iterations,
         });
         apply(estimate, &base, &theta, &mut ref_params, &mut ref_effects);
-        s += track.hop;
     }
     if rows.is_empty() {
         return Err(Error::TooFewSamples {
             what: "one tracking window",
             needed: w,
-            actual: len,
+            actual: stretches.iter().map(|r| r.len()).max().unwrap_or(0),
         });
     }
     Ok(rows)
@@ -303,6 +320,7 @@ pub fn track_greybox_with_progress(
 mod tests {
     use super::*;
     use crate::drive::{PositionLoop, RigEffects, VirtualRig};
+    use crate::greybox::Measurements;
     use crate::signal::{Prbs, Ramp};
 
     #[test]
@@ -340,9 +358,7 @@ mod tests {
             max_iterations: 30,
         };
         let rows = track_greybox(
-            &u,
-            &y,
-            dt,
+            &Measurements::new(&u, &y, dt),
             &truth,
             &[PhysicalParameter::K],
             &GreyboxConfig::default(),
@@ -379,9 +395,7 @@ mod tests {
             ..TrackConfig::default()
         };
         let rows = track_greybox(
-            &u,
-            &out.position,
-            1.0 / rate,
+            &Measurements::new(&u, &out.position, 1.0 / rate),
             &RigParams::default(),
             &[PhysicalParameter::K],
             &GreyboxConfig::default(),
@@ -405,6 +419,56 @@ mod tests {
     }
 
     #[test]
+    fn dropped_samples_split_the_windows_and_the_reference_runs_through() {
+        // Kv tracked on a PRBS whose samples 1000..1003 were dropped (garbage
+        // there): no window contains them, the one after them starts at the
+        // file's row 1000, and every estimate is exact
+        let u = crate::signal::Scenario::Prbs
+            .command(5000.0, 0.4, 1)
+            .unwrap();
+        let mut y = crate::greybox::PhysicalModel::linear(RigParams::default(), Default::default())
+            .simulate(&u, 2e-4)
+            .unwrap();
+        for v in &mut y[1000..1003] {
+            *v += 1.0;
+        }
+        let measured: Vec<usize> = (0..u.len()).filter(|k| !(1000..1003).contains(k)).collect();
+        let mut start = RigParams::default();
+        start.control.kv = 650.0;
+        let cfg = TrackConfig {
+            window: 500,
+            hop: 500,
+            warm_up: 100,
+            max_iterations: 30,
+        };
+        let data = Measurements::new(&u, &y, 2e-4).with_measured(&measured);
+        let rows = track_greybox(
+            &data,
+            &start,
+            &[PhysicalParameter::Kv],
+            &Default::default(),
+            &cfg,
+        )
+        .unwrap();
+        let spans: Vec<(usize, usize)> = rows.iter().map(|r| (r.start, r.end)).collect();
+        assert_eq!(spans, [(0, 500), (500, 1000), (1000, 1500)]);
+        assert!((rows[2].time_s - (1003.0 + 249.5) * 2e-4).abs() < 1e-12);
+        for r in &rows {
+            assert!((r.values[0] - 700.0).abs() < 1e-6, "{r:?}");
+        }
+        // without the mask the garbage lands in the third window
+        let all = track_greybox(
+            &Measurements::new(&u, &y, 2e-4),
+            &start,
+            &[PhysicalParameter::Kv],
+            &Default::default(),
+            &cfg,
+        )
+        .unwrap();
+        assert!(all[2].residual_rms_m > 1e-3, "{:?}", all[2]);
+    }
+
+    #[test]
     fn nonlinear_tracking_is_refused() {
         let u = vec![0.0; 600];
         let cfg = GreyboxConfig {
@@ -412,9 +476,7 @@ mod tests {
             ..GreyboxConfig::default()
         };
         let e = track_greybox(
-            &u,
-            &u,
-            2e-4,
+            &Measurements::new(&u, &u, 2e-4),
             &RigParams::default(),
             &[PhysicalParameter::K],
             &cfg,

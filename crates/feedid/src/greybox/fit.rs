@@ -882,6 +882,20 @@ mod tests {
         p
     }
 
+    /// Every estimate of `fit` within 1e-6 (relative) of its value in `truth`.
+    fn assert_recovered(fit: &GreyboxFit, set: &[PhysicalParameter], truth: &RigParams) {
+        let fx = RigEffects::default();
+        for (e, p) in fit.estimates.iter().zip(set) {
+            let want = p.get(truth, &fx);
+            assert!(
+                (e.value / want - 1.0).abs() < 1e-6,
+                "{}: {} vs {want}",
+                e.name,
+                e.value
+            );
+        }
+    }
+
     fn linear_data(scenario: Scenario, duration: f64) -> (Vec<f64>, Vec<f64>) {
         let u = scenario.command(5000.0, duration, 1).unwrap();
         let y = PhysicalModel::linear(RigParams::default(), LoopModel::Sampled)
@@ -906,16 +920,7 @@ mod tests {
         let start = perturbed(&set, &[1.2, 0.8, 1.25, 0.7, 1.3]);
         let data = Measurements::new(&u, &y, DT).with_measured(&measured);
         let fit = fit_greybox(&data, &start, &set, &GreyboxConfig::default()).unwrap();
-        let fx = RigEffects::default();
-        for (e, p) in fit.estimates.iter().zip(set) {
-            let want = p.get(&truth, &fx);
-            assert!(
-                (e.value / want - 1.0).abs() < 1e-6,
-                "{}: {} vs {want}",
-                e.name,
-                e.value
-            );
-        }
+        assert_recovered(&fit, &set, &truth);
         assert_eq!(fit.residuals, u.len() - dropped.len());
         assert!(fit.residual_rms < 1e-12, "{}", fit.residual_rms);
         // compared, the garbage would pull the estimates away
@@ -964,15 +969,8 @@ mod tests {
             &GreyboxConfig::default(),
         )
         .unwrap();
-        let fx = RigEffects::default();
-        for (e, p) in fit.estimates.iter().zip(set) {
-            let want = p.get(&truth, &fx);
-            assert!(
-                (e.value / want - 1.0).abs() < 1e-6,
-                "{}: {} vs {want}",
-                e.name,
-                e.value
-            );
+        assert_recovered(&fit, &set, &truth);
+        for e in &fit.estimates {
             assert_eq!(e.verdict, Verdict::Identifiable, "{}", e.name);
         }
         assert!(fit.null_directions.is_empty());
@@ -993,16 +991,7 @@ mod tests {
             ..GreyboxConfig::default()
         };
         let fit = fit_greybox(&Measurements::new(&u, &y, DT), &start, &set, &cfg).unwrap();
-        let fx = RigEffects::default();
-        for (e, p) in fit.estimates.iter().zip(set) {
-            let want = p.get(&truth, &fx);
-            assert!(
-                (e.value / want - 1.0).abs() < 1e-6,
-                "{}: {} vs {want}",
-                e.name,
-                e.value
-            );
-        }
+        assert_recovered(&fit, &set, &truth);
     }
 
     #[test]

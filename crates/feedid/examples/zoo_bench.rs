@@ -33,6 +33,16 @@
 //!   shared samples, else the pair is skipped); 1 for the best fixed method;
 //! * `loses` = the method's rms exceeds a baseline's on the samples both
 //!   predict, for some baseline (a baseline against the other two);
+//! * `beyond chance` = it loses, and the Diebold–Mariano test says the
+//!   method's squared errors exceed the baseline's by more than chance (one-
+//!   sided, 5 %; the differences summed in blocks of H samples, Newey–West
+//!   long-run variance: [`dm_statistic`]). Where the best prediction is a
+//!   baseline itself — an axis resting on its command, where the command is
+//!   exact and every estimated model adds the noise of its estimate — a
+//!   method can only tie it, and which of the two is ahead by a fraction of
+//!   a percent is decided by the noise: the same predictions lose on 7 to 15
+//!   members depending only on where the baselines' blocks start
+//!   (`--baseline-phase`). Both counts are printed;
 //! * interval coverage: the share of the scored predicted samples whose
 //!   measured position lies inside the method's 95 % prediction interval
 //!   (the library's default [`feedid::ident::GuardConfig`]); `n/a` for the
@@ -314,6 +324,65 @@ fn shared_rms(y: &[f64], a: &Predictions, b: &Predictions, scored: &[bool]) -> O
     (ra.2 >= MIN_SHARED).then_some((ra.0, rb.0))
 }
 
+/// One-sided 5 % critical value of the standard normal distribution.
+const Z_95: f64 = 1.6448536269514722;
+/// Fewest blocks of `H` samples for a significance test (with fewer, a loss
+/// counts as significant).
+const MIN_BLOCKS: usize = 10;
+
+/// The Diebold–Mariano statistic of "`a` predicts worse than `b`" over the
+/// samples both predict (and `scored`): the loss differential
+/// `d[k] = (y[k] − a[k])² − (y[k] − b[k])²` summed in blocks of `H`
+/// consecutive samples (`k / H`: a horizon's errors are correlated), its
+/// mean over the blocks divided by its standard error from the Newey–West
+/// (Bartlett) long-run variance with `⌊4·(n/100)^(2/9)⌋` lags (n blocks).
+/// Large and positive: `a` is worse beyond chance. `None` with fewer than
+/// [`MIN_BLOCKS`] blocks; `+∞` when every block differs alike (no variance).
+/// Diebold, F. X. & Mariano, R. S. (1995), *Comparing predictive accuracy*,
+/// J. Business & Economic Statistics 13(3).
+fn dm_statistic(y: &[f64], a: &Predictions, b: &Predictions, scored: &[bool]) -> Option<f64> {
+    let mut blocks: Vec<f64> = Vec::new();
+    let mut current: Option<usize> = None;
+    for k in 0..y.len() {
+        if !(scored[k] && a.has[k] && b.has[k]) {
+            continue;
+        }
+        let d = (y[k] - a.value[k]).powi(2) - (y[k] - b.value[k]).powi(2);
+        if current == Some(k / H) {
+            if let Some(last) = blocks.last_mut() {
+                *last += d;
+            }
+        } else {
+            current = Some(k / H);
+            blocks.push(d);
+        }
+    }
+    let n = blocks.len();
+    if n < MIN_BLOCKS {
+        return None;
+    }
+    let mean = blocks.iter().sum::<f64>() / n as f64;
+    let c: Vec<f64> = blocks.iter().map(|d| d - mean).collect();
+    let lags = (4.0 * (n as f64 / 100.0).powf(2.0 / 9.0)).floor() as usize;
+    let gamma = |l: usize| c[l..].iter().zip(&c).map(|(x, y)| x * y).sum::<f64>() / n as f64;
+    let mut lrv = gamma(0);
+    for l in 1..=lags.min(n - 1) {
+        lrv += 2.0 * (1.0 - l as f64 / (lags + 1) as f64) * gamma(l);
+    }
+    if lrv.is_nan() || lrv <= 0.0 {
+        return Some(if mean > 0.0 { f64::INFINITY } else { 0.0 });
+    }
+    Some(mean / (lrv / n as f64).sqrt())
+}
+
+/// Whether `a` loses to `b` beyond chance: its rms on the shared samples is
+/// larger and the Diebold–Mariano statistic exceeds the one-sided 5 %
+/// critical value (or there are too few blocks to test).
+fn loses_significantly(y: &[f64], a: &Predictions, b: &Predictions, scored: &[bool]) -> bool {
+    shared_rms(y, a, b, scored).is_some_and(|(x, r)| x > r)
+        && dm_statistic(y, a, b, scored).map_or(true, |t| t > Z_95)
+}
+
 /// One method on one member.
 #[derive(Clone)]
 struct Row {
@@ -344,6 +413,10 @@ struct Row {
     /// Whether it loses to a baseline when the baselines' blocks start
     /// `q` = 0 … H − 1 samples later (library methods only).
     loses_by_phase: [bool; H],
+    /// The same, beyond chance ([`loses_significantly`]).
+    significant_by_phase: [bool; H],
+    /// Whether it loses to a baseline beyond chance (at `--baseline-phase`).
+    significant: bool,
 }
 
 /// Score every method on one member.
@@ -370,6 +443,8 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
         gaps: 0,
         gap_cost: None,
         loses_by_phase: [false; H],
+        significant_by_phase: [false; H],
+        significant: false,
     };
     let rec = match m.recording_with_gaps() {
         Ok(r) => r,
@@ -442,6 +517,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
         // (as the table: a baseline without error beats any error)
         shared_rms(y, p, b, &scored).is_some_and(|(a, r)| a > r)
     };
+    let significantly = |p: &Predictions, b: &Predictions| loses_significantly(y, p, b, &scored);
     all.iter()
         .map(|p| {
             let own = stats(y, p, |k| scored[k]);
@@ -505,6 +581,15 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                         && (loses_to(p, by_name["command"])
                             || phased[q].iter().any(|b| loses_to(p, b)))
                 }),
+                significant_by_phase: std::array::from_fn(|q| {
+                    LIBRARY.contains(&p.name)
+                        && (significantly(p, by_name["command"])
+                            || phased[q].iter().any(|b| significantly(p, b)))
+                }),
+                significant: BASELINES
+                    .iter()
+                    .filter(|&&b| b != p.name)
+                    .any(|b| significantly(p, by_name[b])),
                 ..base.clone()
             }
         })
@@ -624,12 +709,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(path) = &csv {
         let mut text = String::from(
             "member,method,plant,command,samples,predicted,coverage_percent,\
-             coverage_after_first_window_percent,rms_m,max_m,ratio_to_best_fixed,beaten_by_baseline,worst_baseline_ratio,interval_coverage_percent,\
+             coverage_after_first_window_percent,rms_m,max_m,ratio_to_best_fixed,beaten_by_baseline,worst_baseline_ratio,loses_significantly,interval_coverage_percent,\
              seconds,note,label\n",
         );
         for r in &rows {
             text += &format!(
-                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{:.6},\"{}\",\"{}\"\n",
+                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{:.6},\"{}\",\"{}\"\n",
                 r.member,
                 r.method,
                 r.plant,
@@ -643,6 +728,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.ratio.map_or(String::new(), |v| v.to_string()),
                 r.beaten_by.unwrap_or(""),
                 r.baseline_ratio.map_or(String::new(), |v| v.to_string()),
+                u8::from(r.significant),
                 fmt(r.interval_coverage, 2),
                 r.seconds,
                 r.note.replace('"', "'"),
@@ -682,18 +768,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         wall,
         rayon::current_num_threads()
     );
-    println!("| method | compared | median rms / best fixed | 90th pct rms / best fixed | loses to a baseline | coverage after the first window, min / median [%] | median own rms [µm] | failed | 95 % interval coverage |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| method | compared | median rms / best fixed | 90th pct rms / best fixed | loses to a baseline | of which beyond chance | coverage after the first window, min / median [%] | median own rms [µm] | failed | 95 % interval coverage |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for method in LIBRARY.iter().chain(&BASELINES) {
         let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == *method).collect();
         let ratios: Vec<f64> = mine.iter().filter_map(|r| r.ratio).collect();
         let losses = mine.iter().filter(|r| r.beaten_by.is_some()).count();
+        let significant = mine.iter().filter(|r| r.significant).count();
         let cov: Vec<f64> = mine.iter().map(|r| r.coverage_after).collect();
         let rms: Vec<f64> = mine.iter().filter_map(|r| r.rms).map(|v| v * 1e6).collect();
         let failed = mine.iter().filter(|r| !r.note.is_empty()).count();
         let intervals: Vec<f64> = mine.iter().filter_map(|r| r.interval_coverage).collect();
         println!(
-            "| {method} | {} | {} | {} | {losses} of {} | {} / {} | {} | {failed} | {} |",
+            "| {method} | {} | {} | {} | {losses} of {} | {significant} | {} / {} | {} | {failed} | {} |",
             ratios.len(),
             fmt(quantile(&ratios, 0.5), 2),
             fmt(quantile(&ratios, 0.9), 2),
@@ -719,15 +806,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .join(" | ")
     );
     println!("|---|{}---:|", "---:|".repeat(H));
-    for method in LIBRARY {
+    for (method, significant) in LIBRARY
+        .iter()
+        .map(|m| (m, false))
+        .chain(LIBRARY.iter().map(|m| (m, true)))
+    {
         let counts: Vec<f64> = (0..H)
             .map(|q| {
                 scored
                     .iter()
-                    .filter(|r| r.method == method && r.loses_by_phase[q])
+                    .filter(|r| {
+                        r.method == *method
+                            && if significant {
+                                r.significant_by_phase[q]
+                            } else {
+                                r.loses_by_phase[q]
+                            }
+                    })
                     .count() as f64
             })
             .collect();
+        let method = if significant {
+            format!("{method}, beyond chance")
+        } else {
+            method.to_string()
+        };
         println!(
             "| {method} | {} | {} |",
             counts
@@ -797,7 +900,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          fixed method; ratio: rms of the method / rms of the best fixed method (paper, arx, rls, oe \
          with defaults), each pair on the samples both predict; loses: its rms exceeds a baseline's \
          (command, hold, arx220) on the samples both predict (a recording it does not predict is \
-         not a loss: see coverage); own rms: over the method's own predicted samples. Glitch rows \
+         not a loss: see coverage); beyond chance: and the Diebold–Mariano statistic of the squared \
+         errors (blocks of {H} samples, Newey–West variance) exceeds the one-sided 5 % critical \
+         value {Z_95:.3}; own rms: over the method's own predicted samples. Glitch rows \
          are not scored. Coverage: share of the samples after the method's first window that it \
          predicts. Interval coverage: share of the scored predicted samples inside the method's 95 % \
          prediction interval (median over the recordings)."
@@ -823,13 +928,14 @@ fn gapped_table(gapped: &[&Row]) {
         let cov: Vec<f64> = mine.iter().map(|r| r.coverage).collect();
         let after: Vec<f64> = mine.iter().map(|r| r.coverage_after).collect();
         let losses = mine.iter().filter(|r| r.beaten_by.is_some()).count();
+        let significant = mine.iter().filter(|r| r.significant).count();
         let cost: Vec<f64> = mine
             .iter()
             .filter_map(|r| r.gap_cost)
             .filter(|v| v.is_finite())
             .collect();
         println!(
-            "| {method} | {} / {} | {} / {} | {losses} of {} | {} / {} ({} compared) |",
+            "| {method} | {} / {} | {} / {} | {losses} of {} ({significant} beyond chance) | {} / {} ({} compared) |",
             fmt(quantile(&cov, 0.0), 1),
             fmt(quantile(&cov, 0.5), 1),
             fmt(quantile(&after, 0.0), 1),
@@ -884,6 +990,69 @@ mod tests {
         assert_eq!(h.first, 13);
         let c = baseline_command(&y);
         assert_eq!(c.value, y);
+    }
+
+    fn predictions(value: Vec<f64>) -> Predictions {
+        let n = value.len();
+        Predictions {
+            name: "p",
+            value,
+            has: vec![true; n],
+            interval: None,
+            first: 0,
+            seconds: 0.0,
+            error: None,
+        }
+    }
+
+    #[test]
+    fn the_diebold_mariano_statistic_matches_a_hand_computation() {
+        // y = 0, b exact, a off by 1 in every even block of 10: block sums
+        // d = 10, 0, 10, 0, … (20 blocks), mean 5, deviations ±5;
+        // γ₀ = 25, γ₁ = −25·19/20, γ₂ = 25·18/20; lags ⌊4·0.2^(2/9)⌋ = 2;
+        // lrv = 25 + 2·(2/3)·γ₁ + 2·(1/3)·γ₂ = 8.3333…; t = 5 / √(lrv/20)
+        let y = vec![0.0; 200];
+        let a = predictions((0..200).map(|k| ((k / 10 + 1) % 2) as f64).collect());
+        let b = predictions(vec![0.0; 200]);
+        let scored = vec![true; 200];
+        let lrv = 25.0 - (4.0 / 3.0) * 23.75 + (2.0 / 3.0) * 22.5;
+        let t = dm_statistic(&y, &a, &b, &scored).unwrap();
+        assert!((t - 5.0 / (lrv / 20.0f64).sqrt()).abs() < 1e-12, "{t}");
+        // the other way round: the same statistic, negated
+        let back = dm_statistic(&y, &b, &a, &scored).unwrap();
+        assert!((back + t).abs() < 1e-12);
+        assert!(loses_significantly(&y, &a, &b, &scored));
+        assert!(!loses_significantly(&y, &b, &a, &scored));
+        // fewer than MIN_BLOCKS blocks: no test, a loss counts
+        let few: Vec<bool> = (0..200).map(|k| k < 90).collect();
+        assert_eq!(dm_statistic(&y, &a, &b, &few), None);
+        assert!(loses_significantly(&y, &a, &b, &few));
+    }
+
+    #[test]
+    fn equal_noise_is_no_significant_loss_and_larger_noise_is() {
+        // seeded uniform noise (xorshift): a and b equally noisy, then a 20 % noisier
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut noise = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let n = 2000;
+        let y: Vec<f64> = (0..n).map(|k| (k as f64 * 0.01).sin()).collect();
+        let ea: Vec<f64> = (0..n).map(|_| noise()).collect();
+        let eb: Vec<f64> = (0..n).map(|_| noise()).collect();
+        let scored = vec![true; n];
+        let b = predictions(y.iter().zip(&eb).map(|(y, e)| y + e).collect());
+        let same = predictions(y.iter().zip(&ea).map(|(y, e)| y + e).collect());
+        let t = dm_statistic(&y, &same, &b, &scored).unwrap();
+        assert!(t.abs() < Z_95, "equal noise: t = {t}");
+        assert!(!loses_significantly(&y, &same, &b, &scored));
+        let worse = predictions(y.iter().zip(&ea).map(|(y, e)| y + 1.2 * e).collect());
+        let t = dm_statistic(&y, &worse, &b, &scored).unwrap();
+        assert!(t > 3.0, "20 % more noise: t = {t}");
+        assert!(loses_significantly(&y, &worse, &b, &scored));
     }
 
     #[test]

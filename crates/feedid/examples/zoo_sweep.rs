@@ -7,11 +7,13 @@
 //! ```
 //!
 //! `SET` is `all` (the regular members), `even`, `odd` (halves: choose on
-//! one, check on the other) or `emps` (the EMPS recording, printed). Each
+//! one, check on the other), `small` (members 0–19), `m3,17,…` (these
+//! members) or `emps` (the EMPS recording, printed). Each
 //! line of `configs.txt` is a method and its settings, e.g.
 //! `arx o=3,3,0 w=100 ridge=1e-10 dc=1`, `rls o=8,8,0 lambda=0.999`,
-//! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995 mem=0.1 cons=20` (`lsb:…`,
-//! `rlsb:…`: the same with a constant term), `arx220frame` (the baseline
+//! `auto cands=ls:2,2,0:100:1e-6;rls:8,8,0:0.9995;rest mem=0.1 cons=20` (`lsb:…`,
+//! `rlsb:…`: the same with a constant term; `hold`, `command`, `rest` =
+//! the command at rest), `arx220frame` (the baseline
 //! in the frame of the last measured position) or `arx220unitW` (unit DC
 //! gain, W rows); `#` starts a comment. The CSV has per member and
 //! configuration the rms over the predicted samples, the coverage, the rms
@@ -46,6 +48,7 @@ fn cand(s: &str) -> Candidate {
     match f[0] {
         "hold" => Candidate::Hold,
         "command" => Candidate::Command,
+        "rest" => Candidate::CommandAtRest,
         "ls" | "lsb" => Candidate::Windowed {
             orders: orders(f[1]),
             window: f[2].parse().unwrap(),

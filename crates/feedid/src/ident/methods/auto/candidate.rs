@@ -34,6 +34,14 @@ pub enum Candidate {
     /// The command at the predicted instant (an axis with feed-forward
     /// follows it within its small following error).
     Command,
+    /// The command, chosen only where it is still over the window and the
+    /// horizon (an axis at rest on its set-point, where the command is the
+    /// best prediction there is and every estimated model only adds the
+    /// noise of its estimate), and never part of the candidates' median
+    /// (it is not a model of the axis). Where the axis moves, its error is
+    /// the following error, which grows through a move, so its score at a
+    /// move's start says nothing about the move's end.
+    CommandAtRest,
     /// Unit-gain ARX ([`super::model`]) by exponentially weighted recursive
     /// least squares with forgetting factor `lambda` (memory ≈ 1/(1 − λ)
     /// samples); a sample updates the estimate only if its regression row
@@ -71,6 +79,7 @@ impl fmt::Display for Candidate {
         match self {
             Candidate::Hold => f.write_str("hold"),
             Candidate::Command => f.write_str("command"),
+            Candidate::CommandAtRest => f.write_str("command at rest"),
             Candidate::Recursive {
                 orders: o,
                 lambda,
@@ -100,11 +109,23 @@ impl Candidate {
     /// The orders of an identified candidate.
     pub fn orders(&self) -> Option<ArxOrders> {
         match self {
-            Candidate::Hold | Candidate::Command => None,
+            Candidate::Hold | Candidate::Command | Candidate::CommandAtRest => None,
             Candidate::Recursive { orders, .. } | Candidate::Windowed { orders, .. } => {
                 Some(*orders)
             }
         }
+    }
+
+    /// Whether the candidate may predict only where the command is still
+    /// ([`Candidate::CommandAtRest`]).
+    pub fn at_rest_only(&self) -> bool {
+        matches!(self, Candidate::CommandAtRest)
+    }
+
+    /// Whether the candidate's predictions enter the pointwise median of
+    /// the candidates (all but [`Candidate::CommandAtRest`]).
+    pub(crate) fn in_median(&self) -> bool {
+        !self.at_rest_only()
     }
 
     /// Whether the model has a constant term (bias).
@@ -289,7 +310,7 @@ impl Predictor {
         let n = spec.n_params();
         let n_model = spec.orders().map_or(0, |o| model::n_free(&o));
         let state = match spec {
-            Candidate::Hold | Candidate::Command => State::Plain,
+            Candidate::Hold | Candidate::Command | Candidate::CommandAtRest => State::Plain,
             Candidate::Recursive { .. } => State::Recursive(Box::new(Recursive {
                 p: vec![0.0; n * stride(n)],
                 kappa: 1.0,
@@ -444,7 +465,10 @@ impl Predictor {
     /// Forget all state.
     pub(crate) fn reset(&mut self) {
         self.theta.fill(0.0);
-        self.fitted = matches!(self.spec, Candidate::Hold | Candidate::Command);
+        self.fitted = matches!(
+            self.spec,
+            Candidate::Hold | Candidate::Command | Candidate::CommandAtRest
+        );
         match &mut self.state {
             State::Recursive(r) => {
                 r.cursor = None;
@@ -634,7 +658,7 @@ impl Predictor {
                 let w = signals.window(e..e, 1, "auto hold")?;
                 out.fill(w.position[0]);
             }
-            Candidate::Command => {
+            Candidate::Command | Candidate::CommandAtRest => {
                 let w = signals.window(horizon.clone(), 0, "auto command")?;
                 out.copy_from_slice(w.command);
             }

@@ -71,6 +71,7 @@ impl AutoConfig {
             rls(4, 4, 0.999),
             rls(6, 6, 0.999),
             rls(8, 8, 0.9995),
+            Candidate::CommandAtRest,
         ]
     }
 
@@ -82,7 +83,7 @@ impl AutoConfig {
         let memory = |c: &Candidate| match *c {
             Candidate::Recursive { lambda, .. } => Some((1, lambda)),
             Candidate::Windowed { window, .. } => Some((0, window as f64)),
-            Candidate::Hold | Candidate::Command => None,
+            Candidate::Hold | Candidate::Command | Candidate::CommandAtRest => None,
         };
         let mut best: Option<(usize, (i32, f64))> = None;
         for (i, c) in self.candidates.iter().enumerate() {
@@ -113,7 +114,7 @@ impl AutoConfig {
             Candidate::Recursive { orders: o, .. } | Candidate::Windowed { orders: o, .. } => {
                 *o = orders
             }
-            Candidate::Hold | Candidate::Command => {}
+            Candidate::Hold | Candidate::Command | Candidate::CommandAtRest => {}
         }
         c.validate()?;
         self.candidates[i] = c;

@@ -94,6 +94,17 @@ impl Member {
         }
     }
 
+    /// Whether the candidate may predict a horizon of regime `r`
+    /// ([`Candidate::at_rest_only`]: only where the command is still).
+    fn eligible(&self, r: usize) -> bool {
+        r == 0 || !self.predictor.spec().at_rest_only()
+    }
+
+    /// Whether its predictions enter the candidates' median.
+    fn in_median(&self) -> bool {
+        self.predictor.spec().in_median()
+    }
+
     /// The score in regime `r`, else in the first scored regime, else none.
     fn score_in(&self, r: usize) -> Option<f64> {
         if self.scored[r] > 0 {
@@ -312,7 +323,15 @@ impl AutoEstimator {
             }
         }
         let (members, sorted) = (&self.members, &mut self.sorted);
-        let median = (0..h).map(|j| median_at(members, |m| m.trial.is_some(), last, j, sorted));
+        let median = (0..h).map(|j| {
+            median_at(
+                members,
+                |m| m.trial.is_some() && m.in_median(),
+                last,
+                j,
+                sorted,
+            )
+        });
         Some((hold, mean_square_error(measured, median)?))
     }
 
@@ -388,17 +407,18 @@ impl AutoEstimator {
         }
     }
 
-    /// The ready candidate with the lowest score in the current regime
+    /// The ready candidate eligible in the current regime
+    /// ([`Candidate::at_rest_only`]) with the lowest score there
     /// (unscored candidates last); ties ([`TIE`]) keep the previous choice,
     /// else the first in the order of the settings.
     fn choose(&self) -> Option<usize> {
         let r = self.regime;
         let mut choice: Option<(usize, Option<f64>)> = self
             .selected
-            .filter(|&i| self.members[i].ready)
+            .filter(|&i| self.members[i].ready && self.members[i].eligible(r))
             .map(|i| (i, self.members[i].score_in(r)));
         for (i, m) in self.members.iter().enumerate() {
-            if !m.ready || choice.is_some_and(|(c, _)| c == i) {
+            if !m.ready || !m.eligible(r) || choice.is_some_and(|(c, _)| c == i) {
                 continue;
             }
             let s = m.score_in(r);
@@ -679,13 +699,22 @@ impl Estimator for AutoEstimator {
             First::Median => {
                 let (members, sorted) = (&self.members, &mut self.sorted);
                 for (j, o) in out.iter_mut().enumerate() {
-                    *o = median_at(members, |m| m.pending_len == h, last, j, sorted);
+                    *o = median_at(
+                        members,
+                        |m| m.pending_len == h && m.in_median(),
+                        last,
+                        j,
+                        sorted,
+                    );
                 }
                 return Ok(PredictStatus::Predicted);
             }
             First::Chosen => {}
         }
-        let usable = |i: usize| self.members[i].pending_len == h && !self.dissents(i, h);
+        let usable = |i: usize| {
+            let m = &self.members[i];
+            m.pending_len == h && m.eligible(self.regime) && !self.dissents(i, h)
+        };
         let chosen = match self.selected {
             Some(c) if usable(c) => Some(c),
             _ => {
@@ -712,7 +741,13 @@ impl Estimator for AutoEstimator {
                 let (members, sorted) = (&self.members, &mut self.sorted);
                 if members.iter().any(|m| m.pending_len == h) {
                     for (j, o) in out.iter_mut().enumerate() {
-                        *o = median_at(members, |m| m.pending_len == h, last, j, sorted);
+                        *o = median_at(
+                            members,
+                            |m| m.pending_len == h && m.in_median(),
+                            last,
+                            j,
+                            sorted,
+                        );
                     }
                 } else {
                     out.fill(last);
@@ -816,6 +851,66 @@ mod tests {
         let last = y[first.start - 1];
         for k in first {
             assert_eq!(r.predicted[k], last, "sample {k}: held");
+        }
+    }
+
+    #[test]
+    fn the_command_at_rest_predicts_only_where_the_command_is_still() {
+        // still for 100 samples, a ramp of 1 mm over 100, still again; the
+        // axis follows 3 samples behind, 0.1 µm off the command at rest
+        let n: usize = 400;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let u: Vec<f64> = (0..n)
+            .map(|k| 1e-5 * (k.clamp(100, 200) - 100) as f64)
+            .collect();
+        let y: Vec<f64> = (0..n)
+            .map(|k| u[k.saturating_sub(3)] + 1e-7 * ((k % 3) as f64 - 1.0))
+            .collect();
+        let config = AutoConfig {
+            candidates: vec![Candidate::CommandAtRest],
+            ..AutoConfig::default()
+        };
+        let mut est = config.build().unwrap();
+        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
+        let cfg = EngineConfig {
+            window: 50,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        };
+        let r = run(&mut est, &s, &cfg).unwrap();
+        let (mut at_rest, mut moving) = (0, 0);
+        for w in &r.windows[1..] {
+            let still = u[w.window.start..w.horizon.end]
+                .iter()
+                .all(|&v| v == u[w.window.start]);
+            for k in w.horizon.clone() {
+                if still {
+                    // the only candidate, eligible
+                    assert_eq!(r.predicted[k], u[k], "sample {k}");
+                    at_rest += 1;
+                } else {
+                    // not eligible, and not in the median: the last position, held
+                    assert_eq!(r.predicted[k], y[w.window.end - 1], "sample {k}");
+                    moving += 1;
+                }
+            }
+        }
+        assert!(at_rest > 100 && moving > 100, "{at_rest} {moving}");
+    }
+
+    #[test]
+    fn the_command_at_rest_is_not_part_of_the_median() {
+        // as the median test above: the median of holding and the command
+        // backtests best; the command at rest beside it would make the
+        // median the command
+        let (_, y0, _) = run_command_only(0.0);
+        let lead = y0[55] - y0[50];
+        let (u, y, r) = run_candidates(vec![Candidate::Command, Candidate::CommandAtRest], lead);
+        let first = r.windows[0].horizon.clone();
+        let last = y[first.start - 1];
+        for k in first {
+            assert_eq!(r.predicted[k], 0.5 * (last + u[k]), "sample {k}");
         }
     }
 

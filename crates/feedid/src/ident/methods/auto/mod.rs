@@ -4,8 +4,8 @@
 //! # Candidates
 //!
 //! Every candidate ([`Candidate`], default [`AutoConfig::default_candidates`])
-//! is a *unit-gain ARX model written in increments from the last measured
-//! position* (module `model`): with `A(1) = B(1)` (a position servo follows its
+//! but the command at rest is a *unit-gain ARX model written in increments
+//! from the last measured position* (module `model`): with `A(1) = B(1)` (a position servo follows its
 //! set-point with unit gain),
 //!
 //! ```text
@@ -32,9 +32,21 @@
 //!   bias; see module `model`);
 //! - `rls 3,3,0 λ=0.995`, `rls 4,4,0 λ=0.999`, `rls 6,6,0 λ=0.999`,
 //!   `rls 8,8,0 λ=0.9995`: exponentially weighted recursive least squares
-//!   (memories of 200 to 2000 samples, low to high orders).
+//!   (memories of 200 to 2000 samples, low to high orders);
+//! - `command at rest` ([`Candidate::CommandAtRest`]): the command itself,
+//!   eligible only for a horizon whose command is still over the window and
+//!   the horizon (regime *still* below), and never part of the candidates'
+//!   median. An axis that rests on its set-point (feed-forward, a stiff
+//!   loop) is predicted best by the command, and every estimated model
+//!   there only adds the noise of its estimate (`1 + p/N` in mean square);
+//!   where the axis moves, the command's error is the following error,
+//!   which grows through a move, so its score at a ramp's start (when the
+//!   axis has barely fallen behind) would wrongly recommend it for the
+//!   ramp's end (member 182 of the zoo: 31 % worse), and in the median it
+//!   pulls the first prediction towards a set-point the axis lags (members
+//!   84, 92 and 168: 5–9 % worse).
 //!
-//! All use `nk = 0`, the command at the predicted instant: the command is a
+//! All models use `nk = 0`, the command at the predicted instant: the command is a
 //! planned trajectory, known ahead, and at low sampling rates it is what
 //! matters. They were chosen on the drive zoo ([`crate::zoo`], example
 //! `zoo_sweep`), not on one recording. `--order` sets the orders of the

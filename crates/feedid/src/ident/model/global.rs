@@ -40,6 +40,7 @@
 use std::path::Path;
 use std::str::FromStr;
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
@@ -263,6 +264,9 @@ pub const GLOBAL_FIT_SAMPLES: usize = 200_000;
 /// uniform sampling: fit one segment, [`Recording::slice`]); those of
 /// [`fit_arx`] / [`fit_oe`] (too few samples, no excitation, no stable
 /// model); with `auto`, the last candidate's error when none succeeds.
+///
+/// With `auto` the three kinds are fitted in parallel (rayon's pool) and
+/// compared in a fixed order, so the result does not depend on the threads.
 pub fn fit_global_model<S: AsRef<[f64]>>(
     rec: &Recording<S>,
     kind: &GlobalModelKind,
@@ -276,14 +280,27 @@ pub fn fit_global_model<S: AsRef<[f64]>>(
 
 /// [`fit_global_model`] without the cap.
 fn fit_kind<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Result<ModelFile> {
+    fit_data((rec.command(), rec.position(), rec.dt()), kind)
+}
+
+/// Command, position \[m\] and sample time \[s\] of the fitted samples.
+type Data<'a> = (&'a [f64], &'a [f64], f64);
+
+/// [`fit_kind`] on the fitted samples.
+fn fit_data(data: Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
     if *kind != GlobalModelKind::Auto {
-        return fit_one(rec, kind);
+        return fit_one(data, kind);
     }
     let mut best: Option<ModelFile> = None;
     let mut notes = Vec::new();
     let mut last_err = None;
-    for cand in GlobalModelKind::AUTO_CANDIDATES {
-        match fit_one(rec, &cand) {
+    // independent fits, in parallel; compared in order (the sequential result)
+    let fits: Vec<Result<ModelFile>> = GlobalModelKind::AUTO_CANDIDATES
+        .par_iter()
+        .map(|cand| fit_one(data, cand))
+        .collect();
+    for (cand, fit) in GlobalModelKind::AUTO_CANDIDATES.into_iter().zip(fits) {
+        match fit {
             Ok(f) => {
                 let rms = f
                     .identified_by
@@ -327,8 +344,10 @@ fn fit_kind<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Resu
     }
 }
 
-fn fit_one<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Result<ModelFile> {
-    let (u, y, dt) = (rec.command(), rec.position(), rec.dt());
+/// One kind (not `Auto`) fitted to command `u`, position `y` \[m\] at the
+/// sample time `dt` \[s\].
+fn fit_one(data: Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
+    let (u, y, dt) = data;
     let model = match kind {
         GlobalModelKind::Arx(orders) => fit_arx(u, y, dt, *orders, &ArxConfig::default())?.model,
         GlobalModelKind::Oe { poles, zeros } => {
@@ -339,7 +358,7 @@ fn fit_one<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Resul
             };
             fit_oe(u, y, dt, &cfg)?.model
         }
-        GlobalModelKind::Auto => return fit_kind(rec, kind),
+        GlobalModelKind::Auto => return fit_data(data, kind),
     };
     let sim = model.simulate_at(u, dt)?;
     let stats = ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()));
@@ -353,7 +372,7 @@ fn fit_one<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Resul
         identified_by: Some(ModelProvenance {
             method: kind.name().to_string(),
             orders: kind.orders(),
-            samples: rec.len(),
+            samples: u.len(),
             sample_time_s: dt,
             fit_percent: stats.fit_percent,
             simulation_rms_m: stats.rms,
@@ -428,7 +447,8 @@ mod tests {
         let y: Vec<f64> = (0..n).map(|k| rec.position()[k % rec.len()]).collect();
         let long = Recording::from_rate(5000.0, u, y).unwrap();
         let capped = fit_global_model(&long, &kind).unwrap();
-        let head = fit_one(&long.head(GLOBAL_FIT_SAMPLES).unwrap(), &kind).unwrap();
+        let h = long.head(GLOBAL_FIT_SAMPLES).unwrap();
+        let head = fit_one((h.command(), h.position(), h.dt()), &kind).unwrap();
         assert_eq!(capped, head);
         assert_eq!(capped.identified_by.unwrap().samples, GLOBAL_FIT_SAMPLES);
     }

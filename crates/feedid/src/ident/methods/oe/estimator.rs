@@ -83,6 +83,7 @@
 use std::ops::Range;
 
 use nalgebra::{Complex, DMatrix};
+use rayon::prelude::*;
 
 use super::companion::{is_hurwitz, output, reflect_unstable, Companion, MAX_ORDER};
 use super::srivc::srivc;
@@ -464,6 +465,9 @@ fn lm_config(cfg: &OeConfig, iterations: usize) -> LmConfig {
 /// Fit a continuous-time output-error model `N(s)/D(s)` over a whole
 /// recording: command `u` \[m\], measured position `y` \[m\], sample interval
 /// `dt` \[s\]. The recording should start at rest (see the module doc).
+/// Where SRIVC cycles, each of its best-fitting iterates is refined (in
+/// parallel, on rayon's pool) and the smallest residual wins, the first of
+/// equals in a fixed order: the result does not depend on the threads.
 ///
 /// Errors: [`Error::LengthMismatch`], [`Error::TooFewSamples`] (fewer than
 /// `2·(np + nz + 1) + 2` samples), [`Error::NonFinite`], [`Error::InvalidParameter`],
@@ -492,17 +496,25 @@ pub fn fit_oe(u: &[f64], y: &[f64], dt: f64, cfg: &OeConfig) -> Result<OeFit> {
     let penalty = 1e6 * y_rms;
     // each start refined; the stable fit with the smallest residual wins
     // (the first of equals)
+    // (the starts are independent: refined in parallel, compared in order,
+    // so the result is the sequential one)
+    let refined: Vec<_> = starts
+        .into_par_iter()
+        .map(|(st, mut theta)| {
+            global_lm(u, y, dt, &st, &mut theta, penalty, cfg, cfg.max_iterations)
+                .map(|(report, lm)| (st, theta, report, lm))
+        })
+        .collect();
     let mut best: Option<(Structure, Vec<f64>, LmReport, LevenbergMarquardt)> = None;
     let mut failure = None;
-    for (st, mut theta) in starts {
-        let (report, lm) =
-            match global_lm(u, y, dt, &st, &mut theta, penalty, cfg, cfg.max_iterations) {
-                Ok(r) => r,
-                Err(e) => {
-                    failure.get_or_insert(e);
-                    continue;
-                }
-            };
+    for fit in refined {
+        let (st, theta, report, lm) = match fit {
+            Ok(r) => r,
+            Err(e) => {
+                failure.get_or_insert(e);
+                continue;
+            }
+        };
         let stable = is_hurwitz(&theta[..st.n]) && theta.iter().all(|v| v.is_finite());
         let better = best
             .as_ref()

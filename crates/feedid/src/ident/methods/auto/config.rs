@@ -174,3 +174,33 @@ impl AutoConfig {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The order the README gives for the `candidate` column of `coef.csv`
+    /// (an index into this list).
+    #[test]
+    fn the_default_candidates_are_in_the_order_the_readme_numbers_them() {
+        let names: Vec<String> = AutoConfig::default_candidates()
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "ls 2,2,0 W=100",
+                "ls 2,2,0+c W=100",
+                "rls 3,3,0+c λ=0.99",
+                "rls 3,3,0 λ=0.995",
+                "rls 4,4,0 λ=0.999",
+                "rls 6,6,0 λ=0.999",
+                "rls 8,8,0 λ=0.9995",
+                "command at rest",
+            ]
+        );
+        // the reported (long-memory) candidate is the last recursive one
+        assert_eq!(AutoConfig::default().reported(), Some(6));
+    }
+}

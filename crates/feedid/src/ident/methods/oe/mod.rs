@@ -3,7 +3,9 @@
 
 mod companion;
 mod estimator;
+mod global;
 mod srivc;
 mod window;
 
-pub use estimator::{fit_oe, OeConfig, OeEstimator, OeFit, OeJacobian};
+pub use estimator::{OeConfig, OeEstimator, OeJacobian};
+pub use global::{fit_oe, OeFit};

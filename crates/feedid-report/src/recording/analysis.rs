@@ -8,8 +8,8 @@ use crate::html::{Figure, HtmlReport, Section};
 use crate::plot::{decimate_minmax, LineChart, Series};
 use feedid::drive::{closed_loop_coefficients, simulate_nominal_recording, D1Variant, RigParams};
 use feedid::ident::{
-    fit_global_model, prediction_errors, EngineConfig, GlobalModelKind, LinearModel, Method,
-    OeConfig, ResidualAnalysis, GLOBAL_FIT_SAMPLES,
+    fit_global_model, prediction_errors, simulation_error, EngineConfig, GlobalModelKind,
+    LinearModel, Method, OeConfig, ResidualAnalysis, GLOBAL_FIT_SAMPLES,
 };
 use feedid::lti::TransferFunction;
 use feedid::pipeline::{Identification, Pipeline};
@@ -214,21 +214,17 @@ impl RecordingAnalysis {
                 .map(|k| (y[k], simulated[k])),
         );
         let (global, mut notes) = if opts.global_models {
-            match recording.gaps() {
-                [] => global_models(&recording, opts),
-                _ => {
-                    // on the stretch without dropped samples where the command moves most
-                    let part = recording.moving_segment();
-                    let (global, mut notes) = global_models(&recording.slice(part.clone())?, opts);
-                    notes.push(format!(
-                        "Global models: fitted and simulated on samples {} … {} only, the stretch \
-                         without dropped samples where the command moves most.",
-                        part.start,
-                        part.end - 1
-                    ));
-                    (global, notes)
-                }
+            let (global, mut notes) = global_models(&recording, opts);
+            if let Some(g) = recording.gaps().first() {
+                notes.push(format!(
+                    "Global models: fitted and simulated through the {} gap(s) of dropped samples \
+                     (the first before sample {}; the command interpolated there), compared with \
+                     the measured samples only.",
+                    recording.gaps().len(),
+                    g.index
+                ));
             }
+            (global, notes)
         } else {
             (Vec::new(), Vec::new())
         };
@@ -469,20 +465,18 @@ fn global_models(recording: &Recording, opts: &ReportOptions) -> (Vec<GlobalMode
         || fit_global_model(recording, &GlobalModelKind::Oe { poles, zeros }),
     );
     let (mut global, mut notes) = (Vec::new(), Vec::new());
-    let n = recording.len().min(GLOBAL_FIT_SAMPLES);
-    let (u, y, dt) = (
-        &recording.command()[..n],
-        &recording.position()[..n],
-        recording.dt(),
-    );
+    // simulated over the fitted samples (through any gaps)
+    let head = recording.head(GLOBAL_FIT_SAMPLES);
     for (label, fit) in [(arx_label, arx), (oe_label, oe)] {
         match fit {
-            Ok(file) => match file.model.simulate_at(u, dt) {
-                Ok(sim) if sim.iter().all(|v| v.is_finite()) => global.push(GlobalModel {
+            Ok(file) => match head
+                .as_ref()
+                .map_err(|e| e.to_string())
+                .and_then(|h| simulation_error(&file.model, h).map_err(|e| e.to_string()))
+            {
+                Ok(simulation) if simulation.rms.is_finite() => global.push(GlobalModel {
                     label,
-                    simulation: ErrorStats::from_pairs(
-                        y.iter().copied().zip(sim.iter().copied()),
-                    ),
+                    simulation,
                     model: file.model,
                 }),
                 _ => notes.push(format!(

@@ -203,10 +203,18 @@ fn a_recording_with_dropped_samples_is_reported_segment_by_segment() {
         "{:?}",
         a.notes
     );
-    assert!(a
-        .notes
-        .iter()
-        .any(|n| n.contains("the stretch without dropped samples where the command moves most")));
+    assert!(
+        a.notes.iter().any(|n| n.contains(
+            "Global models: fitted and simulated through the 1 gap(s) of dropped samples"
+        )),
+        "{:?}",
+        a.notes
+    );
+    // the global models are those of the whole recording, through the gap
+    assert!(!a.global.is_empty());
+    for g in &a.global {
+        assert_eq!(g.simulation.samples, a.recording.len(), "{}", g.label);
+    }
     assert!(a
         .facts()
         .iter()

@@ -27,14 +27,15 @@ pub use engine::{
 };
 pub use method::{Method, METHOD_NAMES};
 pub use methods::{
-    coefficients_from_polynomials, fit_arx, fit_oe, polynomials_from_coefficients, ArxConfig,
-    ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders, AutoConfig, AutoEstimator, Candidate,
-    OeConfig, OeEstimator, OeFit, OeJacobian, PaperConfig, PaperDiagnostics, PaperMethod,
-    PredictionMode, RlsConfig, RlsEstimator, SimplexSettings, SimplexStart, Solver, TimeOrigin,
-    MAX_ARX_ORDER, SHIFT_AMPLIFICATION_WARNING,
+    coefficients_from_polynomials, fit_arx, fit_arx_segments, fit_oe, fit_oe_measured,
+    polynomials_from_coefficients, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders,
+    AutoConfig, AutoEstimator, Candidate, OeConfig, OeEstimator, OeFit, OeJacobian, PaperConfig,
+    PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig, RlsEstimator, SimplexSettings,
+    SimplexStart, Solver, TimeOrigin, MAX_ARX_ORDER, SHIFT_AMPLIFICATION_WARNING,
 };
 pub use model::{
-    fit_global_model, GlobalModelKind, LinearModel, ModelFile, ModelProvenance, GLOBAL_FIT_SAMPLES,
+    fit_global_model, simulation_error, GlobalModelKind, LinearModel, ModelFile, ModelProvenance,
+    GLOBAL_FIT_SAMPLES,
 };
 pub use select::{
     frols, order_table, select_order, sweep, Criterion, FrolsConfig, FrolsResult, FrolsTerm,

@@ -354,17 +354,8 @@ impl<'a> Pipeline<'a> {
             .global_model()
             .map(GlobalModelKind::for_summary)
             .filter(|_| self.method_global_model);
-        // global models on the stretch without dropped samples where the
-        // command moves most
-        let gapped = if recording.gaps().is_empty() {
-            None
-        } else {
-            Some(recording.slice(recording.moving_segment())?)
-        };
-        let fit_global = |kind: &GlobalModelKind| match &gapped {
-            Some(part) => fit_global_model(part, kind),
-            None => fit_global_model(recording, kind),
-        };
+        // global models of the whole recording (through any gaps)
+        let fit_global = |kind: &GlobalModelKind| fit_global_model(recording, kind);
         let (global, global_note) = match &method_kind {
             None => (None, None),
             Some(kind) => match fit_global(kind) {
@@ -547,8 +538,9 @@ mod tests {
             .to_string()
             .contains("2 gap(s) of dropped samples (4 missing)"));
         assert!(
-            s.to_string()
-                .contains("on 300 samples of the stretch without dropped samples where"),
+            s.to_string().contains(
+                "on 746 measured samples (simulated through the 2 gap(s), compared where measured)"
+            ),
             "{s}"
         );
         assert!(a.warnings.iter().any(|w| matches!(
@@ -574,9 +566,16 @@ mod tests {
                 whole[k]
             );
         }
-        // the global model: on the segment where the command moves most, as said
-        assert_eq!(rec.moving_segment(), 0..300);
-        assert_eq!(s.global_model_samples, Some(300));
+        // the global model: fitted on every measured sample, simulated
+        // through the gaps (its fit is the free run's over the measured ones)
+        assert_eq!(s.global_model_samples, Some(rec.len()));
+        let g = a.global.as_ref().unwrap();
+        let e = crate::ident::simulation_error(&g.model, &rec).unwrap();
+        assert_eq!(e.samples, rec.len());
+        let p = g.identified_by.as_ref().unwrap();
+        assert_eq!((p.samples, p.missing_samples), (746, 4));
+        assert!((p.fit_percent - e.fit_percent).abs() < 1e-9);
+        assert!(p.fit_percent > 99.0, "{}", p.fit_percent);
     }
 
     #[test]

@@ -184,7 +184,7 @@ impl fmt::Display for IdentifySummary {
         if self.gaps > 0 {
             writeln!(
                 f,
-                "  {} gap(s) of dropped samples ({} missing): the windows restarted after each",
+                "  {} gap(s) of dropped samples ({} missing): the windows restarted after each gap",
                 self.gaps, self.missing_samples
             )?;
         }
@@ -197,12 +197,11 @@ impl fmt::Display for IdentifySummary {
         }
         if let (Some(m), Some(fit)) = (&self.global_model, self.global_fit_percent) {
             let share = match self.global_model_samples {
-                Some(n) if self.gaps > 0 => {
-                    format!(
-                        " on {n} samples of the stretch without dropped samples where the command \
-                         moves most"
-                    )
-                }
+                Some(n) if self.gaps > 0 => format!(
+                    " on {n} measured samples (simulated through the {} gap(s), compared where \
+                     measured)",
+                    self.gaps
+                ),
                 Some(n) if n < self.samples => format!(
                     " on the first {n} samples ({:.1} %)",
                     100.0 * n as f64 / self.samples as f64

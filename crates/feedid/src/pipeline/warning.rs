@@ -59,8 +59,8 @@ pub enum Warning {
         /// Samples of the later segments before their first prediction
         /// (not predicted because of the restarts).
         unpredicted: usize,
-        /// Samples in the stretch without gaps that order selection and the
-        /// global models use.
+        /// Samples in the stretch without gaps that order selection uses
+        /// (the global models run through the gaps).
         stretch: usize,
     },
     /// Paper method with the window time origin: the output model
@@ -140,7 +140,8 @@ impl fmt::Display for Warning {
                 "{missing} sample{} missing in {gaps} gap{} (dropped by the acquisition?; the \
                  first before sample {first}, t = {first_time_s} s): the windows restarted after \
                  each gap, as `feedid stream` does, so {unpredicted} samples at the start of the \
-                 later segments are not predicted; order selection and global models use the \
+                 later segments are not predicted; global models are fitted and simulated through \
+                 the gaps (compared with the measured samples only); order selection uses the \
                  stretch without gaps where the command moves most ({stretch} samples)",
                 if *missing == 1 { " looks" } else { "s look" },
                 if *gaps == 1 { "" } else { "s" },

@@ -10,9 +10,9 @@ mod regressor;
 mod rls;
 
 pub(crate) use arx::fit_arx_rows;
-pub use arx::{fit_arx, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit};
+pub use arx::{fit_arx, fit_arx_segments, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit};
 pub use auto::{AutoConfig, AutoEstimator, Candidate};
-pub use oe::{fit_oe, OeConfig, OeEstimator, OeFit, OeJacobian};
+pub use oe::{fit_oe, fit_oe_measured, OeConfig, OeEstimator, OeFit, OeJacobian};
 pub use paper::{
     coefficients_from_polynomials, polynomials_from_coefficients, PaperConfig, PaperDiagnostics,
     PaperMethod, PredictionMode, SimplexSettings, SimplexStart, Solver, TimeOrigin,

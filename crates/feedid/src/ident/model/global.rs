@@ -44,7 +44,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::ident::{fit_arx, fit_oe, ArxConfig, ArxOrders, LinearModel, OeConfig};
+use crate::ident::{
+    fit_arx, fit_arx_segments, fit_oe, fit_oe_measured, ArxConfig, ArxOrders, LinearModel, OeConfig,
+};
 use crate::recording::Recording;
 use crate::stats::ErrorStats;
 
@@ -166,8 +168,12 @@ pub struct ModelProvenance {
     pub method: String,
     /// Orders (`na,nb,nk` or `poles,zeros`).
     pub orders: String,
-    /// Samples of the recording.
+    /// Samples of the recording fitted (measured ones).
     pub samples: usize,
+    /// Samples dropped in the gaps of the fitted part (the model was
+    /// simulated through them and not compared there); 0 without gaps.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub missing_samples: usize,
     /// Sample time of the recording \[s\].
     pub sample_time_s: f64,
     /// Free-run simulation fit over the recording \[%\] (NRMSE).
@@ -180,6 +186,11 @@ pub struct ModelProvenance {
     /// With `auto`: every candidate tried, `"method orders: simulation rms"` or its error.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub candidates: Vec<String>,
+}
+
+/// Whether a count is zero (serde: written only when not).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// A model file: the model and its provenance.
@@ -260,10 +271,18 @@ pub const GLOBAL_FIT_SAMPLES: usize = 200_000;
 /// [`GLOBAL_FIT_SAMPLES`] samples at most): the one path of every global
 /// model.
 ///
-/// Errors: a recording with gaps of dropped samples (a free-run fit needs
-/// uniform sampling: fit one segment, [`Recording::slice`]); those of
-/// [`fit_arx`] / [`fit_oe`] (too few samples, no excitation, no stable
-/// model); with `auto`, the last candidate's error when none succeeds.
+/// A recording with gaps of dropped samples is fitted whole: ARX on the
+/// rows of every segment between the gaps ([`fit_arx_segments`]: no row
+/// pairs samples across a gap), output error and every free-run
+/// simulation on the regular time grid through the gaps, the command
+/// interpolated where samples were dropped, compared with the measured
+/// samples only ([`fit_oe_measured`]); [`ModelProvenance::samples`] counts
+/// the measured samples and [`ModelProvenance::missing_samples`] the
+/// dropped ones.
+///
+/// Errors: those of [`fit_arx`] / [`fit_oe`] (too few samples, no
+/// excitation, no stable model); with `auto`, the last candidate's error
+/// when none succeeds.
 ///
 /// With `auto` the three kinds are fitted in parallel (rayon's pool) and
 /// compared in a fixed order, so the result does not depend on the threads.
@@ -271,7 +290,6 @@ pub fn fit_global_model<S: AsRef<[f64]>>(
     rec: &Recording<S>,
     kind: &GlobalModelKind,
 ) -> Result<ModelFile> {
-    rec.require_uniform()?;
     if rec.len() <= GLOBAL_FIT_SAMPLES {
         return fit_kind(rec, kind);
     }
@@ -280,14 +298,105 @@ pub fn fit_global_model<S: AsRef<[f64]>>(
 
 /// [`fit_global_model`] without the cap.
 fn fit_kind<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Result<ModelFile> {
-    fit_data((rec.command(), rec.position(), rec.dt()), kind)
+    let grid = Grid::of(rec)?;
+    fit_data(&Data::of(rec, grid.as_ref()), kind)
 }
 
-/// Command, position \[m\] and sample time \[s\] of the fitted samples.
-type Data<'a> = (&'a [f64], &'a [f64], f64);
+/// The free-run simulation error of `model` over the recording: simulated
+/// from rest at the first command sample, on the regular time grid through
+/// any gaps of dropped samples (the command interpolated there), and
+/// compared with the measured samples only — as the global models are
+/// scored ([`ModelProvenance::fit_percent`]).
+///
+/// ```
+/// use feedid::ident::{simulation_error, LinearModel};
+/// let m = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+/// let u: Vec<f64> = (0..500).map(|k| ((k / 50) % 2) as f64 * 1e-3).collect();
+/// let y = m.simulate(&u).unwrap();
+/// let rec = feedid::Recording::from_rate(1000.0, u, y).unwrap().dropping(&[120, 121]).unwrap();
+/// let e = simulation_error(&m, &rec).unwrap();
+/// assert_eq!(e.samples, 498);
+/// assert!(e.rms < 1e-12);
+/// ```
+pub fn simulation_error<S: AsRef<[f64]>>(
+    model: &LinearModel,
+    rec: &Recording<S>,
+) -> Result<ErrorStats> {
+    let grid = Grid::of(rec)?;
+    simulated(model, &Data::of(rec, grid.as_ref()))
+}
+
+/// The free-run simulation of `model` on the data's command (through the
+/// gaps), compared with the measured position.
+fn simulated(model: &LinearModel, data: &Data<'_>) -> Result<ErrorStats> {
+    let (y, dt) = (data.position, data.dt);
+    Ok(match data.grid {
+        None => {
+            let sim = model.simulate_at(data.command, dt)?;
+            ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()))
+        }
+        // through the gaps, compared where measured
+        Some(g) => {
+            let sim = model.simulate_at(&g.command, dt)?;
+            ErrorStats::from_pairs(y.iter().zip(&g.measured).map(|(&v, &k)| (v, sim[k])))
+        }
+    })
+}
+
+impl Grid {
+    /// The recording on its regular grid, `None` without gaps.
+    fn of<S: AsRef<[f64]>>(rec: &Recording<S>) -> Result<Option<Self>> {
+        if rec.gaps().is_empty() {
+            return Ok(None);
+        }
+        Ok(Some(Grid {
+            command: rec.fill_gaps(rec.command())?,
+            position: rec.fill_gaps(rec.position())?,
+            measured: rec.grid_indices(),
+        }))
+    }
+}
+
+impl<'a> Data<'a> {
+    /// The recording's samples, with its `grid` ([`Grid::of`]).
+    fn of<S: AsRef<[f64]>>(rec: &'a Recording<S>, grid: Option<&'a Grid>) -> Self {
+        Data {
+            command: rec.command(),
+            position: rec.position(),
+            dt: rec.dt(),
+            segments: rec.segments(),
+            grid,
+        }
+    }
+}
+
+/// The fitted samples.
+struct Data<'a> {
+    /// Command \[m\], one per sample.
+    command: &'a [f64],
+    /// Measured position \[m\], one per sample.
+    position: &'a [f64],
+    /// Sample time \[s\].
+    dt: f64,
+    /// The segments between gaps (one without gaps).
+    segments: Vec<std::ops::Range<usize>>,
+    /// With gaps: the signals on the regular grid through them.
+    grid: Option<&'a Grid>,
+}
+
+/// A recording with gaps on the regular time grid through them.
+struct Grid {
+    /// Command, the dropped samples interpolated \[m\].
+    command: Vec<f64>,
+    /// Position, the dropped samples interpolated (only the output-error
+    /// fit's initial estimate sees them) \[m\].
+    position: Vec<f64>,
+    /// Grid index of every measured sample.
+    measured: Vec<usize>,
+}
 
 /// [`fit_kind`] on the fitted samples.
-fn fit_data(data: Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
+fn fit_data(data: &Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
     if *kind != GlobalModelKind::Auto {
         return fit_one(data, kind);
     }
@@ -344,24 +453,31 @@ fn fit_data(data: Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
     }
 }
 
-/// One kind (not `Auto`) fitted to command `u`, position `y` \[m\] at the
-/// sample time `dt` \[s\].
-fn fit_one(data: Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
-    let (u, y, dt) = data;
-    let model = match kind {
-        GlobalModelKind::Arx(orders) => fit_arx(u, y, dt, *orders, &ArxConfig::default())?.model,
-        GlobalModelKind::Oe { poles, zeros } => {
+/// One kind fitted to the samples, and its free-run simulation compared
+/// with the measured position.
+fn fit_one(data: &Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
+    let (u, y, dt) = (data.command, data.position, data.dt);
+    let model = match (kind, data.grid) {
+        (GlobalModelKind::Arx(orders), None) => {
+            fit_arx(u, y, dt, *orders, &ArxConfig::default())?.model
+        }
+        (GlobalModelKind::Arx(orders), Some(_)) => {
+            fit_arx_segments(u, y, dt, *orders, &ArxConfig::default(), &data.segments)?.model
+        }
+        (GlobalModelKind::Oe { poles, zeros }, grid) => {
             let cfg = OeConfig {
                 poles: *poles,
                 zeros: *zeros,
                 ..OeConfig::default()
             };
-            fit_oe(u, y, dt, &cfg)?.model
+            match grid {
+                None => fit_oe(u, y, dt, &cfg)?.model,
+                Some(g) => fit_oe_measured(&g.command, &g.position, dt, &g.measured, &cfg)?.model,
+            }
         }
-        GlobalModelKind::Auto => return fit_data(data, kind),
+        (GlobalModelKind::Auto, _) => return fit_data(data, kind),
     };
-    let sim = model.simulate_at(u, dt)?;
-    let stats = ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()));
+    let stats = simulated(&model, data)?;
     if !(stats.rms.is_finite()) {
         return Err(Error::InvalidModel {
             reason: "the global model's simulation is not finite",
@@ -373,6 +489,7 @@ fn fit_one(data: Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
             method: kind.name().to_string(),
             orders: kind.orders(),
             samples: u.len(),
+            missing_samples: data.grid.map_or(0, |g| g.command.len() - u.len()),
             sample_time_s: dt,
             fit_percent: stats.fit_percent,
             simulation_rms_m: stats.rms,
@@ -386,6 +503,7 @@ fn fit_one(data: Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
 mod tests {
     use super::*;
     use crate::drive::{simulate_nominal, RigParams};
+    use crate::lti::TransferFunction;
     use crate::signal::Scenario;
 
     #[test]
@@ -448,9 +566,102 @@ mod tests {
         let long = Recording::from_rate(5000.0, u, y).unwrap();
         let capped = fit_global_model(&long, &kind).unwrap();
         let h = long.head(GLOBAL_FIT_SAMPLES).unwrap();
-        let head = fit_one((h.command(), h.position(), h.dt()), &kind).unwrap();
+        let head = fit_kind(&h, &kind).unwrap();
         assert_eq!(capped, head);
         assert_eq!(capped.identified_by.unwrap().samples, GLOBAL_FIT_SAMPLES);
+    }
+
+    /// A second-order axis (ω = 141 rad/s, ζ ≈ 1.06) at 1 kHz under a
+    /// square-wave command, exact (no noise).
+    fn exact_second_order() -> (TransferFunction, Recording) {
+        let g = TransferFunction::new(vec![2.0e4], vec![1.0, 300.0, 2.0e4]).unwrap();
+        let u: Vec<f64> = (0..1200)
+            .map(|k| if (k / 60) % 2 == 1 { 1e-3 } else { 0.0 })
+            .collect();
+        let y = g
+            .to_state_space()
+            .unwrap()
+            .discretize_zoh(1e-3)
+            .unwrap()
+            .simulate(&u, None)
+            .unwrap();
+        (g, Recording::from_rate(1000.0, u, y).unwrap())
+    }
+
+    #[test]
+    fn a_recording_with_dropped_samples_is_fitted_through_its_gaps() {
+        let (g, full) = exact_second_order();
+        // (none at an edge of the square wave: there the interpolated
+        // command would not be the one the axis saw)
+        let rec = full.dropping(&[200, 201, 202, 650, 905]).unwrap();
+        assert_eq!(rec.gaps().len(), 3);
+        // output error: the true model, from the measured samples only
+        let oe = fit_global_model(&rec, &GlobalModelKind::Oe { poles: 2, zeros: 0 }).unwrap();
+        let tf = match &oe.model {
+            LinearModel::Continuous { num, den } => (num.clone(), den.clone()),
+            other => panic!("{other:?}"),
+        };
+        for (a, b) in tf.1.iter().zip(g.den()) {
+            assert!((a / b - 1.0).abs() < 1e-6, "{:?} vs {:?}", tf.1, g.den());
+        }
+        let p = oe.identified_by.as_ref().unwrap();
+        assert_eq!((p.samples, p.missing_samples), (1195, 5));
+        assert!(p.fit_percent > 99.999, "{}", p.fit_percent);
+        // ARX: the exact discrete model has 2 poles and 2 zeros (ZOH), so
+        // ARX 2,2,1 on the rows of the segments fits it to rounding, and
+        // its free run through the gaps matches the measured samples
+        let arx = fit_global_model(&rec, &GlobalModelKind::Arx(ArxOrders::new(2, 2, 1))).unwrap();
+        let p = arx.identified_by.as_ref().unwrap();
+        assert!(p.fit_percent > 99.999, "{}", p.fit_percent);
+        let e = simulation_error(&arx.model, &rec).unwrap();
+        assert_eq!(e.samples, 1195);
+        assert!((e.fit_percent - p.fit_percent).abs() < 1e-9);
+        // without the gaps: the same models to rounding
+        let whole = fit_global_model(&full, &GlobalModelKind::Oe { poles: 2, zeros: 0 }).unwrap();
+        assert!(
+            (whole.model.dc_gain().unwrap() - oe.model.dc_gain().unwrap()).abs() < 1e-9,
+            "{:?} vs {:?}",
+            whole.model,
+            oe.model
+        );
+        // the written file says what was missing; an old file without the
+        // field still reads
+        let json = oe.to_json();
+        assert!(json.contains("\"missing_samples\": 5"), "{json}");
+        assert!(!whole.to_json().contains("missing_samples"));
+    }
+
+    #[test]
+    fn the_gap_paths_on_a_recording_without_gaps_are_the_plain_fits() {
+        let (_, rec) = exact_second_order();
+        let (u, y, dt) = (rec.command(), rec.position(), rec.dt());
+        let o = ArxOrders::new(3, 2, 1);
+        let cfg = ArxConfig::default();
+        assert_eq!(
+            fit_arx_segments(u, y, dt, o, &cfg, std::slice::from_ref(&(0..u.len()))).unwrap(),
+            fit_arx(u, y, dt, o, &cfg).unwrap()
+        );
+        let oe = OeConfig {
+            poles: 2,
+            zeros: 0,
+            ..OeConfig::default()
+        };
+        let all: Vec<usize> = (0..u.len()).collect();
+        let a = fit_oe_measured(u, y, dt, &all, &oe).unwrap();
+        let b = fit_oe(u, y, dt, &oe).unwrap();
+        assert_eq!((a.num, a.den, a.report), (b.num, b.den, b.report));
+        // bad indices are refused, not indexed
+        for bad in [vec![0, 5, 5], vec![3, 1], vec![0, u.len()]] {
+            let e = fit_oe_measured(u, y, dt, &bad, &oe)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("measured"), "{e}");
+        }
+        // a segment beyond the data is refused
+        let e = fit_arx_segments(u, y, dt, o, &cfg, std::slice::from_ref(&(0..u.len() + 1)))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("segments"), "{e}");
     }
 
     #[test]

@@ -5,6 +5,7 @@ mod global;
 mod linear;
 
 pub use global::{
-    fit_global_model, GlobalModelKind, ModelFile, ModelProvenance, GLOBAL_FIT_SAMPLES,
+    fit_global_model, simulation_error, GlobalModelKind, ModelFile, ModelProvenance,
+    GLOBAL_FIT_SAMPLES,
 };
 pub use linear::LinearModel;

@@ -78,6 +78,63 @@ pub fn fit_arx(
     fit_arx_rows(u, y, dt, orders, cfg, orders.lag(), y.len(), true)
 }
 
+/// Batch ARX fit of a recording with dropped samples: the rows `k = start +
+/// lag … end − 1` of every segment between the gaps (`segments`: sample
+/// ranges, as [`crate::Recording::segments`]), stacked, so that no row pairs
+/// samples across a gap; otherwise as [`fit_arx`] (one segment: the same
+/// fit). [`ArxFit::residuals`] are the stacked rows' residuals and
+/// [`ArxFit::first_row`] the first of them. Errors: as [`fit_arx`]; a
+/// segment beyond the data ([`Error::LengthMismatch`]).
+///
+/// ```
+/// use feedid::ident::{fit_arx, fit_arx_segments, ArxConfig, ArxOrders};
+/// let n = 300;
+/// let u: Vec<f64> = (0..n).map(|k| ((k * 7919) % 101) as f64 / 101.0 - 0.5).collect();
+/// let mut y = vec![0.0; n];
+/// for k in 2..n {
+///     y[k] = 1.2 * y[k - 1] - 0.5 * y[k - 2] + 0.3 * u[k - 1];
+/// }
+/// let cfg = ArxConfig { ridge: 0.0, ..Default::default() };
+/// // samples 150 and 151 lost: two segments, no row across the gap
+/// let (u2, y2): (Vec<f64>, Vec<f64>) =
+///     (0..n).filter(|k| !(150..152).contains(k)).map(|k| (u[k], y[k])).unzip();
+/// let fit = fit_arx_segments(&u2, &y2, 1e-3, ArxOrders::new(2, 1, 1), &cfg, &[0..150, 150..298]).unwrap();
+/// assert!((fit.theta[0] + 1.2).abs() < 1e-10 && (fit.theta[2] - 0.3).abs() < 1e-10);
+/// assert_eq!(fit.n, 148 + 146);
+/// ```
+pub fn fit_arx_segments(
+    u: &[f64],
+    y: &[f64],
+    dt: f64,
+    orders: ArxOrders,
+    cfg: &ArxConfig,
+    segments: &[std::ops::Range<usize>],
+) -> Result<ArxFit> {
+    if let Some(r) = segments.iter().find(|r| r.end > y.len()) {
+        return Err(Error::LengthMismatch {
+            what: "segments (end of the last)",
+            expected: y.len(),
+            actual: r.end,
+        });
+    }
+    let lag = orders.lag();
+    let rows: Vec<std::ops::Range<usize>> = segments
+        .iter()
+        .filter(|r| r.end > r.start + lag)
+        .map(|r| r.start + lag..r.end)
+        .collect();
+    let np = orders.n_params() + usize::from(cfg.offset);
+    let m: usize = rows.iter().map(|r| r.len()).sum();
+    if m <= np {
+        return Err(Error::TooFewSamples {
+            what: "ARX fit over the segments between dropped samples (rows > parameters)",
+            needed: np + 1,
+            actual: m,
+        });
+    }
+    fit_arx_ranges(u, y, dt, orders, cfg, &rows, true)
+}
+
 /// Batch ARX fit over the rows `first_row .. end` (`first_row ≥ lag`).
 pub(crate) fn fit_arx_rows(
     u: &[f64],
@@ -108,6 +165,32 @@ pub(crate) fn fit_arx_rows(
             actual: end,
         });
     }
+    let rows = first_row..end;
+    fit_arx_ranges(
+        u,
+        y,
+        dt,
+        orders,
+        cfg,
+        std::slice::from_ref(&rows),
+        with_std_errors,
+    )
+}
+
+/// The fit of the rows in `rows` (ranges of row indices `k ≥ lag`, more
+/// rows than parameters: checked by the callers), stacked.
+fn fit_arx_ranges(
+    u: &[f64],
+    y: &[f64],
+    dt: f64,
+    orders: ArxOrders,
+    cfg: &ArxConfig,
+    rows: &[std::ops::Range<usize>],
+    with_std_errors: bool,
+) -> Result<ArxFit> {
+    let np = orders.n_params() + usize::from(cfg.offset);
+    let m: usize = rows.iter().map(|r| r.len()).sum();
+    let first_row = rows.first().map_or(orders.lag(), |r| r.start);
     if let Some(i) = y.iter().chain(u).position(|v| !v.is_finite()) {
         return Err(Error::NonFinite {
             channel: if i < y.len() { "position" } else { "command" }.to_string(),
@@ -119,7 +202,7 @@ pub(crate) fn fit_arx_rows(
     let mut a = vec![0.0; m * np];
     let mut b = vec![0.0; m];
     let mut psi = vec![1.0; np];
-    for (row, k) in (first_row..end).enumerate() {
+    for (row, k) in rows.iter().flat_map(|r| r.clone()).enumerate() {
         b[row] = regressor(&orders, y, u, k, reference, &mut psi);
         for j in 0..np {
             a[row + j * m] = psi[j];

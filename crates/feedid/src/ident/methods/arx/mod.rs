@@ -112,4 +112,4 @@ mod tests;
 pub use config::ArxConfig;
 pub use estimator::{ArxDiagnostics, ArxEstimator};
 pub(crate) use fit::fit_arx_rows;
-pub use fit::{fit_arx, ArxFit};
+pub use fit::{fit_arx, fit_arx_segments, ArxFit};

@@ -81,11 +81,81 @@ impl OeFit {
 /// assert!(fit.fit_percent > 99.999);
 /// ```
 pub fn fit_oe(u: &[f64], y: &[f64], dt: f64, cfg: &OeConfig) -> Result<OeFit> {
+    fit_rows(u, y, dt, None, cfg)
+}
+
+/// [`fit_oe`] through the gaps of a recording with dropped samples: `u`
+/// and `y` on the regular time grid through the gaps (as
+/// [`crate::Recording::fill_gaps`] gives them: the command interpolated
+/// where samples were dropped, and the position too, which only the
+/// initial estimate sees), `measured` the grid indices of the samples that
+/// were measured (ascending, as [`crate::Recording::grid_indices`]). The
+/// model is simulated over the whole grid and its error is taken at the
+/// measured samples only: the fit, its standard errors (`N` = the measured
+/// samples), [`OeFit::fit_percent`] and [`OeFit::residual_rms`] are over
+/// them. With every index measured it is [`fit_oe`]. Errors: as
+/// [`fit_oe`] (with the measured samples counted); indices not ascending
+/// or beyond the grid ([`Error::InvalidParameter`]).
+///
+/// ```
+/// use feedid::ident::{fit_oe_measured, OeConfig};
+/// use feedid::lti::TransferFunction;
+/// let g = TransferFunction::new(vec![2.0e4], vec![1.0, 300.0, 2.0e4]).unwrap();
+/// let dt = 1e-3;
+/// let u: Vec<f64> = (0..800).map(|k| if (k / 50) % 2 == 1 { 1e-3 } else { 0.0 }).collect();
+/// let mut y = g.to_state_space().unwrap().discretize_zoh(dt).unwrap().simulate(&u, None).unwrap();
+/// // samples 300 … 304 were lost: what stands there is never compared
+/// y[300..305].fill(1.0);
+/// let measured: Vec<usize> = (0..800).filter(|k| !(300..305).contains(k)).collect();
+/// let cfg = OeConfig { poles: 2, zeros: 0, ..OeConfig::default() };
+/// let fit = fit_oe_measured(&u, &y, dt, &measured, &cfg).unwrap();
+/// assert!((fit.den[1] / 300.0 - 1.0).abs() < 1e-6);
+/// assert!(fit.fit_percent > 99.99);
+/// ```
+pub fn fit_oe_measured(
+    u: &[f64],
+    y: &[f64],
+    dt: f64,
+    measured: &[usize],
+    cfg: &OeConfig,
+) -> Result<OeFit> {
+    if let Some(w) = measured.windows(2).find(|w| w[1] <= w[0]) {
+        return Err(Error::InvalidParameter {
+            name: "measured",
+            value: w[1] as f64,
+            reason: "grid indices of the measured samples must be strictly ascending",
+        });
+    }
+    if let Some(&k) = measured.last().filter(|&&k| k >= y.len()) {
+        return Err(Error::InvalidParameter {
+            name: "measured",
+            value: k as f64,
+            reason: "grid index beyond the recording",
+        });
+    }
+    fit_rows(u, y, dt, Some(measured), cfg)
+}
+
+/// [`fit_oe`] with the residual at the grid indices `rows` (all: `None`).
+fn fit_rows(
+    u: &[f64],
+    y: &[f64],
+    dt: f64,
+    rows: Option<&[usize]>,
+    cfg: &OeConfig,
+) -> Result<OeFit> {
     cfg.validate()?;
     let p = cfg.parameter_count();
     check_signals(u, y, dt, 2 * p + 2)?;
+    let len = rows.map_or(u.len(), <[usize]>::len);
+    if len < 2 * p + 2 {
+        return Err(Error::TooFewSamples {
+            what: "output-error fit (measured samples)",
+            needed: 2 * p + 2,
+            actual: len,
+        });
+    }
     let (starts, srivc_iterations) = initial_estimate(u, y, dt, cfg)?;
-    let len = u.len();
     let y_rms = crate::stats::rms(y).max(f64::MIN_POSITIVE);
     let penalty = 1e6 * y_rms;
     // each start refined; the stable fit with the smallest residual wins
@@ -95,8 +165,18 @@ pub fn fit_oe(u: &[f64], y: &[f64], dt: f64, cfg: &OeConfig) -> Result<OeFit> {
     let refined: Vec<_> = starts
         .into_par_iter()
         .map(|(st, mut theta)| {
-            global_lm(u, y, dt, &st, &mut theta, penalty, cfg, cfg.max_iterations)
-                .map(|(report, lm)| (st, theta, report, lm))
+            global_lm(
+                u,
+                y,
+                rows,
+                dt,
+                &st,
+                &mut theta,
+                penalty,
+                cfg,
+                cfg.max_iterations,
+            )
+            .map(|(report, lm)| (st, theta, report, lm))
         })
         .collect();
     let mut best: Option<(Structure, Vec<f64>, LmReport, LevenbergMarquardt)> = None;
@@ -141,9 +221,10 @@ pub fn fit_oe(u: &[f64], y: &[f64], dt: f64, cfg: &OeConfig) -> Result<OeFit> {
         num_std[k] = theta_std[n + k] * st.physical_factor(n + k);
     }
     let tf = TransferFunction::new(num.clone(), den.clone())?;
-    let mean = y.iter().sum::<f64>() / len as f64;
-    let spread = y
-        .iter()
+    // over the compared samples
+    let compared = || (0..len).map(|j| y[rows.map_or(j, |r| r[j])]);
+    let mean = compared().sum::<f64>() / len as f64;
+    let spread = compared()
         .map(|v| (v - mean) * (v - mean))
         .sum::<f64>()
         .sqrt();
@@ -169,11 +250,13 @@ pub fn fit_oe(u: &[f64], y: &[f64], dt: f64, cfg: &OeConfig) -> Result<OeFit> {
 }
 
 /// Levenberg–Marquardt of the global output-error fit from `theta` (in
-/// place), at most `iterations`; the solver is returned for its Jacobian.
+/// place), at most `iterations`, the error taken at the grid indices `rows`
+/// (all: `None`); the solver is returned for its Jacobian.
 #[allow(clippy::too_many_arguments)]
 fn global_lm(
     u: &[f64],
     y: &[f64],
+    rows: Option<&[usize]>,
     dt: f64,
     st: &Structure,
     theta: &mut [f64],
@@ -194,15 +277,31 @@ fn global_lm(
         }
         let g = th[n + m] / th[n - 1];
         x.fill(0.0);
-        for k in 0..len {
-            r[k] = output(&th[n..], &x) + g * u0 - y[k];
-            comp.step_zoh(&mut x, u[k] - u0);
+        match rows {
+            None => {
+                for k in 0..len {
+                    r[k] = output(&th[n..], &x) + g * u0 - y[k];
+                    comp.step_zoh(&mut x, u[k] - u0);
+                }
+            }
+            // simulated over the whole grid, compared where measured
+            Some(rows) => {
+                let mut next = rows.iter().copied().enumerate().peekable();
+                for k in 0..len {
+                    let Some(&(j, at)) = next.peek() else { break };
+                    if at == k {
+                        r[j] = output(&th[n..], &x) + g * u0 - y[k];
+                        next.next();
+                    }
+                    comp.step_zoh(&mut x, u[k] - u0);
+                }
+            }
         }
         if r.iter().any(|v| !v.is_finite()) {
             r.fill(penalty);
         }
     };
-    let mut lm = LevenbergMarquardt::new(len, st.p());
+    let mut lm = LevenbergMarquardt::new(rows.map_or(len, <[usize]>::len), st.p());
     let report = lm.minimize(&mut residual, theta, &lm_config(cfg, iterations))?;
     Ok((report, lm))
 }

@@ -8,4 +8,4 @@ mod srivc;
 mod window;
 
 pub use estimator::{OeConfig, OeEstimator, OeJacobian};
-pub use global::{fit_oe, OeFit};
+pub use global::{fit_oe, fit_oe_measured, OeFit};

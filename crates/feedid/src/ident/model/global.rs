@@ -343,6 +343,31 @@ fn simulated(model: &LinearModel, data: &Data<'_>) -> Result<ErrorStats> {
     })
 }
 
+/// The fitted samples.
+struct Data<'a> {
+    /// Command \[m\], one per sample.
+    command: &'a [f64],
+    /// Measured position \[m\], one per sample.
+    position: &'a [f64],
+    /// Sample time \[s\].
+    dt: f64,
+    /// The segments between gaps (one without gaps).
+    segments: Vec<std::ops::Range<usize>>,
+    /// With gaps: the signals on the regular grid through them.
+    grid: Option<&'a Grid>,
+}
+
+/// A recording with gaps on the regular time grid through them.
+struct Grid {
+    /// Command, the dropped samples interpolated \[m\].
+    command: Vec<f64>,
+    /// Position, the dropped samples interpolated (only the output-error
+    /// fit's initial estimate sees them) \[m\].
+    position: Vec<f64>,
+    /// Grid index of every measured sample.
+    measured: Vec<usize>,
+}
+
 impl Grid {
     /// The recording on its regular grid, `None` without gaps.
     fn of<S: AsRef<[f64]>>(rec: &Recording<S>) -> Result<Option<Self>> {
@@ -368,31 +393,6 @@ impl<'a> Data<'a> {
             grid,
         }
     }
-}
-
-/// The fitted samples.
-struct Data<'a> {
-    /// Command \[m\], one per sample.
-    command: &'a [f64],
-    /// Measured position \[m\], one per sample.
-    position: &'a [f64],
-    /// Sample time \[s\].
-    dt: f64,
-    /// The segments between gaps (one without gaps).
-    segments: Vec<std::ops::Range<usize>>,
-    /// With gaps: the signals on the regular grid through them.
-    grid: Option<&'a Grid>,
-}
-
-/// A recording with gaps on the regular time grid through them.
-struct Grid {
-    /// Command, the dropped samples interpolated \[m\].
-    command: Vec<f64>,
-    /// Position, the dropped samples interpolated (only the output-error
-    /// fit's initial estimate sees them) \[m\].
-    position: Vec<f64>,
-    /// Grid index of every measured sample.
-    measured: Vec<usize>,
 }
 
 /// [`fit_kind`] on the fitted samples.

@@ -772,8 +772,21 @@ mod tests {
         (t, u, y)
     }
 
-    /// `auto` with these candidates over [`signals_data`] (window 50,
-    /// H = hop = 10).
+    /// `auto` with `config` over time `t` (1 kHz), command `u` and
+    /// position `y` (window 50, H = hop = 10).
+    fn run_on(config: AutoConfig, t: &[f64], u: &[f64], y: &[f64]) -> crate::ident::SlidingResult {
+        let mut est = config.build().unwrap();
+        let s = Signals::new(t, u, y, 1e-3, 0.0);
+        let cfg = EngineConfig {
+            window: 50,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        };
+        run(&mut est, &s, &cfg).unwrap()
+    }
+
+    /// `auto` with these candidates over [`signals_data`].
     fn run_candidates(
         candidates: Vec<Candidate>,
         offset: f64,
@@ -784,15 +797,7 @@ mod tests {
             plausibility: 100.0,
             ..AutoConfig::default()
         };
-        let mut est = config.build().unwrap();
-        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
-        let cfg = EngineConfig {
-            window: 50,
-            horizon: 10,
-            hop: None,
-            warm_up: 0,
-        };
-        let r = run(&mut est, &s, &cfg).unwrap();
+        let r = run_on(config, &t, &u, &y);
         (u, y, r)
     }
 
@@ -870,15 +875,7 @@ mod tests {
             candidates: vec![Candidate::CommandAtRest],
             ..AutoConfig::default()
         };
-        let mut est = config.build().unwrap();
-        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
-        let cfg = EngineConfig {
-            window: 50,
-            horizon: 10,
-            hop: None,
-            warm_up: 0,
-        };
-        let r = run(&mut est, &s, &cfg).unwrap();
+        let r = run_on(config, &t, &u, &y);
         let (mut at_rest, mut moving) = (0, 0);
         for w in &r.windows[1..] {
             let still = u[w.window.start..w.horizon.end]

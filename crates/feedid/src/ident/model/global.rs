@@ -657,11 +657,15 @@ mod tests {
                 .to_string();
             assert!(e.contains("measured"), "{e}");
         }
-        // a segment beyond the data is refused
+        // a segment beyond the data, or a command of another length, is refused
         let e = fit_arx_segments(u, y, dt, o, &cfg, std::slice::from_ref(&(0..u.len() + 1)))
             .unwrap_err()
             .to_string();
         assert!(e.contains("segments"), "{e}");
+        let e = fit_arx_segments(&u[1..], y, dt, o, &cfg, std::slice::from_ref(&(0..y.len())))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("command"), "{e}");
     }
 
     #[test]

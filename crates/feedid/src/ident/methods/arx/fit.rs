@@ -110,6 +110,14 @@ pub fn fit_arx_segments(
     cfg: &ArxConfig,
     segments: &[std::ops::Range<usize>],
 ) -> Result<ArxFit> {
+    orders.validate()?;
+    if u.len() != y.len() {
+        return Err(Error::LengthMismatch {
+            what: "command",
+            expected: y.len(),
+            actual: u.len(),
+        });
+    }
     if let Some(r) = segments.iter().find(|r| r.end > y.len()) {
         return Err(Error::LengthMismatch {
             what: "segments (end of the last)",

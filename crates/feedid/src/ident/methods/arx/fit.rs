@@ -110,14 +110,7 @@ pub fn fit_arx_segments(
     cfg: &ArxConfig,
     segments: &[std::ops::Range<usize>],
 ) -> Result<ArxFit> {
-    orders.validate()?;
-    if u.len() != y.len() {
-        return Err(Error::LengthMismatch {
-            what: "command",
-            expected: y.len(),
-            actual: u.len(),
-        });
-    }
+    check_orders_and_lengths(u, y, orders)?;
     if let Some(r) = segments.iter().find(|r| r.end > y.len()) {
         return Err(Error::LengthMismatch {
             what: "segments (end of the last)",
@@ -143,6 +136,19 @@ pub fn fit_arx_segments(
     fit_arx_ranges(u, y, dt, orders, cfg, &rows, true)
 }
 
+/// Valid orders and one command sample per position sample.
+fn check_orders_and_lengths(u: &[f64], y: &[f64], orders: ArxOrders) -> Result<()> {
+    orders.validate()?;
+    if u.len() != y.len() {
+        return Err(Error::LengthMismatch {
+            what: "command",
+            expected: y.len(),
+            actual: u.len(),
+        });
+    }
+    Ok(())
+}
+
 /// Batch ARX fit over the rows `first_row .. end` (`first_row ≥ lag`).
 pub(crate) fn fit_arx_rows(
     u: &[f64],
@@ -154,14 +160,7 @@ pub(crate) fn fit_arx_rows(
     end: usize,
     with_std_errors: bool,
 ) -> Result<ArxFit> {
-    orders.validate()?;
-    if u.len() != y.len() {
-        return Err(Error::LengthMismatch {
-            what: "command",
-            expected: y.len(),
-            actual: u.len(),
-        });
-    }
+    check_orders_and_lengths(u, y, orders)?;
     let np = orders.n_params() + usize::from(cfg.offset);
     let first_row = first_row.max(orders.lag());
     let end = end.min(y.len());

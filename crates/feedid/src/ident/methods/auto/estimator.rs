@@ -105,6 +105,11 @@ impl Member {
         self.predictor.spec().in_median()
     }
 
+    /// Whether its pending prediction of `h` samples enters the median.
+    fn pending_in_median(&self, h: usize) -> bool {
+        self.pending_len == h && self.in_median()
+    }
+
     /// The score in regime `r`, else in the first scored regime, else none.
     fn score_in(&self, r: usize) -> Option<f64> {
         if self.scored[r] > 0 {
@@ -699,13 +704,7 @@ impl Estimator for AutoEstimator {
             First::Median => {
                 let (members, sorted) = (&self.members, &mut self.sorted);
                 for (j, o) in out.iter_mut().enumerate() {
-                    *o = median_at(
-                        members,
-                        |m| m.pending_len == h && m.in_median(),
-                        last,
-                        j,
-                        sorted,
-                    );
+                    *o = median_at(members, |m| m.pending_in_median(h), last, j, sorted);
                 }
                 return Ok(PredictStatus::Predicted);
             }
@@ -741,13 +740,7 @@ impl Estimator for AutoEstimator {
                 let (members, sorted) = (&self.members, &mut self.sorted);
                 if members.iter().any(|m| m.pending_len == h) {
                     for (j, o) in out.iter_mut().enumerate() {
-                        *o = median_at(
-                            members,
-                            |m| m.pending_len == h && m.in_median(),
-                            last,
-                            j,
-                            sorted,
-                        );
+                        *o = median_at(members, |m| m.pending_in_median(h), last, j, sorted);
                     }
                 } else {
                     out.fill(last);

@@ -123,8 +123,14 @@ pub struct InfoArgs {
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
     /// Command: ramp (30 mm at 50 mm/s), step (1 mm in 0.2 ms), scurve, chirp, prbs, multisine.
-    #[arg(long, value_name = "NAME")]
-    pub scenario: String,
+    #[arg(long, value_name = "NAME", required_unless_present = "command")]
+    pub scenario: Option<String>,
+    /// Run this command instead of a scenario: a CSV with a time column (time_s) and the command (--command-column), at its own sampling rate (e.g. the output of `feedid compensate`).
+    #[arg(long, value_name = "cmd.csv", conflicts_with_all = ["scenario", "rate", "duration"])]
+    pub command: Option<PathBuf>,
+    /// Column of the command in --command, by name or 1-based index.
+    #[arg(long, value_name = "NAME|N", default_value = "command_m", requires = "command")]
+    pub command_column: String,
     /// Rig parameters (TOML); default: the built-in default rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
@@ -567,4 +573,19 @@ pub struct CompensateArgs {
     /// Summary JSON.
     #[arg(long, value_name = "comp.json")]
     pub summary: Option<PathBuf>,
+    /// Learn from a measured run of the program (time_s,command_m,position_m on the desired trajectory's samples): the output is the next run's command (iterative learning control with the model, see docs/GUIDE.md).
+    #[arg(long, value_name = "run.csv", requires = "model", conflicts_with = "check")]
+    pub measured: Option<PathBuf>,
+    /// The command sent in the measured run (a CSV with time_s and command_m, e.g. the last `compensate -o`) [default: the run's own command_m column].
+    #[arg(long, value_name = "cmd.csv", requires = "measured")]
+    pub sent: Option<PathBuf>,
+    /// Learning history (JSON, read if it exists and rewritten): numbers the runs, checks that the error shrinks and keeps the best run to return to.
+    #[arg(long, value_name = "history.json", requires = "measured")]
+    pub history: Option<PathBuf>,
+    /// Learning gain of a step (0 < g < 2; 1: the model's full correction).
+    #[arg(long, default_value_t = 1.0, value_name = "G", requires = "measured")]
+    pub learning_gain: f64,
+    /// σ of the zero-phase filter of the measured error [s], or auto (as much as the run's own noise allows).
+    #[arg(long, default_value = "auto", value_name = "S|auto", requires = "measured")]
+    pub noise_filter: String,
 }

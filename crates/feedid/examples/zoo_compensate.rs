@@ -34,11 +34,33 @@
 //!
 //! The summary is printed as a Markdown table; `--csv FILE` writes one row
 //! per member.
+//!
+//! **Learning from runs** (`--runs R`, R ≥ 2): the command sent (run 1) and
+//! then R − 1 learning steps ([`feedid::compensate::learn`], library
+//! defaults, the same limits and a history), each run on the axis with fresh
+//! noise (seed `noise_seed + 1000 + run`). Per run the **measured** rms of
+//! position − desired (with the noise, as a user sees it) against the axis's
+//! noise floor `√(σ_n² + q²/12)` (σ_n its noise, q its resolution) and
+//! against the plain command's measured rms. A member reaches the target
+//! when within the runs its measured rms is ≤ 3× the noise floor or ≥ 20×
+//! below the plain command's; it grows when one run's rms exceeds the run
+//! before by more than the noise floor.
+//!
+//! **Wrong models** (`--wrong gain|delay|pole`): the identified model,
+//! written as a discrete `B(q)/A(q)` at the member's rate, is spoiled before
+//! it is used — its gain doubled (and kept: unit DC gain off), two samples
+//! of delay added, or its slowest pole moved 30 % (`s → 1.3·s`, `z → z^1.3`).
+//!
+//! ```sh
+//! cargo run --release -p feedid --example zoo_compensate -- --runs 5
+//! cargo run --release -p feedid --example zoo_compensate -- --runs 5 --wrong delay
+//! ```
 
 use std::path::PathBuf;
 
-use feedid::compensate::{compensate_model, CompensateConfig, ModelQuality};
-use feedid::ident::{fit_global_model, GlobalModelKind};
+use feedid::compensate::{compensate_model, learn, CompensateConfig, LearnConfig, ModelQuality};
+use feedid::ident::{fit_global_model, GlobalModelKind, LinearModel};
+use feedid::lti::{poly_from_roots, poly_roots, Complex, StateSpace};
 use feedid::signal::{Chirp, Sweep};
 use feedid::zoo::{CommandSpec, MemberSpec, Zoo};
 use feedid::Recording;
@@ -57,6 +79,64 @@ struct Row {
     sent_rms: f64,
     predicted_benefit: f64,
     sent: String,
+    /// Measured rms per run (run 1: the command sent).
+    runs: Vec<f64>,
+    /// Measured rms of the plain command.
+    plain_measured: f64,
+    /// Noise floor √(σ² + q²/12).
+    floor: f64,
+    /// Why the learning ended early, if it did.
+    learn_note: String,
+}
+
+/// How the model is spoiled (`--wrong`).
+#[derive(Clone, Copy, PartialEq)]
+enum Wrong {
+    None,
+    Gain,
+    Delay,
+    Pole,
+}
+
+/// The model as a discrete `B(q)/A(q)` at interval `dt`.
+fn as_discrete(model: &LinearModel, dt: f64) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let sys = model.discrete_state_space(Some(dt)).map_err(|e| e.to_string())?;
+    let tf = StateSpace::new(sys.a.clone(), sys.b.clone(), sys.c.clone(), sys.d)
+        .and_then(|s| s.to_tf())
+        .map_err(|e| e.to_string())?;
+    let a = tf.den().to_vec();
+    let mut b = vec![0.0; a.len() - tf.num().len()];
+    b.extend_from_slice(tf.num());
+    Ok((b, a))
+}
+
+/// The model spoiled as `wrong` says (module doc).
+fn spoil(model: &LinearModel, dt: f64, wrong: Wrong) -> Result<LinearModel, String> {
+    if wrong == Wrong::None {
+        return Ok(model.clone());
+    }
+    let (mut b, mut a) = as_discrete(model, dt)?;
+    match wrong {
+        Wrong::None => {}
+        Wrong::Gain => b.iter_mut().for_each(|v| *v *= 2.0),
+        Wrong::Delay => b.splice(0..0, [0.0, 0.0]).for_each(drop),
+        Wrong::Pole => {
+            let mut roots = poly_roots(&a).map_err(|e| e.to_string())?;
+            let slowest = roots
+                .iter()
+                .filter(|z| z.norm() < 1.0)
+                .map(|z| z.norm())
+                .fold(0.0_f64, f64::max);
+            for z in roots.iter_mut() {
+                if (z.norm() - slowest).abs() < 1e-12 * slowest.max(1e-300) && slowest > 0.0 {
+                    let (r, th) = (z.norm(), z.arg());
+                    *z = Complex::from_polar(r.powf(1.3), 1.3 * th);
+                }
+            }
+            a = poly_from_roots(&roots);
+        }
+    }
+    LinearModel::discrete(b, a, dt).map_err(|e| e.to_string())
 }
 
 fn rms_against(truth: &[f64], desired: &[f64]) -> f64 {
@@ -96,7 +176,13 @@ fn command_peaks(u: &[f64], dt: f64) -> (f64, f64) {
     (v, a)
 }
 
-fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
+fn run(
+    zoo: &Zoo,
+    index: usize,
+    max_smoothing: f64,
+    runs: usize,
+    wrong: Wrong,
+) -> Result<Row, String> {
     let member = zoo.member(index).map_err(|e| e.to_string())?;
     let spec = &member.spec;
     let desired = &member.command;
@@ -132,7 +218,8 @@ fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
         .map_err(|e| e.to_string())?;
     let rec = Recording::from_rate(rate, ident.command.clone(), ident.position.clone())
         .map_err(|e| e.to_string())?;
-    let file = fit_global_model(&rec, &GlobalModelKind::Auto).map_err(|e| e.to_string())?;
+    let mut file = fit_global_model(&rec, &GlobalModelKind::Auto).map_err(|e| e.to_string())?;
+    file.model = spoil(&file.model, dt, wrong)?;
     // the identification fit (what `identify` reports), and the share of the
     // following error the model explains on the member's own recording (the
     // plain program run once, as `compensate --check` would use it)
@@ -160,6 +247,7 @@ fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
         max_acceleration: (1.5 * a).max(1.5 * pa),
         max_smoothing,
         quality,
+        unit_dc_gain: wrong != Wrong::Gain,
         ..CompensateConfig::default()
     };
     let (command, sent, predicted_benefit) = match compensate_model(&file.model, desired, dt, &cfg)
@@ -179,6 +267,47 @@ fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
     let comp = spec
         .run_plant(&command, spec.noise_seed)
         .map_err(|e| e.to_string())?;
+    // learning from runs: run 1 is the command sent, each run fresh noise
+    let measured_rms = |p: &[f64]| rms_against(p, desired);
+    let mut sent_cmd = command.clone();
+    let mut history = None;
+    let mut run_rms = Vec::new();
+    let mut learn_note = String::new();
+    let lcfg = LearnConfig {
+        compensate: cfg,
+        ..LearnConfig::default()
+    };
+    for j in 0..runs.max(1) {
+        let r = spec
+            .run_plant(&sent_cmd, spec.noise_seed.wrapping_add(1000 + j as u64))
+            .map_err(|e| e.to_string())?;
+        run_rms.push(measured_rms(&r.position));
+        if j + 1 >= runs {
+            break;
+        }
+        match learn(
+            &file.model,
+            desired,
+            &sent_cmd,
+            &r.position,
+            dt,
+            &lcfg,
+            history.as_ref(),
+        ) {
+            Ok(step) => {
+                if let feedid::compensate::LearnStatus::Stopped { best_run, .. } = step.status {
+                    learn_note = format!("stopped after run {}, best {best_run}", j + 1);
+                }
+                sent_cmd = step.command;
+                history = Some(step.history);
+            }
+            Err(e) => {
+                learn_note = format!("run {}: {e}", j + 1);
+                break;
+            }
+        }
+    }
+    let floor = (spec.noise_std_m.powi(2) + spec.resolution_m.powi(2) / 12.0).sqrt();
     let prov = file.identified_by.as_ref();
     Ok(Row {
         index,
@@ -192,7 +321,70 @@ fn run(zoo: &Zoo, index: usize, max_smoothing: f64) -> Result<Row, String> {
         sent_rms: rms_against(&comp.truth, desired),
         predicted_benefit,
         sent,
+        runs: run_rms,
+        plain_measured: measured_rms(&plain.position),
+        floor,
+        learn_note,
     })
+}
+
+/// The learning table (module doc).
+fn learning_summary(rows: &[Row], runs: usize) {
+    let reached = |r: &Row, upto: usize| {
+        r.runs[..upto.min(r.runs.len())]
+            .iter()
+            .any(|&v| v <= 3.0 * r.floor || v <= r.plain_measured / 20.0)
+    };
+    let grows = |r: &Row| r.runs.windows(2).any(|w| w[1] > w[0] + r.floor);
+    println!("\nlearning from runs (measured rms, with the noise):\n");
+    println!("| run | median rms / noise floor | median plain / rms | at target by this run | grew since the run before |");
+    println!("|---:|---:|---:|---:|---:|");
+    for j in 0..runs {
+        let with: Vec<&Row> = rows.iter().filter(|r| r.runs.len() > j).collect();
+        let mut ratio: Vec<f64> = with.iter().map(|r| r.runs[j] / r.floor).collect();
+        let mut red: Vec<f64> = with.iter().map(|r| r.plain_measured / r.runs[j]).collect();
+        let at = rows.iter().filter(|r| reached(r, j + 1)).count();
+        let grew = with
+            .iter()
+            .filter(|r| j > 0 && r.runs[j] > r.runs[j - 1] + r.floor)
+            .count();
+        println!(
+            "| {} | {:.2} | {:.1}× | {} of {} | {} |",
+            j + 1,
+            median(&mut ratio),
+            median(&mut red),
+            at,
+            rows.len(),
+            grew
+        );
+    }
+    let missed: Vec<&Row> = rows.iter().filter(|r| !reached(r, runs)).collect();
+    println!(
+        "\n{} of {} members at the target within {runs} runs; {} grew by more than the noise in some run",
+        rows.len() - missed.len(),
+        rows.len(),
+        rows.iter().filter(|r| grows(r)).count()
+    );
+    for r in missed.iter().chain(rows.iter().filter(|r| grows(r)).collect::<Vec<_>>().iter()) {
+        println!(
+            "  #{} {} ({}): floor {:.3} µm, plain {:.3} µm, runs {} µm{}",
+            r.index,
+            r.label,
+            r.model,
+            1e6 * r.floor,
+            1e6 * r.plain_measured,
+            r.runs
+                .iter()
+                .map(|v| format!("{:.3}", 1e6 * v))
+                .collect::<Vec<_>>()
+                .join(" → "),
+            if r.learn_note.is_empty() {
+                String::new()
+            } else {
+                format!("; {}", r.learn_note)
+            }
+        );
+    }
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -240,6 +432,8 @@ fn main() {
     let mut limit = usize::MAX;
     let mut max_smoothing = CompensateConfig::default().max_smoothing;
     let mut csv: Option<PathBuf> = None;
+    let mut runs = 1usize;
+    let mut wrong = Wrong::None;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
@@ -257,12 +451,28 @@ fn main() {
                     .unwrap_or(max_smoothing);
                 i += 1;
             }
+            "--runs" => {
+                runs = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(runs);
+                i += 1;
+            }
+            "--wrong" => {
+                wrong = match args.get(i + 1).map(String::as_str) {
+                    Some("gain") => Wrong::Gain,
+                    Some("delay") => Wrong::Delay,
+                    Some("pole") => Wrong::Pole,
+                    other => {
+                        eprintln!("--wrong {other:?}: expected gain, delay or pole");
+                        std::process::exit(2);
+                    }
+                };
+                i += 1;
+            }
             "--csv" => {
                 csv = args.get(i + 1).map(PathBuf::from);
                 i += 1;
             }
             other => {
-                eprintln!("unknown argument {other}; use --limit N, --csv FILE");
+                eprintln!("unknown argument {other}; use --limit N, --max-smoothing S, --runs R, --wrong gain|delay|pole, --csv FILE");
                 std::process::exit(2);
             }
         }
@@ -287,7 +497,7 @@ fn main() {
     let start = std::time::Instant::now();
     let results: Vec<(usize, Result<Row, String>)> = indices
         .par_iter()
-        .map(|&i| (i, run(&zoo, i, max_smoothing)))
+        .map(|&i| (i, run(&zoo, i, max_smoothing, runs, wrong)))
         .collect();
     let mut rows = Vec::new();
     for (i, r) in results {
@@ -342,6 +552,9 @@ fn main() {
             r.predicted_benefit,
             r.sent
         );
+    }
+    if runs > 1 {
+        learning_summary(&rows, runs);
     }
     if let Some(path) = csv {
         let mut text = String::from(

@@ -301,6 +301,18 @@ pub enum Error {
         smoothing_ms: f64,
     },
 
+    /// A learning history is not of the program being learned (or not a
+    /// history of this version).
+    #[error("the learning history is of another program: its {what} is {}, this one's {}; start a new history for a new program", short_number(*history), short_number(*actual))]
+    HistoryMismatch {
+        /// What differs, e.g. `"number of samples"`.
+        what: &'static str,
+        /// The history's value.
+        history: f64,
+        /// This program's value.
+        actual: f64,
+    },
+
     /// A computed command violates a velocity or acceleration limit.
     #[error("command {quantity} {value:.4} {unit} at t = {time:.4} s exceeds the limit {limit} {unit}; {hint}")]
     LimitExceeded {

@@ -16,18 +16,8 @@ use feedid::io::{cell, read_recording, ChannelRef, ReadOptions};
 use crate::args::CompensateArgs;
 use crate::cmd::{check_distinct, load_effects, load_model_params, Outputs};
 
-/// Compute, write, verify, print.
-pub fn run(a: &CompensateArgs) -> Result<()> {
-    let mut ins = vec![a.desired.as_path()];
-    ins.extend(a.model.as_deref());
-    ins.extend(a.params.as_deref());
-    ins.extend(a.rig.as_deref());
-    ins.extend(a.effects.as_deref());
-    ins.extend(a.check.as_deref());
-    let mut outs = vec![a.output.as_path()];
-    outs.extend(a.verify_out.as_deref());
-    outs.extend(a.summary.as_deref());
-    check_distinct(&ins, &outs)?;
+/// The settings of the command from the arguments (validated).
+pub(crate) fn config(a: &CompensateArgs) -> Result<CompensateConfig> {
     let smoothing = match a.smooth.trim() {
         "auto" => Smoothing::Auto,
         s => Smoothing::Fixed(s.parse::<f64>().map_err(|_| {
@@ -35,7 +25,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         })?),
     };
     let start: StartMode = a.start.parse()?;
-    let mut cfg = CompensateConfig {
+    let cfg = CompensateConfig {
         smoothing,
         max_velocity: a.max_velocity,
         max_acceleration: a.max_acceleration,
@@ -48,30 +38,56 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         ..CompensateConfig::default()
     };
     cfg.validate()?;
-    let position_loop: LoopModel = a.position_loop.parse()?;
-    let verify_rig = if a.verify {
-        let params = load_model_params(a.rig.as_deref(), a.allow_unstable)?;
-        let effects = match &a.effects {
-            Some(p) => load_effects(p)?,
-            None => RigEffects::default(),
-        };
-        Some(
-            VirtualRig::new(params)
-                .with_effects(effects)
-                .with_seed(a.seed),
-        )
-    } else {
-        None
-    };
+    Ok(cfg)
+}
 
-    // the desired trajectory: one position column against time
+/// The desired trajectory: one position column against time.
+pub(crate) fn read_desired(a: &CompensateArgs) -> Result<feedid::Recording> {
     let opts = ReadOptions {
         time: Some(ChannelRef::parse(&a.desired_time)?),
         command: Some(ChannelRef::parse(&a.desired_column)?),
         position: Some(ChannelRef::parse(&a.desired_column)?),
         ..ReadOptions::default()
     };
-    let rec = read_recording(&a.desired, &opts)?;
+    Ok(read_recording(&a.desired, &opts)?)
+}
+
+/// A rig for `--verify`, if asked.
+pub(crate) fn verify_rig(a: &CompensateArgs) -> Result<Option<VirtualRig>> {
+    if !a.verify {
+        return Ok(None);
+    }
+    let params = load_model_params(a.rig.as_deref(), a.allow_unstable)?;
+    let effects = match &a.effects {
+        Some(p) => load_effects(p)?,
+        None => RigEffects::default(),
+    };
+    Ok(Some(
+        VirtualRig::new(params)
+            .with_effects(effects)
+            .with_seed(a.seed),
+    ))
+}
+
+/// Compute, write, verify, print.
+pub fn run(a: &CompensateArgs) -> Result<()> {
+    if a.measured.is_some() {
+        return super::learn::run(a);
+    }
+    let mut ins = vec![a.desired.as_path()];
+    ins.extend(a.model.as_deref());
+    ins.extend(a.params.as_deref());
+    ins.extend(a.rig.as_deref());
+    ins.extend(a.effects.as_deref());
+    ins.extend(a.check.as_deref());
+    let mut outs = vec![a.output.as_path()];
+    outs.extend(a.verify_out.as_deref());
+    outs.extend(a.summary.as_deref());
+    check_distinct(&ins, &outs)?;
+    let mut cfg = config(a)?;
+    let position_loop: LoopModel = a.position_loop.parse()?;
+    let verify_rig = verify_rig(a)?;
+    let rec = read_desired(a)?;
     let desired = rec.position();
     let dt = rec.dt();
 
@@ -240,7 +256,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
 }
 
 /// A length in µm, in scientific notation when below 1 nm.
-fn micrometres(m: f64) -> String {
+pub(crate) fn micrometres(m: f64) -> String {
     if m != 0.0 && m.abs() < 1e-9 {
         format!("{:.3e} µm", 1e6 * m)
     } else {
@@ -249,7 +265,7 @@ fn micrometres(m: f64) -> String {
 }
 
 /// A limit for JSON (∞ as null).
-fn json_limit(v: f64) -> serde_json::Value {
+pub(crate) fn json_limit(v: f64) -> serde_json::Value {
     if v.is_finite() {
         v.into()
     } else {
@@ -310,7 +326,7 @@ fn describe(t: &mut String, c: &Compensation, q: &ModelQuality) {
     );
 }
 
-fn describe_verification(t: &mut String, v: &Verification, seed: u64) {
+pub(crate) fn describe_verification(t: &mut String, v: &Verification, seed: u64) {
     let _ = writeln!(t, "  virtual rig (seed {seed}), measured − desired:");
     for (name, e) in [
         ("uncompensated", &v.uncompensated),

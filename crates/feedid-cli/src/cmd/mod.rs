@@ -13,6 +13,7 @@ mod simulate;
 mod stream;
 
 mod compensate;
+mod learn;
 mod greybox;
 mod report;
 mod sweep;

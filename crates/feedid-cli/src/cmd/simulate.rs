@@ -2,6 +2,7 @@
 
 use anyhow::Result;
 use feedid::drive::{RigEffects, VirtualRig};
+use feedid::io::{read_recording, ChannelRef, ReadOptions};
 use feedid::signal::Scenario;
 
 use crate::args::SimulateArgs;
@@ -14,10 +15,10 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         .params
         .iter()
         .chain(&a.effects)
+        .chain(&a.command)
         .map(|p| p.as_path())
         .collect();
     check_distinct(&inputs, &[a.output.as_path()])?;
-    let scenario: Scenario = a.scenario.parse()?;
     let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let effects = if a.linear {
         RigEffects::linear()
@@ -26,14 +27,35 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     } else {
         RigEffects::default()
     };
-    let duration = a.duration.unwrap_or_else(|| scenario.default_duration());
-    let command = scenario.command(a.rate, duration, a.seed)?;
+    // the command: a scenario, or a file's command run from rest at its
+    // first value (the rig starts at 0, which stands for that value)
+    let (what, rate, command, offset) = match (&a.command, &a.scenario) {
+        (Some(path), _) => {
+            let opts = ReadOptions {
+                command: Some(ChannelRef::parse(&a.command_column)?),
+                position: Some(ChannelRef::parse(&a.command_column)?),
+                ..ReadOptions::default()
+            };
+            let rec = read_recording(path, &opts)?;
+            let c0 = rec.command()[0];
+            let rel: Vec<f64> = rec.command().iter().map(|c| c - c0).collect();
+            (format!("{} as", path.display()), rec.rate_hz(), rel, c0)
+        }
+        (None, Some(name)) => {
+            let scenario: Scenario = name.parse()?;
+            let duration = a.duration.unwrap_or_else(|| scenario.default_duration());
+            let command = scenario.command(a.rate, duration, a.seed)?;
+            (scenario.name().to_string(), a.rate, command, 0.0)
+        }
+        (None, None) => anyhow::bail!("give --scenario NAME or --command cmd.csv"),
+    };
+    let duration = command.len() as f64 / rate;
     let rig = VirtualRig::new(params)
         .with_effects(effects)
         .with_seed(a.seed);
     let bar = ProgressBar::new("simulate", "samples");
     let update = |done: u64, total: u64| bar.update(done, total);
-    let out = rig.simulate_with_progress(&command, a.rate, &update);
+    let out = rig.simulate_with_progress(&command, rate, &update);
     bar.finish();
     let out = out.map_err(|e| params_error(a.params.as_deref().or(a.effects.as_deref()), e))?;
     // an unstable rig (allowed by --allow-unstable) may run away: never write
@@ -65,9 +87,9 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
                 w,
                 "{},{},{},{},{},{}",
                 out.time[k],
-                out.command[k],
-                out.position[k],
-                out.true_position[k],
+                out.command[k] + offset,
+                out.position[k] + offset,
+                out.true_position[k] + offset,
                 out.motor_current[k],
                 out.velocity[k]
             )?;
@@ -75,14 +97,14 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         Ok(())
     })?;
     outputs.commit()?;
-    let peak = command.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+    let peak = command.iter().fold(0.0_f64, |m, c| m.max((c + offset).abs()));
     println!(
         "{}: {} samples at {} Hz ({:.3} s), {} command, peak {:.4} mm, effects {}",
         a.output.display(),
         out.len(),
-        a.rate,
+        rate,
         duration,
-        scenario.name(),
+        what,
         1e3 * peak,
         if a.linear { "off (linear)" } else { "on" }
     );

@@ -493,7 +493,7 @@ fn extend(e: &[f64], pre: usize, post: usize, start: StartMode) -> Vec<f64> {
 }
 
 /// Samples for the slowest pole of `sys` to decay to 1e-12.
-fn model_settle(sys: &DiscreteStateSpace) -> Result<usize> {
+pub(super) fn model_settle(sys: &DiscreteStateSpace) -> Result<usize> {
     let r = sys.poles()?.iter().fold(0.0_f64, |m, p| m.max(p.norm()));
     if r >= 1.0 {
         return Err(Error::InvalidModel {

@@ -13,11 +13,14 @@
 //!   segments moving at either end, and the model's prediction.
 //! * [`Benefit`], [`ModelQuality`], [`Fallback`]: "never worse" — the plain
 //!   command is sent when the model expects little benefit or fits poorly.
+//! * [`learn`]: iterative learning control from measured runs of a repeated
+//!   program, the model as learning filter, convergence checked run by run.
 //! * [`verify_on_rig`]: tracking error on the virtual rig before and after.
 
 mod benefit;
 mod command;
 mod inverse;
+mod learn;
 mod smoothing;
 mod verify;
 
@@ -25,6 +28,10 @@ pub use benefit::{Benefit, Fallback, ModelQuality};
 pub use command::{
     compensate, compensate_model, compensate_params, CompensateConfig, Compensation, Smoothing,
     StartMode,
+};
+pub use learn::{
+    learn, noise_level, BestRun, LearnConfig, LearnStatus, Learning, LearningHistory, LearningRun,
+    NoiseFilter, HISTORY_FORMAT, HISTORY_VERSION,
 };
 pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
 pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, taper_profile};

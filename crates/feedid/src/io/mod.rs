@@ -35,7 +35,8 @@ pub use self::read::{
     read_recording, read_recording_from_bytes, read_recording_with_progress, ReadProgress,
     READ_PROGRESS_BYTES,
 };
-pub use self::source::{read_small_text, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES};
+pub use self::source::{
+    read_small_text, read_text_up_to, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES};
 pub use self::stream::{
     PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,
 };

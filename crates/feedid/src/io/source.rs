@@ -89,8 +89,14 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
 /// Read a small text file (rig parameters, effects, a model): at most
 /// [`MAX_SMALL_FILE_BYTES`], UTF-8, no NUL byte.
 pub fn read_small_text(path: &Path) -> Result<String> {
+    read_text_up_to(path, MAX_SMALL_FILE_BYTES)
+}
+
+/// Read a text file of at most `limit` bytes (UTF-8, no NUL byte), e.g. a
+/// learning history, which holds a command and an error per sample.
+pub fn read_text_up_to(path: &Path, limit: u64) -> Result<String> {
     let (file, _) = open_input(path)?;
-    let bytes = read_to_end_bounded(file, Some(MAX_SMALL_FILE_BYTES), path)?;
+    let bytes = read_to_end_bounded(file, Some(limit), path)?;
     if let Some(i) = bytes.iter().position(|&b| b == 0) {
         return Err(Error::Malformed {
             path: path.to_path_buf(),

@@ -1,0 +1,331 @@
+//! `feedid compensate --measured`: the next run's command learned from a
+//! measured run of the program (iterative learning control with the
+//! identified model, `feedid::compensate::learn`).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use feedid::compensate::{
+    learn, verify_on_rig, LearnConfig, LearnStatus, Learning, LearningHistory, NoiseFilter,
+};
+use feedid::io::{cell, read_recording, read_text_up_to, ChannelRef, ReadOptions};
+use feedid::Recording;
+
+use super::compensate::{config, describe_verification, json_limit, micrometres, read_desired};
+use crate::args::CompensateArgs;
+use crate::cmd::{check_distinct, Outputs};
+
+/// Learn, write, verify, print.
+pub fn run(a: &CompensateArgs) -> Result<()> {
+    let Some(measured_path) = a.measured.as_deref() else {
+        bail!("--measured run.csv is needed to learn");
+    };
+    let Some(model_path) = a.model.as_deref() else {
+        bail!("learning from a run needs --model model.json (an identified model)");
+    };
+    let mut ins = vec![a.desired.as_path(), model_path, measured_path];
+    ins.extend(a.sent.as_deref());
+    let mut outs = vec![a.output.as_path()];
+    outs.extend(a.verify_out.as_deref());
+    outs.extend(a.summary.as_deref());
+    outs.extend(a.history.as_deref());
+    check_distinct(&ins, &outs)?;
+    let noise_filter = match a.noise_filter.trim() {
+        "auto" => NoiseFilter::Auto,
+        s => NoiseFilter::Fixed(s.parse::<f64>().map_err(|_| {
+            anyhow::anyhow!("invalid --noise-filter `{s}`: expected a time in seconds or auto")
+        })?),
+    };
+    let cfg = LearnConfig {
+        gain: a.learning_gain,
+        noise_filter,
+        compensate: config(a)?,
+        ..LearnConfig::default()
+    };
+    cfg.validate()?;
+    let verify_rig = super::compensate::verify_rig(a)?;
+
+    let rec = read_desired(a)?;
+    let desired = rec.position();
+    let dt = rec.dt();
+    let file = crate::cmd::load_model_file(model_path)?;
+    let run = read_recording(measured_path, &ReadOptions::default())?;
+    same_grid(&rec, &a.desired, &run, measured_path)?;
+    let sent: Vec<f64> = match a.sent.as_deref() {
+        Some(p) => {
+            let opts = ReadOptions {
+                command: Some(ChannelRef::parse("command_m")?),
+                position: Some(ChannelRef::parse("command_m")?),
+                ..ReadOptions::default()
+            };
+            let s = read_recording(p, &opts)?;
+            same_grid(&rec, &a.desired, &s, p)?;
+            s.command().to_vec()
+        }
+        None => run.command().to_vec(),
+    };
+    let history = match a.history.as_deref() {
+        Some(p) => read_history(p)?,
+        None => None,
+    };
+    let step = learn(
+        &file.model,
+        desired,
+        &sent,
+        run.position(),
+        dt,
+        &cfg,
+        history.as_ref(),
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {e}", measured_path.display()))?;
+
+    let how = match &file.identified_by {
+        Some(p) => format!("{} {} (fit {:.2} %)", p.method, p.orders, p.fit_percent),
+        None => "model".to_string(),
+    };
+    let source = format!("{} [{how}]", model_path.display());
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "{}: run {} of {} ({} samples at {:.2} Hz); model {source}",
+        measured_path.display(),
+        step.run,
+        a.desired.display(),
+        rec.len(),
+        rec.rate_hz()
+    );
+    describe(&mut text, &step);
+    let verification = match &verify_rig {
+        Some(rig) => Some(verify_on_rig(rig, desired, &step.command, rec.rate_hz())?),
+        None => None,
+    };
+    if let Some(v) = &verification {
+        describe_verification(&mut text, v, a.seed);
+    }
+
+    let mut outputs = Outputs::default();
+    let command = step.command.clone();
+    let predicted = step.predicted.clone();
+    let time = rec.time().to_vec();
+    let desired_v = desired.to_vec();
+    outputs.add(&a.output, move |w| {
+        writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
+        for k in 0..time.len() {
+            writeln!(
+                w,
+                "{},{},{},{}",
+                cell(Some(time[k])),
+                cell(Some(command[k])),
+                cell(Some(desired_v[k])),
+                cell(Some(predicted[k]))
+            )?;
+        }
+        Ok(())
+    })?;
+    if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
+        let time = rec.time().to_vec();
+        let desired_v = desired.to_vec();
+        let (pu, pc) = (
+            v.position_uncompensated.clone(),
+            v.position_compensated.clone(),
+        );
+        outputs.add(p, move |w| {
+            writeln!(
+                w,
+                "time_s,desired_m,position_uncompensated_m,position_compensated_m"
+            )?;
+            for k in 0..time.len() {
+                writeln!(
+                    w,
+                    "{},{},{},{}",
+                    cell(Some(time[k])),
+                    cell(Some(desired_v[k])),
+                    cell(Some(pu[k])),
+                    cell(Some(pc[k]))
+                )?;
+            }
+            Ok(())
+        })?;
+    }
+    if let Some(p) = &a.summary {
+        let mut v = serde_json::to_value(&step)?;
+        if let Some(obj) = v.as_object_mut() {
+            obj.insert("desired".into(), a.desired.display().to_string().into());
+            obj.insert("model".into(), source.clone().into());
+            obj.insert(
+                "measured_run".into(),
+                measured_path.display().to_string().into(),
+            );
+            obj.insert(
+                "sent".into(),
+                a.sent
+                    .as_deref()
+                    .unwrap_or(measured_path)
+                    .display()
+                    .to_string()
+                    .into(),
+            );
+            obj.insert("samples".into(), rec.len().into());
+            obj.insert("rate_hz".into(), rec.rate_hz().into());
+            obj.insert("max_velocity_limit".into(), json_limit(a.max_velocity));
+            obj.insert(
+                "max_acceleration_limit".into(),
+                json_limit(a.max_acceleration),
+            );
+            if let Some(ver) = &verification {
+                let mut vv = serde_json::to_value(ver)?;
+                if let Some(o) = vv.as_object_mut() {
+                    o.insert("seed".into(), a.seed.into());
+                }
+                obj.insert("verification".into(), vv);
+            }
+        }
+        outputs.add_text(p, format!("{}\n", serde_json::to_string_pretty(&v)?))?;
+    }
+    if let Some(p) = &a.history {
+        outputs.add_text(p, format!("{}\n", serde_json::to_string(&step.history)?))?;
+    }
+    outputs.commit()?;
+    print!("{text}");
+    warn(&step, a);
+    Ok(())
+}
+
+/// A file on the desired trajectory's samples: as many rows, the same interval.
+fn same_grid(desired: &Recording, desired_path: &Path, other: &Recording, path: &Path) -> Result<()> {
+    if other.len() != desired.len() {
+        bail!(
+            "{}: {} samples, but the desired trajectory {} has {}: a run must be recorded on the program's samples",
+            path.display(),
+            other.len(),
+            desired_path.display(),
+            desired.len()
+        );
+    }
+    if (other.dt() - desired.dt()).abs() > 1e-6 * desired.dt() {
+        bail!(
+            "{}: sample interval {} s, but the desired trajectory {} has {} s",
+            path.display(),
+            other.dt(),
+            desired_path.display(),
+            desired.dt()
+        );
+    }
+    Ok(())
+}
+
+/// The history at `path`: `None` when there is no file yet.
+fn read_history(path: &Path) -> Result<Option<LearningHistory>> {
+    match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e).with_context(|| format!("{}", path.display())),
+        Ok(m) if !m.is_file() => bail!(
+            "{}: not a regular file; a learning history is a JSON file that feedid writes",
+            path.display()
+        ),
+        Ok(_) => {}
+    }
+    let text = read_text_up_to(path, feedid::io::MAX_STREAM_BYTES)?;
+    let h: LearningHistory = serde_json::from_str(&text).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: not a feedid learning history ({e}); give a new file name to start one",
+            path.display()
+        )
+    })?;
+    Ok(Some(h))
+}
+
+fn describe(t: &mut String, s: &Learning) {
+    let _ = writeln!(
+        t,
+        "  measured − desired: rms {}, max {} (noise {}{})",
+        micrometres(s.measured.rms),
+        micrometres(s.measured.max_abs),
+        micrometres(s.noise_m),
+        if s.wild_samples > 0 {
+            format!("; {} wild sample(s) held", s.wild_samples)
+        } else {
+            String::new()
+        }
+    );
+    if let Some(p) = s.previous_rms_m {
+        let change = if s.measured.rms <= p {
+            format!("shrank {:.2}×", p / s.measured.rms.max(1e-300))
+        } else {
+            format!("grew {:.2}×", s.measured.rms / p.max(1e-300))
+        };
+        let _ = writeln!(t, "  run {}: rms {} — {change}", s.run - 1, micrometres(p));
+    }
+    let status = match s.status {
+        LearnStatus::First => "first run of this history: a step from it".to_string(),
+        LearnStatus::Improving => "no worse than the best run: a step from it".to_string(),
+        LearnStatus::AtNoise => {
+            "at the noise of the measurement (rms within 1.25× the noise): nothing left to learn, the same command again".to_string()
+        }
+        LearnStatus::Damped {
+            best_run,
+            best_rms_m,
+        } => format!(
+            "worse than run {best_run} (rms {}) or not shrinking as predicted: the step is taken again from run {best_run} with half the gain",
+            micrometres(best_rms_m)
+        ),
+        LearnStatus::Stopped {
+            best_run,
+            best_rms_m,
+        } => format!(
+            "stopped: run {best_run}'s command (rms {}) is sent again",
+            micrometres(best_rms_m)
+        ),
+    };
+    let _ = writeln!(t, "  learning: {status}");
+    if s.gain > 0.0 {
+        let _ = writeln!(
+            t,
+            "  step: gain {}{}, noise filter σ {:.3} ms",
+            s.gain,
+            if s.gain_limited {
+                " (halved to keep the command within its limits)"
+            } else {
+                ""
+            },
+            1e3 * s.noise_filter_s
+        );
+    }
+    let _ = writeln!(
+        t,
+        "  next run, as the model predicts it: rms {} (measured with the noise: about {})",
+        micrometres(s.predicted_next_rms_m),
+        micrometres(s.predicted_next_measured_rms_m)
+    );
+    if let Some(c) = &s.step {
+        let _ = writeln!(
+            t,
+            "  command: smoothing σ up to {:.3} ms on {:.1} % of the samples; peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
+            1e3 * c.smoothing_s,
+            100.0 * c.smoothed_share,
+            c.peak_velocity,
+            c.peak_velocity_time_s,
+            c.peak_acceleration,
+            c.peak_acceleration_time_s
+        );
+    }
+}
+
+fn warn(s: &Learning, a: &CompensateArgs) {
+    if a.history.is_none() {
+        eprintln!(
+            "note: without --history the runs are not numbered and nothing checks that the error shrinks; give --history FILE to keep them"
+        );
+    }
+    match s.status {
+        LearnStatus::Damped { best_run, .. } => eprintln!(
+            "warning: run {} was worse than run {best_run} or did not shrink as the model predicted; the gain is halved to {} — if this repeats, identify the model again on a richer run",
+            s.run, s.gain
+        ),
+        LearnStatus::Stopped { best_run, .. } => eprintln!(
+            "warning: the learning has stopped: the error kept growing with the gain halved; run {best_run}'s command is written again. The model is wrong where the error lives: identify it again (a richer run, or on this program's own recording) and start a new history"
+        ),
+        _ => {}
+    }
+}

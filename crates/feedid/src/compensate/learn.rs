@@ -1,0 +1,1065 @@
+//! Learning from measured runs: iterative learning control (ILC) of the
+//! command of a repeated program, with the identified model as its learning
+//! filter.
+//!
+//! A machine tool repeats its programs, and the measured tracking error of
+//! the last run is the best information there is about the next. With the
+//! desired trajectory `y_d`, the command `u_j` sent in run `j` and the
+//! measured position `y_j`, the update with the model `G` (rescaled to unit
+//! DC gain as [`super::compensate_model`] uses it) is the model-inverse ILC
+//! (Arimoto, Kawamura & Miyazaki 1984; Bristow, Tharayil & Alleyne, "A
+//! survey of iterative learning control", IEEE Control Systems Magazine
+//! 26(3), 2006):
+//!
+//! ```text
+//! e_j     = y_d − y_j                                (measured tracking error)
+//! ẽ_j     = N·H(e_j)                                 (wild samples held, noise filtered)
+//! u_{j+1} = u_j + α·G⁻¹·ẽ_j
+//! ```
+//!
+//! computed as the compensation ([`super::compensate_model`]) of the
+//! **virtual reference** `r = G·u_j + α·ẽ_j`: since `G⁻¹·r = u_j + α·G⁻¹·ẽ_j`,
+//! that compensation is the update, and it inherits the stable inverse
+//! (anti-causal for zeros outside the unit circle), the velocity and
+//! acceleration limits with smoothing only where they need it (the Q filter
+//! of ILC, acting on the correction only), and the start modes. Where the
+//! program rests at its start ([`StartMode::Rest`]) nothing is learned
+//! before it moves. A step whose command cannot meet the limits is taken
+//! with half the gain (up to [`LearnConfig::max_halvings`] times,
+//! [`Learning::gain_limited`]).
+//!
+//! **Convergence.** With the axis `P = G·(1 + Δ)` the noise-free tracking
+//! error of the next run is `ε_{j+1} = (1 − α·(1 + Δ))·ε_j` at each
+//! frequency the filters pass, so the error shrinks monotonically where
+//! `|1 − α(1 + Δ)| < 1`: for `α = 1` wherever the model's relative error
+//! `|Δ| < 1` — a model off by a factor 2 in gain still converges (half the
+//! error each run), one with twice the gain oscillates. Where the model is
+//! wrong at high frequency (a delay, a resonance) the error there grows.
+//!
+//! **Noise.** `G⁻¹` has a large high-frequency gain, so the measurement
+//! noise of `e_j` must not reach it: `N` is a zero-phase Gaussian smoothing
+//! whose σ is chosen by Morozov's discrepancy principle — the largest σ (of
+//! 0, ½, 1, 1½, 2, 3, 4, 6, … samples) for which what it removes,
+//! `rms(e − N·e)`, is no more than the noise level `σ̂` (estimated from the
+//! second differences of `e`, median absolute deviation, so that a smooth
+//! error and a few corners do not count as noise). Isolated wild samples
+//! (`|e_k − median₅(e)_k| > 6σ̂`, Hampel's identifier) are replaced by the
+//! local median first. With noise of variance `σ²` and `α`, the stationary
+//! noise-driven error is `α·var(N·n)/(2 − α)`, below the noise itself.
+//!
+//! **Monotone convergence is checked.** With a history of the earlier runs
+//! ([`LearningHistory`]) each measured run is compared with the best run so
+//! far: when its rms grew by more than [`LearnConfig::growth_tolerance`]
+//! (relative) plus a tenth of the noise — or stalled: the step before
+//! expected at least to halve it and it shrank less than 10 %, well above
+//! the noise — the step is taken again **from the best run** (its command and filtered error are in the history) with half
+//! the gain and twice the noise filter ([`LearnStatus::Damped`]); after
+//! [`LearnConfig::max_halvings`] halvings the learning stops and the best
+//! run's command is sent again ([`LearnStatus::Stopped`]), and in every
+//! later step of that history.
+//!
+//! A run whose rms is within 1.25× its noise level is **at the noise**: what
+//! is left cannot be told from the noise, and the same command is sent again
+//! ([`LearnStatus::AtNoise`]) — learning the noise would only add it.
+//!
+//! **The next run's error** is predicted with the model:
+//! `e_{j+1} ≈ ẽ_j − G·(u_{j+1} − u_j)`, its rms noise-free and, with the
+//! noise `σ̂`, as it will be measured `√(rms² + σ̂²)`.
+//!
+//! ```
+//! use feedid::compensate::{learn, LearnConfig, LearnStatus};
+//! use feedid::ident::LinearModel;
+//! // the axis: a lag with one sample of delay; the model: 30 % too slow
+//! let axis = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+//! let model = LinearModel::discrete(vec![0.0, 0.14], vec![1.0, -0.86], 1e-3).unwrap();
+//! let desired: Vec<f64> = (0..400)
+//!     .map(|k| 1e-3 * ((k as f64 - 50.0) / 200.0).clamp(0.0, 1.0))
+//!     .collect();
+//! let cfg = LearnConfig::exact();
+//! let mut command = desired.clone();
+//! let mut history = None;
+//! let mut rms = Vec::new();
+//! for _ in 0..6 {
+//!     let y = axis.simulate(&command).unwrap();
+//!     let step = learn(&model, &desired, &command, &y, 1e-3, &cfg, history.as_ref()).unwrap();
+//!     rms.push(step.measured.rms);
+//!     command = step.command;
+//!     history = Some(step.history);
+//! }
+//! assert!(rms[5] < 1e-3 * rms[0], "{rms:?}");
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+use super::command::{compensate_model, model_settle, CompensateConfig, Compensation, StartMode};
+use super::smoothing::gaussian_smooth;
+use crate::error::{Error, Result};
+use crate::ident::LinearModel;
+use crate::lti::DiscreteStateSpace;
+use crate::stats::ErrorStats;
+
+/// Format name of a learning history file.
+pub const HISTORY_FORMAT: &str = "feedid-learning-history";
+/// Version of the learning history format.
+pub const HISTORY_VERSION: u32 = 1;
+
+/// How the measured error is filtered before it is learned.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseFilter {
+    /// σ by the discrepancy principle from the run's own noise (default).
+    Auto,
+    /// One σ \[s\] (0: none).
+    Fixed(f64),
+}
+
+/// Settings of a learning step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LearnConfig {
+    /// Learning gain α of the first step (0 < α < 2); default 1.
+    pub gain: f64,
+    /// Noise filter of the measured error; default [`NoiseFilter::Auto`].
+    pub noise_filter: NoiseFilter,
+    /// A run is worse than the best so far when its rms exceeds the best's
+    /// by more than this share (plus a tenth of the noise); default 0.05.
+    pub growth_tolerance: f64,
+    /// Halvings of the gain after which the learning stops; default 3.
+    pub max_halvings: u32,
+    /// Limits, smoothing, start and DC gain of the command, as for
+    /// [`super::compensate_model`] (its fall-back settings do not apply:
+    /// the measured runs, not the model's fit, decide).
+    pub compensate: CompensateConfig,
+}
+
+impl Default for LearnConfig {
+    fn default() -> Self {
+        Self {
+            gain: 1.0,
+            noise_filter: NoiseFilter::Auto,
+            growth_tolerance: 0.05,
+            max_halvings: 3,
+            compensate: CompensateConfig::default(),
+        }
+    }
+}
+
+impl LearnConfig {
+    /// No limits, no smoothing, no noise filter: the plain ILC update (for
+    /// noise-free data and tests).
+    pub fn exact() -> Self {
+        Self {
+            noise_filter: NoiseFilter::Fixed(0.0),
+            compensate: CompensateConfig {
+                smoothing: super::Smoothing::Fixed(0.0),
+                max_velocity: f64::INFINITY,
+                max_acceleration: f64::INFINITY,
+                ..CompensateConfig::default()
+            },
+            ..Self::default()
+        }
+    }
+
+    /// Check the settings.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.gain > 0.0 && self.gain < 2.0) {
+            return Err(Error::InvalidParameter {
+                name: "learning gain",
+                value: self.gain,
+                reason: "must be > 0 and < 2 (1: the model's full correction)",
+            });
+        }
+        if let NoiseFilter::Fixed(s) = self.noise_filter {
+            if !(s.is_finite() && s >= 0.0) {
+                return Err(Error::InvalidParameter {
+                    name: "noise filter",
+                    value: s,
+                    reason: "must be finite and >= 0 (s)",
+                });
+            }
+        }
+        if !(self.growth_tolerance.is_finite() && self.growth_tolerance >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "growth tolerance",
+                value: self.growth_tolerance,
+                reason: "must be finite and >= 0",
+            });
+        }
+        if self.max_halvings > 30 {
+            return Err(Error::InvalidParameter {
+                name: "max halvings",
+                value: self.max_halvings as f64,
+                reason: "must be <= 30",
+            });
+        }
+        self.compensate.validate()
+    }
+}
+
+/// What the learning step did.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum LearnStatus {
+    /// No earlier run known: a step from this run.
+    First,
+    /// The run is no worse than the best so far: a step from it.
+    Improving,
+    /// The run's rms is within 1.25× its noise: nothing can be told from
+    /// the noise, the same command is sent again.
+    AtNoise,
+    /// The run was worse than the best: the step is taken again from the
+    /// best run with half the gain and twice the noise filter.
+    Damped {
+        /// The best run so far.
+        best_run: usize,
+        /// Its measured rms \[m\].
+        best_rms_m: f64,
+    },
+    /// The error kept growing after the gain was halved the most allowed:
+    /// the best run's command is sent again.
+    Stopped {
+        /// The best run so far, whose command is sent again.
+        best_run: usize,
+        /// Its measured rms \[m\].
+        best_rms_m: f64,
+    },
+}
+
+/// One measured run of a learning history.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LearningRun {
+    /// Run number (1: the first run measured).
+    pub run: usize,
+    /// RMS of desired − measured \[m\].
+    pub measured_rms_m: f64,
+    /// Largest |desired − measured| \[m\].
+    pub measured_max_m: f64,
+    /// Noise level of the measured error \[m\] (module doc).
+    pub noise_m: f64,
+    /// What the step after this run did.
+    pub status: LearnStatus,
+    /// Learning gain decided for that step (before any halving for the
+    /// limits; 0 when stopped).
+    pub gain: f64,
+    /// σ of its noise filter \[s\].
+    pub noise_filter_s: f64,
+    /// The model's prediction of the next run's rms, noise-free \[m\].
+    pub predicted_next_rms_m: f64,
+}
+
+/// The best run so far: what a damped step starts from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BestRun {
+    /// Its run number.
+    pub run: usize,
+    /// Its measured rms \[m\].
+    pub measured_rms_m: f64,
+    /// The command sent in it \[m\].
+    pub command: Vec<f64>,
+    /// Its measured error, wild samples held (not noise filtered) \[m\].
+    pub error: Vec<f64>,
+}
+
+/// The runs of one program so far (the file `--history` keeps).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LearningHistory {
+    /// Always [`HISTORY_FORMAT`].
+    pub format: String,
+    /// [`HISTORY_VERSION`].
+    pub version: u32,
+    /// Samples of the desired trajectory.
+    pub samples: usize,
+    /// Its sample interval \[s\].
+    pub dt: f64,
+    /// Its first and last value and its mean \[m\] (to recognise it).
+    pub desired_fingerprint: [f64; 3],
+    /// The measured runs, oldest first.
+    pub runs: Vec<LearningRun>,
+    /// The best run so far.
+    pub best: Option<BestRun>,
+}
+
+impl LearningHistory {
+    /// An empty history of the program `desired` at interval `dt` \[s\].
+    pub fn new(desired: &[f64], dt: f64) -> Self {
+        Self {
+            format: HISTORY_FORMAT.to_string(),
+            version: HISTORY_VERSION,
+            samples: desired.len(),
+            dt,
+            desired_fingerprint: fingerprint(desired),
+            runs: Vec::new(),
+            best: None,
+        }
+    }
+
+    /// Check that the history is of this program (format, samples, interval,
+    /// fingerprint) and well formed.
+    pub fn check(&self, desired: &[f64], dt: f64) -> Result<()> {
+        if self.format != HISTORY_FORMAT || self.version != HISTORY_VERSION {
+            return Err(Error::HistoryMismatch {
+                what: "format version",
+                history: self.version as f64,
+                actual: HISTORY_VERSION as f64,
+            });
+        }
+        if self.samples != desired.len() {
+            return Err(Error::HistoryMismatch {
+                what: "number of samples",
+                history: self.samples as f64,
+                actual: desired.len() as f64,
+            });
+        }
+        if (self.dt - dt).abs() > 1e-9 * dt {
+            return Err(Error::HistoryMismatch {
+                what: "sample interval (s)",
+                history: self.dt,
+                actual: dt,
+            });
+        }
+        let f = fingerprint(desired);
+        let scale = desired.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);
+        for (what, a, b) in [
+            ("first desired value (m)", self.desired_fingerprint[0], f[0]),
+            ("last desired value (m)", self.desired_fingerprint[1], f[1]),
+            ("mean desired value (m)", self.desired_fingerprint[2], f[2]),
+        ] {
+            if !((a - b).abs() <= 1e-9 * scale) {
+                return Err(Error::HistoryMismatch {
+                    what,
+                    history: a,
+                    actual: b,
+                });
+            }
+        }
+        if let Some(b) = &self.best {
+            if b.command.len() != desired.len() || b.error.len() != desired.len() {
+                return Err(Error::HistoryMismatch {
+                    what: "samples of the best run",
+                    history: b.command.len().min(b.error.len()) as f64,
+                    actual: desired.len() as f64,
+                });
+            }
+            if let Some(i) = b
+                .command
+                .iter()
+                .chain(&b.error)
+                .position(|v| !v.is_finite())
+            {
+                return Err(Error::NonFinite {
+                    channel: "learning history's best run".to_string(),
+                    index: i % desired.len(),
+                    value: f64::NAN,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+fn fingerprint(desired: &[f64]) -> [f64; 3] {
+    let n = desired.len().max(1) as f64;
+    [
+        desired.first().copied().unwrap_or(0.0),
+        desired.last().copied().unwrap_or(0.0),
+        desired.iter().sum::<f64>() / n,
+    ]
+}
+
+/// The command for the next run and what the last run showed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Learning {
+    /// The command for the next run \[m\].
+    #[serde(skip)]
+    pub command: Vec<f64>,
+    /// The model's prediction of the next run's position \[m\].
+    #[serde(skip)]
+    pub predicted: Vec<f64>,
+    /// Number of the run measured (1 without a history).
+    pub run: usize,
+    /// Desired − measured of that run \[m\] (`fit_percent` against the desired).
+    pub measured: ErrorStats,
+    /// Its noise level \[m\] (module doc).
+    pub noise_m: f64,
+    /// Wild samples held in the measured error.
+    pub wild_samples: usize,
+    /// The previous run's measured rms, when the history has it \[m\].
+    pub previous_rms_m: Option<f64>,
+    /// What the step did.
+    pub status: LearnStatus,
+    /// Learning gain of the step.
+    pub gain: f64,
+    /// True when the gain was halved (from the history's or the settings')
+    /// to keep the command within its limits.
+    pub gain_limited: bool,
+    /// σ of the noise filter of the step \[s\].
+    pub noise_filter_s: f64,
+    /// The model's prediction of the next run's rms error, noise-free \[m\].
+    pub predicted_next_rms_m: f64,
+    /// The same as it will be measured, with the noise \[m\].
+    pub predicted_next_measured_rms_m: f64,
+    /// The step's command as [`super::compensate_model`] computed it:
+    /// smoothing, peaks, zeros (its prediction is of the virtual reference);
+    /// `None` when no step was taken (stopped, or at the noise).
+    pub step: Option<Compensation>,
+    /// The history with this run added.
+    #[serde(skip)]
+    pub history: LearningHistory,
+}
+
+/// A run whose rms is at most this many times its noise level is at the
+/// noise: what is left cannot be told from the noise, and is not learned.
+const AT_NOISE: f64 = 1.25;
+
+/// Multiplier of the noise level for a wild sample (Hampel's identifier).
+const WILD: f64 = 6.0;
+
+/// One learning step (module doc): `desired`, the command `sent` in the run
+/// and its `measured` position, one value per sample at interval `dt` \[s\];
+/// `history` the earlier runs of the same program (`None`: the first).
+pub fn learn(
+    model: &LinearModel,
+    desired: &[f64],
+    sent: &[f64],
+    measured: &[f64],
+    dt: f64,
+    cfg: &LearnConfig,
+    history: Option<&LearningHistory>,
+) -> Result<Learning> {
+    cfg.validate()?;
+    let n = desired.len();
+    if n < 10 {
+        return Err(Error::TooFewSamples {
+            what: "a learning step",
+            needed: 10,
+            actual: n,
+        });
+    }
+    for (what, v) in [("sent command", sent), ("measured position", measured)] {
+        if v.len() != n {
+            return Err(Error::LengthMismatch {
+                what,
+                expected: n,
+                actual: v.len(),
+            });
+        }
+    }
+    for (channel, v) in [
+        ("desired", desired),
+        ("sent command", sent),
+        ("measured position", measured),
+    ] {
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(Error::NonFinite {
+                channel: channel.to_string(),
+                index: i,
+                value: v[i],
+            });
+        }
+    }
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "sample interval",
+            value: dt,
+            reason: "must be finite and > 0 (s)",
+        });
+    }
+    let mut history = match history {
+        Some(h) => {
+            h.check(desired, dt)?;
+            h.clone()
+        }
+        None => LearningHistory::new(desired, dt),
+    };
+    let run = history.runs.last().map_or(1, |r| r.run + 1);
+    let previous_rms_m = history.runs.last().map(|r| r.measured_rms_m);
+
+    // the measured error, its noise and its wild samples
+    let raw: Vec<f64> = desired.iter().zip(measured).map(|(d, y)| d - y).collect();
+    let noise = noise_level(&raw);
+    let (error, wild_samples) = hold_wild(&raw, noise);
+    let stats = ErrorStats::from_pairs(desired.iter().copied().zip(measured.iter().copied()));
+
+    // the decision against the best run so far
+    let last_gain = history.runs.last().map(|r| r.gain);
+    let last_filter = history.runs.last().map(|r| r.noise_filter_s);
+    let grew = history.best.as_ref().is_some_and(|b| {
+        stats.rms > b.measured_rms_m * (1.0 + cfg.growth_tolerance) + 0.1 * noise
+    });
+    // the last step was to halve the error at least and left it as it was
+    let stalled = history.runs.last().is_some_and(|r| {
+        r.gain > 0.0
+            && r.predicted_next_rms_m.hypot(noise) < 0.5 * r.measured_rms_m
+            && stats.rms > 0.9 * r.measured_rms_m
+            && stats.rms > 3.0 * noise
+    });
+    let stopped = history
+        .runs
+        .last()
+        .is_some_and(|r| matches!(r.status, LearnStatus::Stopped { .. }));
+    // the last damped or learning gain (a run at the noise took no step)
+    let last_gain = history
+        .runs
+        .iter()
+        .rev()
+        .find(|r| r.gain > 0.0 || matches!(r.status, LearnStatus::Stopped { .. }))
+        .map(|r| r.gain)
+        .or(last_gain);
+    let halvings = |g: f64| (cfg.gain / g).log2().round().max(0.0) as u32;
+    let (status, gain, base_cmd, base_err, filter_floor) = match (&history.best, grew || stalled) {
+        (Some(b), worse) if worse || stopped => {
+            let g = 0.5 * last_gain.unwrap_or(cfg.gain);
+            if stopped || halvings(g) > cfg.max_halvings {
+                (
+                    LearnStatus::Stopped {
+                        best_run: b.run,
+                        best_rms_m: b.measured_rms_m,
+                    },
+                    0.0,
+                    b.command.clone(),
+                    b.error.clone(),
+                    0.0,
+                )
+            } else {
+                (
+                    LearnStatus::Damped {
+                        best_run: b.run,
+                        best_rms_m: b.measured_rms_m,
+                    },
+                    g,
+                    b.command.clone(),
+                    b.error.clone(),
+                    (2.0 * last_filter.unwrap_or(0.0)).max(dt),
+                )
+            }
+        }
+        (best, _) => {
+            let first = best.is_none();
+            let at_noise = stats.rms <= AT_NOISE * noise;
+            let status = if first {
+                LearnStatus::First
+            } else if at_noise {
+                LearnStatus::AtNoise
+            } else {
+                LearnStatus::Improving
+            };
+            // a damped gain is kept while the runs improve; at the noise
+            // there is nothing left to learn: the same command again
+            let g = if at_noise {
+                0.0
+            } else {
+                history
+                    .runs
+                    .iter()
+                    .rev()
+                    .map(|r| r.gain)
+                    .find(|g| *g > 0.0)
+                    .unwrap_or(cfg.gain)
+            };
+            (status, g, sent.to_vec(), error.clone(), 0.0)
+        }
+    };
+
+    // the model as the compensation uses it, and its prediction of the base run
+    let comp_cfg = CompensateConfig {
+        fallback: false,
+        ..cfg.compensate
+    };
+    let sys = model.discrete_state_space(Some(dt))?;
+    let g_dc = sys.dc_gain()?;
+    if !(g_dc.is_finite() && g_dc.abs() > 1e-12) {
+        return Err(Error::InvalidModel {
+            reason: "the model's DC gain is zero or infinite; a position model must have a finite non-zero DC gain",
+        });
+    }
+    let out_scale = if comp_cfg.unit_dc_gain { 1.0 / g_dc } else { 1.0 };
+    let y_base = simulate_run(&sys, &base_cmd, out_scale, g_dc, comp_cfg.start)?;
+
+    let sigma = match cfg.noise_filter {
+        NoiseFilter::Fixed(s) => s / dt,
+        NoiseFilter::Auto => discrepancy_sigma(&base_err, noise),
+    }
+    .max(filter_floor / dt);
+    let mut filtered = vec![0.0; n];
+    gaussian_smooth(&base_err, sigma, &mut filtered);
+    // before the program moves the axis rests: nothing to learn there but
+    // noise (and a step into the learned error would ask the inverse for an
+    // unbounded command at the very start)
+    let scale = desired.iter().fold(0.0_f64, |m, v| m.max((v - desired[0]).abs()));
+    let moves = desired
+        .iter()
+        .position(|v| (v - desired[0]).abs() > 1e-12 * scale)
+        .unwrap_or(n);
+    if comp_cfg.start == StartMode::Rest {
+        filtered[..moves].fill(0.0);
+    }
+
+    let decided_gain = gain;
+    let mut gain = gain;
+    let mut gain_limited = false;
+    let (command, step) = if gain > 0.0 {
+        // a step the limits cannot take is taken with half the gain
+        let mut halvings_left = cfg.max_halvings;
+        let step = loop {
+            let reference: Vec<f64> = y_base
+                .iter()
+                .zip(&filtered)
+                .map(|(y, e)| y + gain * e)
+                .collect();
+            match compensate_model(model, &reference, dt, &comp_cfg) {
+                Ok(step) => break step,
+                Err(Error::LimitUnreachable { .. }) if halvings_left > 0 => {
+                    halvings_left -= 1;
+                    gain *= 0.5;
+                    gain_limited = true;
+                }
+                Err(e) => return Err(e),
+            }
+        };
+        (step.command.clone(), Some(step))
+    } else {
+        // stopped (the best run's command) or at the noise (this run's) again
+        (base_cmd.clone(), None)
+    };
+    if let Some(i) = command.iter().position(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            channel: "learned command".to_string(),
+            index: i,
+            value: command[i],
+        });
+    }
+    let predicted = simulate_run(&sys, &command, out_scale, g_dc, comp_cfg.start)?;
+    // e_{j+1} ≈ ẽ − (ŷ_{j+1} − ŷ_base) on the base run's filtered error
+    let mut ss = 0.0;
+    for k in 0..n {
+        let e = filtered[k] - (predicted[k] - y_base[k]);
+        ss += e * e;
+    }
+    let predicted_next_rms_m = (ss / n as f64).sqrt();
+    let predicted_next_measured_rms_m = predicted_next_rms_m.hypot(noise);
+    let noise_filter_s = sigma * dt;
+
+    history.runs.push(LearningRun {
+        run,
+        measured_rms_m: stats.rms,
+        measured_max_m: stats.max_abs,
+        noise_m: noise,
+        status,
+        gain: decided_gain,
+        noise_filter_s,
+        predicted_next_rms_m,
+    });
+    let better = history
+        .best
+        .as_ref()
+        .map_or(true, |b| stats.rms < b.measured_rms_m);
+    if better {
+        history.best = Some(BestRun {
+            run,
+            measured_rms_m: stats.rms,
+            command: sent.to_vec(),
+            error,
+        });
+    }
+    Ok(Learning {
+        command,
+        predicted,
+        run,
+        measured: stats,
+        noise_m: noise,
+        wild_samples,
+        previous_rms_m,
+        status,
+        gain,
+        gain_limited,
+        noise_filter_s,
+        predicted_next_rms_m,
+        predicted_next_measured_rms_m,
+        step,
+        history,
+    })
+}
+
+/// The model's position for the command `u` of a run: from rest at `u[0]`
+/// ([`StartMode::Rest`]) or moving at `u`'s first velocity
+/// ([`StartMode::Moving`], the velocity held back until the model settles);
+/// `out_scale` rescales the model's deviations, `g_dc` its DC gain.
+fn simulate_run(
+    sys: &DiscreteStateSpace,
+    u: &[f64],
+    out_scale: f64,
+    g_dc: f64,
+    start: StartMode,
+) -> Result<Vec<f64>> {
+    let u0 = u[0];
+    let rest = u0 * g_dc * out_scale;
+    let pre = match start {
+        StartMode::Rest => 0,
+        StartMode::Moving => model_settle(sys)?,
+    };
+    let v0 = u[1] - u[0];
+    let mut ext: Vec<f64> = (0..pre).map(|i| -v0 * (pre - i) as f64).collect();
+    ext.extend(u.iter().map(|v| v - u0));
+    let mut x = vec![0.0; sys.order()];
+    let mut y = vec![0.0; ext.len()];
+    let mut scratch = vec![0.0; sys.order()];
+    // from a rest state at the extended start (zero deviation there)
+    let first = ext[0];
+    for v in &mut ext {
+        *v -= first;
+    }
+    sys.simulate_into(&ext, &mut x, &mut y, &mut scratch)?;
+    let offset = first * g_dc * out_scale;
+    Ok(y[pre..]
+        .iter()
+        .map(|v| rest + offset + out_scale * v)
+        .collect())
+}
+
+/// Noise level of a signal: the median absolute deviation of its second
+/// differences, scaled to a standard deviation (`√6·σ` for white noise).
+pub fn noise_level(e: &[f64]) -> f64 {
+    if e.len() < 3 {
+        return 0.0;
+    }
+    let mut d: Vec<f64> = e
+        .windows(3)
+        .map(|w| w[2] - 2.0 * w[1] + w[0])
+        .collect();
+    let m = median(&mut d);
+    let mut dev: Vec<f64> = d.iter().map(|v| (v - m).abs()).collect();
+    1.4826 * median(&mut dev) / 6.0_f64.sqrt()
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
+    *m
+}
+
+/// Hampel's identifier: samples farther than [`WILD`]·`noise` from the
+/// median of their five neighbours are replaced by it; returns the count.
+fn hold_wild(e: &[f64], noise: f64) -> (Vec<f64>, usize) {
+    let mut out = e.to_vec();
+    if noise <= 0.0 || e.len() < 5 {
+        return (out, 0);
+    }
+    let mut count = 0;
+    let mut w = [0.0; 5];
+    for k in 0..e.len() {
+        let lo = k.saturating_sub(2).min(e.len() - 5);
+        w.copy_from_slice(&e[lo..lo + 5]);
+        let m = median(&mut w);
+        if (e[k] - m).abs() > WILD * noise {
+            out[k] = m;
+            count += 1;
+        }
+    }
+    (out, count)
+}
+
+/// σ levels \[samples\] of the noise filter.
+const LEVELS: [f64; 14] = [
+    0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0, 32.0, 48.0,
+];
+
+/// The largest σ of [`LEVELS`] whose smoothing removes no more than the noise
+/// (`rms(e − N·e) ≤ noise`, Morozov's discrepancy principle).
+fn discrepancy_sigma(e: &[f64], noise: f64) -> f64 {
+    if noise <= 0.0 {
+        return 0.0;
+    }
+    let n = e.len();
+    let mut out = vec![0.0; n];
+    let mut chosen = 0.0;
+    for &s in &LEVELS[1..] {
+        if 4.0 * s >= n as f64 {
+            break;
+        }
+        gaussian_smooth(e, s, &mut out);
+        let ss: f64 = e.iter().zip(&out).map(|(a, b)| (a - b).powi(2)).sum();
+        if (ss / n as f64).sqrt() > noise {
+            break;
+        }
+        chosen = s;
+    }
+    chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    const DT: f64 = 1e-3;
+
+    fn axis() -> LinearModel {
+        // second-order position loop with one sample of delay, unit DC gain
+        LinearModel::discrete(vec![0.0, 0.05, 0.03], vec![1.0, -1.5, 0.58], DT).unwrap()
+    }
+
+    fn program() -> Vec<f64> {
+        // rest, a smooth move of 2 mm, rest
+        (0..600)
+            .map(|k| {
+                let s = ((k as f64 - 50.0) / 300.0).clamp(0.0, 1.0);
+                2e-3 * (3.0 * s * s - 2.0 * s * s * s)
+            })
+            .collect()
+    }
+
+    fn rms(v: &[f64]) -> f64 {
+        (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+    }
+
+    /// Runs of `learn` on `plant` from the plain command, noise `sigma`.
+    fn runs(
+        plant: &LinearModel,
+        model: &LinearModel,
+        cfg: &LearnConfig,
+        sigma: f64,
+        count: usize,
+    ) -> (Vec<f64>, Vec<f64>, Vec<LearnStatus>) {
+        let desired = program();
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut command = desired.clone();
+        let mut history: Option<LearningHistory> = None;
+        let (mut measured, mut truth, mut status) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..count {
+            let y = plant.simulate(&command).unwrap();
+            truth.push(rms(&y
+                .iter()
+                .zip(&desired)
+                .map(|(a, b)| a - b)
+                .collect::<Vec<_>>()));
+            let noisy: Vec<f64> = y
+                .iter()
+                .map(|v| v + sigma * (rng.random::<f64>() - 0.5) * 12f64.sqrt())
+                .collect();
+            let s = learn(model, &desired, &command, &noisy, DT, cfg, history.as_ref()).unwrap();
+            measured.push(s.measured.rms);
+            status.push(s.status);
+            command = s.command;
+            history = Some(s.history);
+        }
+        (measured, truth, status)
+    }
+
+    #[test]
+    fn an_exact_model_learns_the_exact_inverse_in_one_step() {
+        let a = axis();
+        let (_, truth, status) = runs(&a, &a, &LearnConfig::exact(), 0.0, 3);
+        assert_eq!(status[0], LearnStatus::First);
+        assert!(truth[0] > 1e-5, "{truth:?}");
+        // the inverse is exact: the second run follows to rounding
+        assert!(truth[1] < 1e-12 * truth[0] + 1e-18, "{truth:?}");
+    }
+
+    #[test]
+    fn half_the_gain_halves_the_error_each_run() {
+        // exact model, α = ½: ε_{j+1} = ½·ε_j (closed form)
+        let a = axis();
+        let cfg = LearnConfig {
+            gain: 0.5,
+            ..LearnConfig::exact()
+        };
+        let (_, truth, _) = runs(&a, &a, &cfg, 0.0, 5);
+        for j in 1..5 {
+            let r = truth[j] / truth[j - 1];
+            assert!((r - 0.5).abs() < 1e-9, "run {j}: ratio {r}");
+        }
+    }
+
+    #[test]
+    fn a_model_with_twice_the_gain_still_converges() {
+        // P = G/2: ε_{j+1} = (1 − ½)·ε_j
+        let a = axis();
+        let LinearModel::Discrete { b, a: den, dt } = a.clone() else {
+            unreachable!()
+        };
+        let double = LinearModel::discrete(b.iter().map(|v| 2.0 * v).collect(), den, dt).unwrap();
+        let cfg = LearnConfig {
+            compensate: CompensateConfig {
+                unit_dc_gain: false,
+                ..LearnConfig::exact().compensate
+            },
+            ..LearnConfig::exact()
+        };
+        let (_, truth, _) = runs(&a, &double, &cfg, 0.0, 5);
+        for j in 1..5 {
+            let r = truth[j] / truth[j - 1];
+            assert!((r - 0.5).abs() < 1e-9, "run {j}: ratio {r}");
+        }
+    }
+
+    #[test]
+    fn noisy_runs_converge_to_the_noise_and_stay_there() {
+        let a = axis();
+        let sigma = 0.2e-6;
+        let (measured, truth, _) = runs(&a, &a, &LearnConfig::default(), sigma, 8);
+        assert!(truth[0] > 100.0 * sigma, "{truth:?}");
+        for j in 2..8 {
+            // measured at the noise floor, the true error below it
+            assert!(measured[j] < 1.5 * sigma, "run {j}: {measured:?}");
+            assert!(truth[j] < sigma, "run {j}: {truth:?}");
+        }
+    }
+
+    #[test]
+    fn a_model_with_half_the_gain_is_damped_and_then_converges() {
+        // P = 2G: with α = 1 the error flips sign and keeps its size
+        // (1 − 2 = −1); the check halves the gain (1 − 2·½ = 0)
+        let a = axis();
+        let LinearModel::Discrete { b, a: den, dt } = a.clone() else {
+            unreachable!()
+        };
+        let half = LinearModel::discrete(b.iter().map(|v| 0.5 * v).collect(), den, dt).unwrap();
+        let cfg = LearnConfig {
+            compensate: CompensateConfig {
+                unit_dc_gain: false,
+                ..LearnConfig::exact().compensate
+            },
+            growth_tolerance: 0.0,
+            ..LearnConfig::exact()
+        };
+        let (measured, truth, status) = runs(&a, &half, &cfg, 0.0, 6);
+        assert!(
+            status
+                .iter()
+                .any(|s| matches!(s, LearnStatus::Damped { best_run: 1, .. })),
+            "{status:?}"
+        );
+        assert!(truth[5] < 1e-6 * truth[0], "{truth:?} {measured:?}");
+    }
+
+    #[test]
+    fn a_model_that_cannot_learn_stops_and_sends_the_best_command_again() {
+        // the model's sign is wrong: every step makes it worse
+        let a = axis();
+        let LinearModel::Discrete { b, a: den, dt } = a.clone() else {
+            unreachable!()
+        };
+        let wrong = LinearModel::discrete(b.iter().map(|v| -v).collect(), den, dt).unwrap();
+        let cfg = LearnConfig {
+            compensate: CompensateConfig {
+                unit_dc_gain: false,
+                ..LearnConfig::exact().compensate
+            },
+            ..LearnConfig::exact()
+        };
+        let desired = program();
+        let mut command = desired.clone();
+        let mut history = None;
+        let mut last = None;
+        for _ in 0..8 {
+            let y = a.simulate(&command).unwrap();
+            let s = learn(&wrong, &desired, &command, &y, DT, &cfg, history.as_ref()).unwrap();
+            command = s.command.clone();
+            history = Some(s.history.clone());
+            last = Some(s);
+        }
+        let s = last.unwrap();
+        assert!(
+            matches!(s.status, LearnStatus::Stopped { best_run: 1, .. }),
+            "{:?}",
+            s.status
+        );
+        // the best run was the plain command
+        assert_eq!(s.command, desired);
+    }
+
+    #[test]
+    fn the_noise_level_of_white_noise_is_its_standard_deviation() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let e: Vec<f64> = (0..20_000)
+            .map(|k| {
+                // a smooth signal plus Gaussian noise (Box–Muller)
+                let (u1, u2): (f64, f64) = (rng.random(), rng.random());
+                let g = (-2.0 * (1.0 - u1).ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
+                1e-3 * (k as f64 * 1e-3).sin() + 1e-6 * g
+            })
+            .collect();
+        let s = noise_level(&e);
+        assert!((s / 1e-6 - 1.0).abs() < 0.03, "{s}");
+        // a smooth signal alone has (almost) none
+        let smooth: Vec<f64> = (0..2000).map(|k| (k as f64 * 1e-3).sin()).collect();
+        assert!(noise_level(&smooth) < 1e-6);
+    }
+
+    #[test]
+    fn a_wild_sample_is_held_and_not_learned() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut e: Vec<f64> = (0..500)
+            .map(|_| 1e-7 * (rng.random::<f64>() - 0.5))
+            .collect();
+        e[200] = 1e-3;
+        let noise = noise_level(&e);
+        let (held, count) = hold_wild(&e, noise);
+        assert_eq!(count, 1);
+        assert!(held[200].abs() < 1e-6);
+        assert_eq!(held[199], e[199]);
+    }
+
+    #[test]
+    fn the_discrepancy_filter_removes_about_the_noise() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let e: Vec<f64> = (0..4000)
+            .map(|k| 1e-4 * (k as f64 * 2e-3).sin() + 1e-6 * (rng.random::<f64>() - 0.5) * 12f64.sqrt())
+            .collect();
+        let noise = noise_level(&e);
+        let s = discrepancy_sigma(&e, noise);
+        assert!(s >= 3.0, "{s}");
+        let mut out = vec![0.0; e.len()];
+        gaussian_smooth(&e, s, &mut out);
+        let removed = rms(&e.iter().zip(&out).map(|(a, b)| a - b).collect::<Vec<_>>());
+        assert!(removed <= noise && removed > 0.8 * noise, "{removed} vs {noise}");
+        // noise-free: no filter
+        let clean: Vec<f64> = (0..4000).map(|k| 1e-4 * (k as f64 * 2e-3).sin()).collect();
+        assert_eq!(discrepancy_sigma(&clean, noise_level(&clean)), 0.0);
+    }
+
+    #[test]
+    fn a_history_of_another_program_is_refused() {
+        let a = axis();
+        let desired = program();
+        let y = a.simulate(&desired).unwrap();
+        let s = learn(&a, &desired, &desired, &y, DT, &LearnConfig::default(), None).unwrap();
+        let other: Vec<f64> = desired.iter().map(|v| 2.0 * v).collect();
+        let e = learn(
+            &a,
+            &other,
+            &other,
+            &y,
+            DT,
+            &LearnConfig::default(),
+            Some(&s.history),
+        )
+        .unwrap_err();
+        assert!(matches!(e, Error::HistoryMismatch { .. }), "{e}");
+        let e = learn(
+            &a,
+            &desired,
+            &desired,
+            &y,
+            2.0 * DT,
+            &LearnConfig::default(),
+            Some(&s.history),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("sample interval"), "{e}");
+    }
+
+    #[test]
+    fn the_history_round_trips_through_json() {
+        let a = axis();
+        let desired = program();
+        let y = a.simulate(&desired).unwrap();
+        let s = learn(&a, &desired, &desired, &y, DT, &LearnConfig::default(), None).unwrap();
+        let text = serde_json::to_string(&s.history).unwrap();
+        let back: LearningHistory = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, s.history);
+    }
+}

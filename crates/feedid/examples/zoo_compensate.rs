@@ -295,14 +295,31 @@ fn run(
             history.as_ref(),
         ) {
             Ok(step) => {
-                if let feedid::compensate::LearnStatus::Stopped { best_run, .. } = step.status {
-                    learn_note = format!("stopped after run {}, best {best_run}", j + 1);
+                use feedid::compensate::LearnStatus as S;
+                let tag = match step.status {
+                    S::First => "first",
+                    S::Improving => "improving",
+                    S::AtNoise => "at noise",
+                    S::Damped { .. } => "damped",
+                    S::Stopped { .. } => "stopped",
+                };
+                if !learn_note.is_empty() {
+                    learn_note.push_str(", ");
                 }
+                learn_note.push_str(&format!(
+                    "{tag} (noise {:.3} µm, filter {:.2} ms, gain {}{}, σ {:.2} ms, held {:.1} %)",
+                    1e6 * step.noise_m,
+                    1e3 * step.noise_filter_s,
+                    step.gain,
+                    if step.gain_limited { " limited" } else { "" },
+                    1e3 * step.step_smoothing_s,
+                    100.0 * step.held_back_share
+                ));
                 sent_cmd = step.command;
                 history = Some(step.history);
             }
             Err(e) => {
-                learn_note = format!("run {}: {e}", j + 1);
+                learn_note.push_str(&format!("; run {}: {e}", j + 1));
                 break;
             }
         }
@@ -356,6 +373,22 @@ fn learning_summary(rows: &[Row], runs: usize) {
             at,
             rows.len(),
             grew
+        );
+    }
+    for (name, sel) in [
+        ("fit ≥ 95 %", rows.iter().filter(|r| r.fit >= 95.0).collect::<Vec<_>>()),
+        ("fit < 95 %", rows.iter().filter(|r| r.fit.is_nan() || r.fit < 95.0).collect()),
+    ] {
+        let mut last: Vec<f64> = sel
+            .iter()
+            .map(|r| r.plain_measured / r.runs[r.runs.len() - 1])
+            .collect();
+        println!(
+            "{name}: {} of {} at the target within {runs} runs, {} grew, median plain / last run {:.1}×",
+            sel.iter().filter(|r| reached(r, runs)).count(),
+            sel.len(),
+            sel.iter().filter(|r| grows(r)).count(),
+            median(&mut last)
         );
     }
     let missed: Vec<&Row> = rows.iter().filter(|r| !reached(r, runs)).collect();

@@ -95,7 +95,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         rec.len(),
         rec.rate_hz()
     );
-    describe(&mut text, &step);
+    describe(&mut text, &step, a);
     let verification = match &verify_rig {
         Some(rig) => Some(verify_on_rig(rig, desired, &step.command, rec.rate_hz())?),
         None => None,
@@ -236,7 +236,7 @@ fn read_history(path: &Path) -> Result<Option<LearningHistory>> {
     Ok(Some(h))
 }
 
-fn describe(t: &mut String, s: &Learning) {
+fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
     let _ = writeln!(
         t,
         "  measured − desired: rms {}, max {} (noise {}{})",
@@ -279,17 +279,42 @@ fn describe(t: &mut String, s: &Learning) {
         ),
     };
     let _ = writeln!(t, "  learning: {status}");
+    let _ = writeln!(
+        t,
+        "  model: explains {:.1} % of the run's error{}",
+        100.0 * s.explained_share,
+        if s.gain > 0.0 && s.explained_share < 1.0 {
+            " (the step's gain is scaled by it, at least ½)"
+        } else {
+            ""
+        }
+    );
     if s.gain > 0.0 {
         let _ = writeln!(
             t,
-            "  step: gain {}{}, noise filter σ {:.3} ms",
+            "  step: gain {:.3}{}, noise filter σ {:.3} ms, step smoothing σ {:.3} ms{}",
             s.gain,
             if s.gain_limited {
                 " (halved to keep the command within its limits)"
             } else {
                 ""
             },
-            1e3 * s.noise_filter_s
+            1e3 * s.noise_filter_s,
+            1e3 * s.step_smoothing_s,
+            if s.held_back_share > 0.0 {
+                format!(
+                    ", held back on {:.1} % of the samples (limits)",
+                    100.0 * s.held_back_share
+                )
+            } else {
+                String::new()
+            }
+        );
+    } else if s.gain_limited {
+        let _ = writeln!(
+            t,
+            "  step: none — no step keeps the command within --max-velocity {} m/s and --max-acceleration {} m/s² (raise them, or --max-smoothing {} s); the same command again",
+            a.max_velocity, a.max_acceleration, a.max_smoothing
         );
     }
     let _ = writeln!(
@@ -298,18 +323,14 @@ fn describe(t: &mut String, s: &Learning) {
         micrometres(s.predicted_next_rms_m),
         micrometres(s.predicted_next_measured_rms_m)
     );
-    if let Some(c) = &s.step {
-        let _ = writeln!(
-            t,
-            "  command: smoothing σ up to {:.3} ms on {:.1} % of the samples; peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
-            1e3 * c.smoothing_s,
-            100.0 * c.smoothed_share,
-            c.peak_velocity,
-            c.peak_velocity_time_s,
-            c.peak_acceleration,
-            c.peak_acceleration_time_s
-        );
-    }
+    let _ = writeln!(
+        t,
+        "  command: peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
+        s.peaks.velocity,
+        s.peaks.velocity_time_s,
+        s.peaks.acceleration,
+        s.peaks.acceleration_time_s
+    );
 }
 
 fn warn(s: &Learning, a: &CompensateArgs) {

@@ -42,6 +42,19 @@
 //! [`Smoothing::Fixed`] smooths the correction with one σ everywhere and
 //! reports [`Error::LimitExceeded`] (figures of that command) over a limit.
 //!
+//! **The start eased in.** With a rest start the smoothing may never move
+//! the trajectory before its first sample, so where the program starts
+//! moving soon after its first sample σ is capped there and a velocity or
+//! jerk step at the start of motion cannot be smoothed enough. There the
+//! inverse aims at the start **eased in causally**: from the first sample
+//! that moves, `(1 − w)·H·y + w·y`, `H` four first-order lags of time
+//! constant τ (unit gain, causal: nothing moves before the trajectory does)
+//! and `w` a step from 0 to 1 with every derivative continuous over
+//! `16·τ`. The command then compensates fully only after the easing (mean
+//! lag `4τ`, [`Compensation::start_ease_s`]); the model's prediction shows
+//! what is left at the start. τ (from ½ sample in the σ levels) is raised
+//! only when a limit is exceeded where the cap binds.
+//!
 //! **Ends.** The trajectory is a segment: before its first sample the axis
 //! rests at `y_d[0]` ([`StartMode::Rest`], default; whatever the command
 //! would need before — smoothing, pre-actuation of non-minimum-phase zeros —
@@ -275,6 +288,10 @@ pub struct Compensation {
     /// Largest command offset the compensation would have needed before the
     /// first sample (lost with [`StartMode::Rest`]) \[m\].
     pub pre_actuation_m: f64,
+    /// Mean lag of the causal easing of the start (the command reaches the
+    /// full compensation over about 4× this after the first move) \[s\];
+    /// 0: none.
+    pub start_ease_s: f64,
     /// What the axis did before the first sample.
     pub start: StartMode,
     /// Velocity held after the last sample \[m/s\].
@@ -435,14 +452,16 @@ impl Problem<'_> {
         }
     }
 
-    fn command(&self, sigma: &[f64], sigma_plain: &[f64]) -> Result<Candidate> {
+    fn command(&self, sigma: &[f64], sigma_plain: &[f64], start_tau: f64) -> Result<Candidate> {
         let len = self.ext.len();
         let mut plain = vec![0.0; len];
         gaussian_smooth_profile(&self.ext, sigma_plain, &mut plain);
+        // what the inverse aims at: the plain part, its start eased in
+        let target = self.eased(&plain, start_tau);
         let mut corr = vec![0.0; len];
         let mut work = Vec::new();
-        self.inverse.apply_into(&plain, &mut corr, &mut work)?;
-        for (c, p) in corr.iter_mut().zip(&plain) {
+        self.inverse.apply_into(&target, &mut corr, &mut work)?;
+        for (c, p) in corr.iter_mut().zip(&target) {
             *c -= p;
         }
         let mut fc = vec![0.0; len];
@@ -450,6 +469,40 @@ impl Problem<'_> {
         let raw: Vec<f64> = (0..len).map(|i| plain[i] + fc[i]).collect();
         let sent = self.sent(&raw);
         Ok(Candidate { raw, sent, plain })
+    }
+
+    /// The start eased in (module doc): from the first sample that moves,
+    /// `(1 − w)·H·y + w·y` with `H` [`START_LAGS`] first-order lags of time
+    /// constant `tau` \[samples\] (causal: nothing moves earlier) and `w` a
+    /// smooth step from 0 to 1 over `4·START_LAGS·tau` samples; `tau = 0`
+    /// or a moving start: `y` unchanged.
+    fn eased(&self, y: &[f64], tau: f64) -> Vec<f64> {
+        if tau <= 0.0 || self.start != StartMode::Rest {
+            return y.to_vec();
+        }
+        let scale = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let Some(f) = y.iter().position(|v| v.abs() > 1e-12 * scale) else {
+            return y.to_vec();
+        };
+        let a = (-1.0 / tau).exp();
+        let mut lagged = y.to_vec();
+        for _ in 0..START_LAGS {
+            let mut state = 0.0;
+            for v in lagged.iter_mut() {
+                state = a * state + (1.0 - a) * *v;
+                *v = state;
+            }
+        }
+        let span = 4.0 * START_LAGS as f64 * tau;
+        y.iter()
+            .zip(&lagged)
+            .enumerate()
+            .map(|(i, (&v, &h))| {
+                let x = if i < f { 0.0 } else { (i - f) as f64 / span };
+                let w = smooth_step(x);
+                (1.0 - w) * h + w * v
+            })
+            .collect()
     }
 
     /// What is sent of `raw`: with a rest start nothing before the first sample.
@@ -469,6 +522,23 @@ impl Problem<'_> {
         p.acceleration_at = p.acceleration_at.saturating_sub(self.pre);
         p
     }
+}
+
+/// First-order lags of the eased start ([`Problem::eased`]).
+const START_LAGS: usize = 4;
+
+/// A step from 0 (x ≤ 0) to 1 (x ≥ 1) with every derivative continuous:
+/// `φ(x)/(φ(x) + φ(1 − x))`, `φ(x) = exp(−1/x)`.
+fn smooth_step(x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let a = (-1.0 / x).exp();
+    let b = (-1.0 / (1.0 - x)).exp();
+    a / (a + b)
 }
 
 /// Build the extended grid: `pre` samples before (rest, or the first
@@ -529,7 +599,7 @@ fn predict(sys: &DiscreteStateSpace, p: &Problem<'_>, sent: &[f64]) -> Result<Ve
 }
 
 /// σ levels \[samples\] tried by [`Smoothing::Auto`], up to `max`.
-fn levels(max: f64) -> Vec<f64> {
+pub(super) fn levels(max: f64) -> Vec<f64> {
     let mut c = vec![0.0, 0.5, 1.0, 1.5];
     let mut s = 2.0;
     while s <= max {
@@ -565,7 +635,7 @@ fn check_desired(desired: &[f64]) -> Result<()> {
 
 /// The outcome of the limit search.
 enum Search {
-    Met(Candidate, Vec<f64>, Vec<f64>),
+    Met(Candidate, Vec<f64>, Vec<f64>, f64),
     Unreachable(Peaks),
 }
 
@@ -577,7 +647,7 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
         let mut sigma = vec![s / dt; len];
         p.capped(&mut sigma);
         let zero = vec![0.0; len];
-        let c = p.command(&sigma, &zero)?;
+        let c = p.command(&sigma, &zero, 0.0)?;
         let pk = p.peaks(&c.sent);
         if over(pk.velocity, cfg.max_velocity) {
             return Err(Error::LimitExceeded {
@@ -599,7 +669,7 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
                 hint: LIMIT_HINT,
             });
         }
-        return Ok(Search::Met(c, sigma, zero));
+        return Ok(Search::Met(c, sigma, zero, 0.0));
     }
     let lv = levels(cfg.max_smoothing / dt);
     let next = |s: f64| lv.iter().copied().find(|&l| l > s + 1e-12);
@@ -609,8 +679,9 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
     let mut sigma_p = raw_p.clone();
     let mut best: Option<Peaks> = None;
     let d = p.inverse.delay();
+    let mut tau = 0.0;
     for _ in 0..MAX_ROUNDS {
-        let c = p.command(&sigma, &sigma_p)?;
+        let c = p.command(&sigma, &sigma_p, tau)?;
         let pk = p.peaks(&c.sent);
         let score =
             |q: &Peaks| (q.velocity / cfg.max_velocity).max(q.acceleration / cfg.max_acceleration);
@@ -624,6 +695,8 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
         let snap_c = raw_c.clone();
         let snap_p = raw_p.clone();
         let mut violations = 0usize;
+        // a violation where the rest start caps the smoothing
+        let mut capped = false;
         for i in lo..hi {
             let vel = |s: &[f64]| ((s[i] - s[i - 1]) / dt).abs();
             let acc = |s: &[f64]| ((s[i + 1] - 2.0 * s[i] + s[i - 1]) / (dt * dt)).abs();
@@ -643,6 +716,9 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
                     continue;
                 }
                 if let Some(to) = next(snap[i]) {
+                    if also && p.cap.as_ref().is_some_and(|cap| cap[i] < to) {
+                        capped = true;
+                    }
                     let r = (4.0 * to).ceil() as usize + 4;
                     let a = i.saturating_sub(r);
                     let b = (i + d + r + 1).min(len);
@@ -654,7 +730,14 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
             }
         }
         if violations == 0 {
-            return Ok(Search::Met(c, sigma, sigma_p));
+            return Ok(Search::Met(c, sigma, sigma_p, tau));
+        }
+        if capped {
+            // ease the start in more slowly (causal: the rest start allows it)
+            if let Some(t) = next(tau) {
+                tau = t.max(1.0);
+                raised = true;
+            }
         }
         if !raised {
             break;
@@ -726,8 +809,8 @@ fn compensate_with(
     let predicted_plain_error =
         ErrorStats::from_pairs(desired.iter().copied().zip(predicted_plain.iter().copied()));
 
-    let (candidate, sigma, sigma_p, limit_fallback) = match search_limits(&problem, cfg)? {
-        Search::Met(c, s, sp) => (Some(c), s, sp, None),
+    let (candidate, sigma, sigma_p, start_tau, limit_fallback) = match search_limits(&problem, cfg)? {
+        Search::Met(c, s, sp, tau) => (Some(c), s, sp, tau, None),
         Search::Unreachable(best) => {
             // quote the quantity the trajectory itself exceeds, if any
             let plain_v = plain_peaks.velocity > cfg.max_velocity * (1.0 + 1e-9);
@@ -771,7 +854,7 @@ fn compensate_with(
                 achievable,
                 limit,
             };
-            (None, Vec::new(), Vec::new(), Some(fb))
+            (None, Vec::new(), Vec::new(), 0.0, Some(fb))
         }
     };
 
@@ -825,6 +908,11 @@ fn compensate_with(
             smoothed_share = 0.0;
         }
     }
+    let start_ease_s = if fallback.is_none() {
+        dt * START_LAGS as f64 * start_tau
+    } else {
+        0.0
+    };
     let peaks = problem.peaks(&sent_rel);
     let u_rest = y0 / g;
     let command: Vec<f64> = sent_rel[window].iter().map(|v| u_rest + v).collect();
@@ -850,6 +938,7 @@ fn compensate_with(
         zeros: inverse.zeros().to_vec(),
         exact_inverse: inverse.is_exact(),
         pre_actuation_m: pre_actuation,
+        start_ease_s,
         start: cfg.start,
         end_velocity: (e[n - 1] - e[n - 2]) / dt,
     })

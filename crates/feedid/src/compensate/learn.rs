@@ -17,16 +17,31 @@
 //! u_{j+1} = u_j + α·G⁻¹·ẽ_j
 //! ```
 //!
-//! computed as the compensation ([`super::compensate_model`]) of the
-//! **virtual reference** `r = G·u_j + α·ẽ_j`: since `G⁻¹·r = u_j + α·G⁻¹·ẽ_j`,
-//! that compensation is the update, and it inherits the stable inverse
-//! (anti-causal for zeros outside the unit circle), the velocity and
-//! acceleration limits with smoothing only where they need it (the Q filter
-//! of ILC, acting on the correction only), and the start modes. Where the
-//! program rests at its start ([`StartMode::Rest`]) nothing is learned
-//! before it moves. A step whose command cannot meet the limits is taken
-//! with half the gain (up to [`LearnConfig::max_halvings`] times,
-//! [`Learning::gain_limited`]).
+//! The step `G⁻¹·ẽ_j` is the compensation ([`super::compensate_model`]) of
+//! `ẽ_j` as a trajectory, `Δ = ẽ + F·(G⁻¹ − 1)·ẽ`: the stable inverse
+//! (anti-causal for zeros outside the unit circle) with a zero-phase
+//! Gaussian smoothing `F` of the step only — the last command is kept as it
+//! was sent. σ of `F` starts at 0 and is raised (the compensation's σ
+//! levels, up to [`super::CompensateConfig::max_smoothing`]) only until the
+//! new command meets the velocity and acceleration limits (or is no worse
+//! than the last one where that one exceeds them), the step held back
+//! locally where it still would not (`(1 − W)·Δ`, `W` a smooth window around
+//! those samples; [`Learning::held_back_share`]); when no σ allowed does,
+//! the gain is halved (up to [`LearnConfig::max_halvings`] times,
+//! [`Learning::gain_limited`]). Where the program rests at its start
+//! ([`StartMode::Rest`]) nothing is learned before it moves, and the error
+//! learned eases in over `8 + 8σ` samples after it starts to (a kink of the
+//! noise there would ask the inverse for an unbounded command that the
+//! smoothing, which may not move anything before the first sample, cannot
+//! round).
+//!
+//! **Trust in the model.** The share of the base run's error that the model
+//! explains, `1 − ‖y − ŷ‖/‖e − ē‖` (`ŷ` the model's position for the
+//! command sent), scales the step's gain (clamped to
+//! \[[`LearnConfig::min_trust`], 1\], default ½): a model as
+//! wrong as the axis's own error cannot be relied on to correct it, and on
+//! the drive zoo the half-gain steps of such models grow the error on fewer
+//! axes at no cost where the model fits.
 //!
 //! **Convergence.** With the axis `P = G·(1 + Δ)` the noise-free tracking
 //! error of the next run is `ε_{j+1} = (1 − α·(1 + Δ))·ε_j` at each
@@ -86,12 +101,12 @@
 //!     command = step.command;
 //!     history = Some(step.history);
 //! }
-//! assert!(rms[5] < 1e-3 * rms[0], "{rms:?}");
+//! assert!(rms[5] < 1e-2 * rms[0], "{rms:?}");
 //! ```
 
 use serde::{Deserialize, Serialize};
 
-use super::command::{compensate_model, model_settle, CompensateConfig, Compensation, StartMode};
+use super::command::{compensate_model, levels, model_settle, CompensateConfig, Smoothing, StartMode};
 use super::smoothing::gaussian_smooth;
 use crate::error::{Error, Result};
 use crate::ident::LinearModel;
@@ -121,10 +136,15 @@ pub struct LearnConfig {
     /// Noise filter of the measured error; default [`NoiseFilter::Auto`].
     pub noise_filter: NoiseFilter,
     /// A run is worse than the best so far when its rms exceeds the best's
-    /// by more than this share (plus a tenth of the noise); default 0.05.
+    /// by more than this share (plus a tenth of the noise); default 0.01.
     pub growth_tolerance: f64,
     /// Halvings of the gain after which the learning stops; default 3.
     pub max_halvings: u32,
+    /// Smallest factor of the gain for a model that explains little of the
+    /// run's error (module doc, 1: the gain as decided); default 0.5.
+    pub min_trust: f64,
+    /// Ease the learned error in after a rest start (module doc); default true.
+    pub ease_start: bool,
     /// Limits, smoothing, start and DC gain of the command, as for
     /// [`super::compensate_model`] (its fall-back settings do not apply:
     /// the measured runs, not the model's fit, decide).
@@ -136,19 +156,23 @@ impl Default for LearnConfig {
         Self {
             gain: 1.0,
             noise_filter: NoiseFilter::Auto,
-            growth_tolerance: 0.05,
+            growth_tolerance: 0.01,
             max_halvings: 3,
+            min_trust: 0.5,
+            ease_start: true,
             compensate: CompensateConfig::default(),
         }
     }
 }
 
 impl LearnConfig {
-    /// No limits, no smoothing, no noise filter: the plain ILC update (for
-    /// noise-free data and tests).
+    /// No limits, no smoothing, no noise filter, no easing, the gain as
+    /// given: the plain ILC update (for noise-free data and tests).
     pub fn exact() -> Self {
         Self {
             noise_filter: NoiseFilter::Fixed(0.0),
+            min_trust: 1.0,
+            ease_start: false,
             compensate: CompensateConfig {
                 smoothing: super::Smoothing::Fixed(0.0),
                 max_velocity: f64::INFINITY,
@@ -182,6 +206,13 @@ impl LearnConfig {
                 name: "growth tolerance",
                 value: self.growth_tolerance,
                 reason: "must be finite and >= 0",
+            });
+        }
+        if !(self.min_trust > 0.0 && self.min_trust <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "min trust",
+                value: self.min_trust,
+                reason: "must be > 0 and <= 1",
             });
         }
         if self.max_halvings > 30 {
@@ -389,18 +420,26 @@ pub struct Learning {
     /// Learning gain of the step.
     pub gain: f64,
     /// True when the gain was halved (from the history's or the settings')
-    /// to keep the command within its limits.
+    /// to keep the command within its limits (gain 0: no step could).
     pub gain_limited: bool,
     /// σ of the noise filter of the step \[s\].
     pub noise_filter_s: f64,
+    /// Share of the base run's error the model explains (`1 − ‖y − ŷ‖/‖e − ē‖`);
+    /// the step's gain is the decided one times this, clamped to
+    /// \[[`LearnConfig::min_trust`], 1\].
+    pub explained_share: f64,
     /// The model's prediction of the next run's rms error, noise-free \[m\].
     pub predicted_next_rms_m: f64,
     /// The same as it will be measured, with the noise \[m\].
     pub predicted_next_measured_rms_m: f64,
-    /// The step's command as [`super::compensate_model`] computed it:
-    /// smoothing, peaks, zeros (its prediction is of the virtual reference);
-    /// `None` when no step was taken (stopped, or at the noise).
-    pub step: Option<Compensation>,
+    /// σ of the zero-phase smoothing of the step (raised only to keep the
+    /// command within its limits) \[s\].
+    pub step_smoothing_s: f64,
+    /// Share of the samples where the step was held back to keep the
+    /// command within its limits (nothing learned there this run).
+    pub held_back_share: f64,
+    /// Peak velocity and acceleration of the command and their times.
+    pub peaks: CommandPeaks,
     /// The history with this run added.
     #[serde(skip)]
     pub history: LearningHistory,
@@ -409,6 +448,25 @@ pub struct Learning {
 /// A run whose rms is at most this many times its noise level is at the
 /// noise: what is left cannot be told from the noise, and is not learned.
 const AT_NOISE: f64 = 1.25;
+
+/// The share of a run's tracking error the model explains:
+/// `1 − ‖y − ŷ‖ / ‖e − ē‖` with the run's position `y = y_d − e` and the
+/// model's `ŷ` for its command (`−∞…1`; 1 when there is no error).
+fn explained_share(desired: &[f64], error: &[f64], model: &[f64]) -> f64 {
+    let n = error.len() as f64;
+    let mean = error.iter().sum::<f64>() / n;
+    let (mut sr, mut se) = (0.0, 0.0);
+    for k in 0..error.len() {
+        let y = desired[k] - error[k];
+        sr += (y - model[k]).powi(2);
+        se += (error[k] - mean).powi(2);
+    }
+    if se > 0.0 {
+        1.0 - (sr / se).sqrt()
+    } else {
+        1.0
+    }
+}
 
 /// Multiplier of the noise level for a wild sample (Hampel's identifier).
 const WILD: f64 = 6.0;
@@ -475,7 +533,7 @@ pub fn learn(
 
     // the measured error, its noise and its wild samples
     let raw: Vec<f64> = desired.iter().zip(measured).map(|(d, y)| d - y).collect();
-    let noise = noise_level(&raw);
+    let noise = run_noise(&raw, measured);
     let (error, wild_samples) = hold_wild(&raw, noise);
     let stats = ErrorStats::from_pairs(desired.iter().copied().zip(measured.iter().copied()));
 
@@ -535,10 +593,10 @@ pub fn learn(
         (best, _) => {
             let first = best.is_none();
             let at_noise = stats.rms <= AT_NOISE * noise;
-            let status = if first {
-                LearnStatus::First
-            } else if at_noise {
+            let status = if at_noise {
                 LearnStatus::AtNoise
+            } else if first {
+                LearnStatus::First
             } else {
                 LearnStatus::Improving
             };
@@ -555,7 +613,14 @@ pub fn learn(
                     .find(|g| *g > 0.0)
                     .unwrap_or(cfg.gain)
             };
-            (status, g, sent.to_vec(), error.clone(), 0.0)
+            // and so is a damped step's noise filter
+            let floor = history
+                .runs
+                .iter()
+                .rev()
+                .find(|r| matches!(r.status, LearnStatus::Damped { .. }))
+                .map_or(0.0, |r| r.noise_filter_s);
+            (status, g, sent.to_vec(), error.clone(), floor)
         }
     };
 
@@ -573,6 +638,10 @@ pub fn learn(
     }
     let out_scale = if comp_cfg.unit_dc_gain { 1.0 / g_dc } else { 1.0 };
     let y_base = simulate_run(&sys, &base_cmd, out_scale, g_dc, comp_cfg.start)?;
+    // the share of the base run's error that the model explains scales the
+    // gain: a model as wrong as the axis's own error cannot correct it
+    let explained = explained_share(desired, &base_err, &y_base);
+    let trust = explained.clamp(cfg.min_trust, 1.0);
 
     let sigma = match cfg.noise_filter {
         NoiseFilter::Fixed(s) => s / dt,
@@ -583,42 +652,26 @@ pub fn learn(
     gaussian_smooth(&base_err, sigma, &mut filtered);
     // before the program moves the axis rests: nothing to learn there but
     // noise (and a step into the learned error would ask the inverse for an
-    // unbounded command at the very start)
+    // unbounded command at the very start); the step eases in from there
     let scale = desired.iter().fold(0.0_f64, |m, v| m.max((v - desired[0]).abs()));
-    let moves = desired
-        .iter()
-        .position(|v| (v - desired[0]).abs() > 1e-12 * scale)
-        .unwrap_or(n);
-    if comp_cfg.start == StartMode::Rest {
-        filtered[..moves].fill(0.0);
-    }
+    let moves = match comp_cfg.start {
+        StartMode::Rest => desired
+            .iter()
+            .position(|v| (v - desired[0]).abs() > 1e-12 * scale)
+            .unwrap_or(n),
+        StartMode::Moving => 0,
+    };
+    filtered[..moves].fill(0.0);
 
     let decided_gain = gain;
-    let mut gain = gain;
-    let mut gain_limited = false;
-    let (command, step) = if gain > 0.0 {
-        // a step the limits cannot take is taken with half the gain
-        let mut halvings_left = cfg.max_halvings;
-        let step = loop {
-            let reference: Vec<f64> = y_base
-                .iter()
-                .zip(&filtered)
-                .map(|(y, e)| y + gain * e)
-                .collect();
-            match compensate_model(model, &reference, dt, &comp_cfg) {
-                Ok(step) => break step,
-                Err(Error::LimitUnreachable { .. }) if halvings_left > 0 => {
-                    halvings_left -= 1;
-                    gain *= 0.5;
-                    gain_limited = true;
-                }
-                Err(e) => return Err(e),
-            }
-        };
-        (step.command.clone(), Some(step))
+    let (command, gain, step_sigma, gain_limited, held_share) = if gain > 0.0 {
+        match increment(model, &base_cmd, &filtered, moves, dt, cfg, gain * trust)? {
+            Some(st) => (st.command, st.gain, st.sigma, st.gain < gain * trust, st.held_share),
+            None => (base_cmd.clone(), 0.0, 0.0, true, 0.0),
+        }
     } else {
         // stopped (the best run's command) or at the noise (this run's) again
-        (base_cmd.clone(), None)
+        (base_cmd.clone(), 0.0, 0.0, false, 0.0)
     };
     if let Some(i) = command.iter().position(|v| !v.is_finite()) {
         return Err(Error::NonFinite {
@@ -627,6 +680,7 @@ pub fn learn(
             value: command[i],
         });
     }
+    let peaks = CommandPeaks::of(&command, dt, comp_cfg.start);
     let predicted = simulate_run(&sys, &command, out_scale, g_dc, comp_cfg.start)?;
     // e_{j+1} ≈ ẽ − (ŷ_{j+1} − ŷ_base) on the base run's filtered error
     let mut ss = 0.0;
@@ -672,11 +726,265 @@ pub fn learn(
         gain,
         gain_limited,
         noise_filter_s,
+        explained_share: explained,
         predicted_next_rms_m,
         predicted_next_measured_rms_m,
-        step,
+        step_smoothing_s: step_sigma * dt,
+        held_back_share: held_share,
+        peaks,
         history,
     })
+}
+
+/// Peak |velocity| and |acceleration| of a command (finite differences, from
+/// its rest before the first sample, or its first velocity when moving).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct CommandPeaks {
+    /// Peak velocity \[m/s\].
+    pub velocity: f64,
+    /// Its time from the first sample \[s\].
+    pub velocity_time_s: f64,
+    /// Peak acceleration \[m/s²\].
+    pub acceleration: f64,
+    /// Its time \[s\].
+    pub acceleration_time_s: f64,
+}
+
+impl CommandPeaks {
+    /// The peaks of `u` at interval `dt` \[s\].
+    pub fn of(u: &[f64], dt: f64, start: StartMode) -> Self {
+        let n = u.len();
+        let before = match start {
+            StartMode::Rest => u[0],
+            StartMode::Moving if n > 1 => 2.0 * u[0] - u[1],
+            StartMode::Moving => u[0],
+        };
+        let at = |k: isize| if k < 0 { before } else { u[k as usize] };
+        let mut p = CommandPeaks::default();
+        for k in 0..n as isize {
+            let v = ((at(k) - at(k - 1)) / dt).abs();
+            if v > p.velocity {
+                p.velocity = v;
+                p.velocity_time_s = k as f64 * dt;
+            }
+            if (k as usize) + 1 < n {
+                let a = ((at(k + 1) - 2.0 * at(k) + at(k - 1)) / (dt * dt)).abs();
+                if a > p.acceleration {
+                    p.acceleration = a;
+                    p.acceleration_time_s = k as f64 * dt;
+                }
+            }
+        }
+        p
+    }
+}
+
+/// The learning step `u + g·Δ` (module doc): `Δ = e + F·(G⁻¹ − 1)·e` the
+/// compensation of the filtered error `e` with a zero-phase smoothing `F`
+/// of σ from the compensation's levels; where the new command exceeds a
+/// limit the step is held back locally (`(1 − W)·Δ`, `W` one around the
+/// violating samples and easing to zero over as many samples on each side,
+/// widened up to [`HOLD_ROUNDS`] times). The smallest σ whose step is held
+/// back on at most [`HOLD_SHARE`] of the samples is taken, else the one held
+/// back least; when none meets the limits the gain is halved (at most
+/// [`LearnConfig::max_halvings`] times). `None`: no step meets them.
+fn increment(
+    model: &LinearModel,
+    base: &[f64],
+    error: &[f64],
+    moves: usize,
+    dt: f64,
+    cfg: &LearnConfig,
+    gain: f64,
+) -> Result<Option<Step>> {
+    let comp = &cfg.compensate;
+    let sigmas: Vec<f64> = match comp.smoothing {
+        Smoothing::Fixed(s) => vec![s / dt],
+        Smoothing::Auto => levels(comp.max_smoothing / dt),
+    };
+    let base_peaks = CommandPeaks::of(base, dt, comp.start);
+    let mut deltas: Vec<Option<Vec<f64>>> = vec![None; sigmas.len()];
+    let mut g = gain;
+    for _ in 0..=cfg.max_halvings {
+        let mut best: Option<Step> = None;
+        for (i, &sigma) in sigmas.iter().enumerate() {
+            if deltas[i].is_none() {
+                let inc_cfg = CompensateConfig {
+                    smoothing: Smoothing::Fixed(sigma * dt),
+                    max_velocity: f64::INFINITY,
+                    max_acceleration: f64::INFINITY,
+                    fallback: false,
+                    ..*comp
+                };
+                let eased = if cfg.ease_start {
+                    ease_in(error, moves, sigma, comp.start)
+                } else {
+                    error.to_vec()
+                };
+                deltas[i] = Some(compensate_model(model, &eased, dt, &inc_cfg)?.command);
+            }
+            let delta = deltas[i].as_deref().unwrap_or(&[]);
+            if let Some((command, held)) = held_back(base, delta, g, dt, comp, &base_peaks) {
+                let step = Step {
+                    command,
+                    gain: g,
+                    sigma,
+                    held_share: held,
+                };
+                if held <= HOLD_SHARE {
+                    return Ok(Some(step));
+                }
+                if best.as_ref().map_or(true, |b| held < b.held_share) {
+                    best = Some(step);
+                }
+            }
+        }
+        if best.is_some() {
+            return Ok(best);
+        }
+        g *= 0.5;
+    }
+    Ok(None)
+}
+
+/// The error to learn eased in after a rest start, where the program
+/// starts moving at sample `moves`: `w·e`, `w` a step with every derivative
+/// continuous from 0 at `moves` to 1 after `8 + 8σ` samples (σ of the step's
+/// smoothing \[samples\]), so that the inverse meets no kink of the noise
+/// there, which the smoothing may not round (it may not move anything before
+/// the first sample).
+fn ease_in(e: &[f64], moves: usize, sigma: f64, start: StartMode) -> Vec<f64> {
+    if start == StartMode::Moving {
+        return e.to_vec();
+    }
+    let span = 8.0 + 8.0 * sigma;
+    e.iter()
+        .enumerate()
+        .map(|(k, v)| {
+            if k < moves {
+                0.0
+            } else {
+                v * smooth_step((k - moves) as f64 / span)
+            }
+        })
+        .collect()
+}
+
+/// Most rounds of widening where a step is held back.
+const HOLD_ROUNDS: usize = 8;
+
+/// Largest share of the samples a step may be held back on before a
+/// smoother step is tried.
+const HOLD_SHARE: f64 = 0.05;
+
+/// A learning step that meets the limits.
+struct Step {
+    command: Vec<f64>,
+    gain: f64,
+    /// σ of its smoothing \[samples\].
+    sigma: f64,
+    /// Share of the samples where it is held back (W > ½).
+    held_share: f64,
+}
+
+/// `base + g·(1 − W)·delta` within the limits (or no worse than `base`),
+/// with `W` as small as the rounds allow, and the share held back; `None`
+/// when even the widest hold does not meet them.
+fn held_back(
+    base: &[f64],
+    delta: &[f64],
+    g: f64,
+    dt: f64,
+    comp: &CompensateConfig,
+    base_peaks: &CommandPeaks,
+) -> Option<(Vec<f64>, f64)> {
+    let n = base.len();
+    let mut hold = vec![false; n];
+    let mut width = 4usize;
+    let mut w = vec![0.0; n];
+    for _ in 0..=HOLD_ROUNDS {
+        let command: Vec<f64> = (0..n).map(|k| base[k] + g * (1.0 - w[k]) * delta[k]).collect();
+        let bad = violations(&command, dt, comp, base_peaks);
+        if bad.is_empty() {
+            let share = w.iter().filter(|v| **v > 0.5).count() as f64 / n as f64;
+            return Some((command, share));
+        }
+        for k in bad {
+            hold[k] = true;
+        }
+        // W: one within `width` of a held sample, easing to 0 over `width` more
+        let mut dist = vec![usize::MAX; n];
+        let mut last: Option<usize> = None;
+        for k in 0..n {
+            if hold[k] {
+                last = Some(k);
+            }
+            if let Some(l) = last {
+                dist[k] = k - l;
+            }
+        }
+        last = None;
+        for k in (0..n).rev() {
+            if hold[k] {
+                last = Some(k);
+            }
+            if let Some(l) = last {
+                dist[k] = dist[k].min(l - k);
+            }
+        }
+        for k in 0..n {
+            w[k] = if dist[k] == usize::MAX {
+                0.0
+            } else if dist[k] <= width {
+                1.0
+            } else {
+                1.0 - smooth_step((dist[k] - width) as f64 / width as f64)
+            };
+        }
+        width *= 2;
+    }
+    None
+}
+
+/// Samples of `u` whose velocity (with the one before) or acceleration
+/// (with its neighbours) exceeds the limits of `comp` (or `base`'s peaks
+/// where those exceed them).
+fn violations(u: &[f64], dt: f64, comp: &CompensateConfig, base: &CommandPeaks) -> Vec<usize> {
+    let n = u.len();
+    let before = match comp.start {
+        StartMode::Rest => u[0],
+        StartMode::Moving if n > 1 => 2.0 * u[0] - u[1],
+        StartMode::Moving => u[0],
+    };
+    let at = |k: isize| if k < 0 { before } else { u[k as usize] };
+    let vlim = comp.max_velocity.max(base.velocity) * (1.0 + 1e-9);
+    let alim = comp.max_acceleration.max(base.acceleration) * (1.0 + 1e-9);
+    let mut out = Vec::new();
+    for k in 0..n as isize {
+        let v = ((at(k) - at(k - 1)) / dt).abs();
+        let a = if (k as usize) + 1 < n {
+            ((at(k + 1) - 2.0 * at(k) + at(k - 1)) / (dt * dt)).abs()
+        } else {
+            0.0
+        };
+        if v > vlim || a > alim {
+            out.push(k as usize);
+        }
+    }
+    out
+}
+
+/// A step from 0 (x ≤ 0) to 1 (x ≥ 1) with every derivative continuous.
+fn smooth_step(x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let a = (-1.0 / x).exp();
+    let b = (-1.0 / (1.0 - x)).exp();
+    a / (a + b)
 }
 
 /// The model's position for the command `u` of a run: from rest at `u[0]`
@@ -728,6 +1036,34 @@ pub fn noise_level(e: &[f64]) -> f64 {
     let m = median(&mut d);
     let mut dev: Vec<f64> = d.iter().map(|v| (v - m).abs()).collect();
     1.4826 * median(&mut dev) / 6.0_f64.sqrt()
+}
+
+/// Noise level of a run's error `e` (module doc): [`noise_level`], or, when
+/// the measured position is quantised (a quarter or more of its second
+/// differences exactly zero, where the median absolute deviation sees
+/// nothing), the larger of it and the rms of the second differences of `e`
+/// without their largest 2 % (corners, wild samples), scaled as for white
+/// noise (`√6`, and 0.874 for the trimmed tail).
+fn run_noise(e: &[f64], measured: &[f64]) -> f64 {
+    let mad = noise_level(e);
+    if e.len() < 3 || measured.len() != e.len() {
+        return mad;
+    }
+    let zero = measured
+        .windows(3)
+        .filter(|w| w[2] - 2.0 * w[1] + w[0] == 0.0)
+        .count();
+    if 4 * zero < measured.len() - 2 {
+        return mad;
+    }
+    let mut sq: Vec<f64> = e
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2))
+        .collect();
+    sq.sort_by(f64::total_cmp);
+    let keep = sq.len() - sq.len() / 50;
+    let ms = sq[..keep].iter().sum::<f64>() / keep.max(1) as f64;
+    mad.max((ms / (6.0 * 0.874)).sqrt())
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -932,7 +1268,9 @@ mod tests {
                 .any(|s| matches!(s, LearnStatus::Damped { best_run: 1, .. })),
             "{status:?}"
         );
-        assert!(truth[5] < 1e-6 * truth[0], "{truth:?} {measured:?}");
+        // (what is left is the part of the error the damped step's noise
+        // filter of one sample keeps from being learned)
+        assert!(truth[5] < 1e-3 * truth[0], "{truth:?} {measured:?}");
     }
 
     #[test]
@@ -969,6 +1307,87 @@ mod tests {
         );
         // the best run was the plain command
         assert_eq!(s.command, desired);
+    }
+
+    #[test]
+    fn a_learned_command_keeps_its_limits() {
+        // a ramp asks the inverse for a velocity kick at its corners; with
+        // an acceleration limit the step is smoothed or held back there
+        let a = axis();
+        let desired: Vec<f64> = (0..800)
+            .map(|k| 1e-3 * ((k as f64 - 50.0) / 500.0).clamp(0.0, 1.0))
+            .collect();
+        let plain = CommandPeaks::of(&desired, DT, StartMode::Rest);
+        let cfg = LearnConfig {
+            compensate: CompensateConfig {
+                max_velocity: 2.0 * plain.velocity,
+                max_acceleration: 1.5 * plain.acceleration,
+                ..CompensateConfig::default()
+            },
+            ..LearnConfig::default()
+        };
+        let mut command = desired.clone();
+        let mut history = None;
+        let mut rms = Vec::new();
+        for _ in 0..4 {
+            let y = a.simulate(&command).unwrap();
+            let s = learn(&a, &desired, &command, &y, DT, &cfg, history.as_ref()).unwrap();
+            let p = CommandPeaks::of(&s.command, DT, StartMode::Rest);
+            assert!(p.velocity <= cfg.compensate.max_velocity * (1.0 + 1e-9), "{p:?}");
+            assert!(
+                p.acceleration <= cfg.compensate.max_acceleration * (1.0 + 1e-9),
+                "{p:?}"
+            );
+            assert_eq!(p, s.peaks);
+            rms.push(s.measured.rms);
+            command = s.command;
+            history = Some(s.history);
+        }
+        // and still learns
+        assert!(rms[3] < 0.2 * rms[0], "{rms:?}");
+    }
+
+    #[test]
+    fn a_model_that_explains_little_of_the_error_takes_smaller_steps() {
+        // the model: the axis's lag with 3× its time constant
+        let a = axis();
+        let slow = LinearModel::discrete(vec![0.0, 0.01], vec![1.0, -0.99], DT).unwrap();
+        let desired = program();
+        let y = a.simulate(&desired).unwrap();
+        let trusting = LearnConfig {
+            min_trust: 1.0,
+            ..LearnConfig::exact()
+        };
+        let wary = LearnConfig {
+            min_trust: 0.5,
+            ..LearnConfig::exact()
+        };
+        let s1 = learn(&slow, &desired, &desired, &y, DT, &trusting, None).unwrap();
+        let s2 = learn(&slow, &desired, &desired, &y, DT, &wary, None).unwrap();
+        assert!(s1.explained_share < 0.5, "{}", s1.explained_share);
+        assert_eq!(s1.gain, 1.0);
+        assert_eq!(s2.gain, 0.5);
+        // the decided gain is what the history keeps
+        assert_eq!(s2.history.runs[0].gain, 1.0);
+        // the exact model explains all of it
+        let s3 = learn(&a, &desired, &desired, &y, DT, &wary, None).unwrap();
+        assert!(s3.explained_share > 1.0 - 1e-9, "{}", s3.explained_share);
+        assert!((s3.gain - 1.0).abs() < 1e-9, "{}", s3.gain);
+    }
+
+    #[test]
+    fn nothing_is_learned_before_the_program_moves() {
+        let a = axis();
+        let desired = program();
+        let mut y = a.simulate(&desired).unwrap();
+        // an offset of the measurement at rest before the move
+        for v in y.iter_mut().take(50) {
+            *v += 1e-6;
+        }
+        let s = learn(&a, &desired, &desired, &y, DT, &LearnConfig::default(), None).unwrap();
+        for k in 0..50 {
+            assert_eq!(s.command[k], desired[k], "sample {k}");
+        }
     }
 
     #[test]

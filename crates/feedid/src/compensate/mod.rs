@@ -30,7 +30,7 @@ pub use command::{
     StartMode,
 };
 pub use learn::{
-    learn, noise_level, BestRun, LearnConfig, LearnStatus, Learning, LearningHistory, LearningRun,
+    learn, noise_level, BestRun, CommandPeaks, LearnConfig, LearnStatus, Learning, LearningHistory, LearningRun,
     NoiseFilter, HISTORY_FORMAT, HISTORY_VERSION,
 };
 pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};

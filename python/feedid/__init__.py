@@ -41,6 +41,7 @@ __all__ = [
     "simulate",
     "model",
     "compensate",
+    "learn",
     "__version__",
 ]
 
@@ -704,4 +705,115 @@ def compensate(
     out: Dict[str, Any] = json.loads(summary)
     out["command"] = command
     out["predicted"] = predicted
+    return out
+
+
+def _model_kw(model: Any, what: str) -> Dict[str, Any]:
+    """The identified model as keyword arguments of the native functions."""
+    if isinstance(model, Identification):
+        if model.model is None:
+            raise InputError(f"this identification has no global model to {what} with")
+        return {"model_json": json.dumps(model.model)}
+    if isinstance(model, Mapping):
+        return {"model_json": json.dumps(dict(model))}
+    if model is None:
+        raise InputError(f"{what} needs an identified model (Identification, model dict or model.json)")
+    return {"model_path": os.fspath(model)}
+
+
+def learn(
+    time: Any,
+    desired: Any,
+    model: Union["Identification", Mapping[str, Any], PathLike],
+    measured: Any,
+    sent: Any = None,
+    history: Union[None, Mapping[str, Any], PathLike] = None,
+    *,
+    gain: float = 1.0,
+    noise_filter: Union[None, float, str] = None,
+    smooth: Union[None, float, str] = None,
+    max_smoothing: float = 0.02,
+    max_velocity: float = 1.0,
+    max_acceleration: float = 30.0,
+    keep_dc_gain: bool = False,
+    start: str = "rest",
+) -> Dict[str, Any]:
+    """The next run's command learned from a measured run of the program
+    (``feedid compensate --measured``): iterative learning control with the
+    identified model as its learning filter.
+
+    Parameters
+    ----------
+    time, desired : array_like
+        Time [s] and desired position [m] of the program.
+    model
+        The identified model: an :class:`Identification`, a model dict or a
+        model.json path (``feedid identify --model-out``).
+    measured : Recording, path or array_like
+        The last run: a :class:`Recording` or recording path (its position,
+        and its command as ``sent`` unless given), or its measured position
+        [m], one value per desired sample.
+    sent : array_like, optional
+        The command sent in that run [m] (``--sent``); default the run's own
+        command (required when ``measured`` is an array).
+    history : dict or path, optional
+        The learning history: ``result["history"]`` of the previous step, or a
+        history.json written by ``--history``; default a new history (run 1).
+    gain : float
+        Learning gain of a step, 0 < gain < 2 (``--learning-gain``); default 1.
+    noise_filter : float or "auto", optional
+        σ [s] of the filter of the measured error; default auto
+        (``--noise-filter``).
+    smooth, max_smoothing, max_velocity, max_acceleration, keep_dc_gain, start
+        The command's limits and settings, as for :func:`compensate`.
+
+    Returns
+    -------
+    dict
+        ``command`` [m] and ``predicted`` [m] (NumPy), ``history`` (a dict:
+        pass it to the next step, or ``json.dump`` it), and the summary's keys
+        (``run``, ``measured``, ``status``, ``gain``,
+        ``predicted_next_rms_m``, ...).
+    """
+    kw = _model_kw(model, "learn")
+    if isinstance(measured, (str, bytes, os.PathLike)):
+        measured = read(measured)
+    if isinstance(measured, Recording):
+        position = np.asarray(measured.position, dtype=np.float64)
+        if sent is None:
+            sent = measured.command
+    else:
+        position = _array(measured, "measured")
+        if sent is None:
+            raise InputError("give sent= (the command of the run) when measured is an array")
+    if history is None:
+        history_json = None
+    elif isinstance(history, Mapping):
+        history_json = json.dumps(dict(history))
+    else:
+        with open(os.fspath(history), encoding="utf-8") as f:
+            history_json = f.read()
+    for name, value in (("smooth", smooth), ("noise_filter", noise_filter)):
+        if isinstance(value, str) and value.strip() != "auto":
+            raise InputError(f"invalid {name} `{value}`: expected a time in seconds or auto")
+    command, predicted, summary, new_history = _feedid.learn(
+        _array(time, "time"),
+        _array(desired, "desired"),
+        _array(sent, "sent"),
+        position,
+        history_json=history_json,
+        gain=gain,
+        noise_filter=None if isinstance(noise_filter, str) else noise_filter,
+        smooth=None if isinstance(smooth, str) else smooth,
+        max_smoothing=max_smoothing,
+        max_velocity=max_velocity,
+        max_acceleration=max_acceleration,
+        keep_dc_gain=keep_dc_gain,
+        start=start,
+        **kw,
+    )
+    out: Dict[str, Any] = json.loads(summary)
+    out["command"] = command
+    out["predicted"] = predicted
+    out["history"] = json.loads(new_history)
     return out

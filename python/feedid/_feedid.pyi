@@ -161,3 +161,22 @@ def compensate(
     fallback: bool = True,
     check: Optional[Recording] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], str]: ...
+
+def learn(
+    time: npt.NDArray[np.float64],
+    desired: npt.NDArray[np.float64],
+    sent: npt.NDArray[np.float64],
+    measured: npt.NDArray[np.float64],
+    *,
+    model_json: Optional[str] = None,
+    model_path: Optional[str] = None,
+    history_json: Optional[str] = None,
+    gain: float = 1.0,
+    noise_filter: Optional[float] = None,
+    smooth: Optional[float] = None,
+    max_smoothing: float = 0.02,
+    max_velocity: float = 1.0,
+    max_acceleration: float = 30.0,
+    keep_dc_gain: bool = False,
+    start: str = "rest",
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], str, str]: ...

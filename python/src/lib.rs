@@ -8,6 +8,7 @@
 
 mod errors;
 mod identify;
+mod learn;
 mod method;
 mod params;
 mod recording;
@@ -26,6 +27,7 @@ fn _feedid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rig::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(rig::model, m)?)?;
     m.add_function(wrap_pyfunction!(rig::compensate, m)?)?;
+    m.add_function(wrap_pyfunction!(learn::learn, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -101,11 +101,16 @@ pub fn model(
 }
 
 /// What is known of an identified model's quality without a check
-/// recording: its free-run fit (as `feedid compensate --model` without `--check`).
+/// recording: its fits on its identification recording (as `feedid
+/// compensate --model` without `--check`).
 fn quality(file: &ModelFile) -> ModelQuality {
     ModelQuality {
         position_fit_percent: file.identified_by.as_ref().map(|p| p.fit_percent),
-        error_fit_percent: None,
+        error_fit_percent: file
+            .identified_by
+            .as_ref()
+            .and_then(|p| p.error_fit_percent),
+        noise_rms_m: None,
     }
 }
 

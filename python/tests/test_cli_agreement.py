@@ -150,3 +150,57 @@ def test_compensate_equals_the_cli_with_its_options(cli, tmp_path, py_options, c
     # the option did what it says: the plain command is sent on a fall-back only
     assert (out["fallback"] or {}).get("reason") == fallback, out["fallback"]
     assert np.array_equal(out["command"], desired) == (fallback is not None)
+
+
+def test_learning_from_runs_equals_the_cli_step_by_step(cli, tmp_path):
+    # a heavy axis with feed-forward and friction: the compensated command
+    # leaves a few µm that learning takes away
+    params, effects = tmp_path / "heavy.toml", tmp_path / "fx.toml"
+    params.write_text("[table]\nmass = 60.0\n[control]\nkv = 60.0\nkvff = 0.9\n")
+    effects.write_text("[table_friction]\ncoulomb = 25.0\nbreakaway = 30.0\n"
+                       "stribeck_velocity = 1e-3\nsmoothing_velocity = 1e-4\n")
+    prog, model = tmp_path / "prog.csv", tmp_path / "m.json"
+    cli("simulate", "--scenario", "scurve", "--params", params, "--effects", effects, "-o", prog)
+    cli("identify", prog, "-o", tmp_path / "p.csv", "--model-out", model)
+    program = feedid.read(prog)
+    t, desired = np.asarray(program.time), np.asarray(program.command)
+    command_path = tmp_path / "cmd1.csv"
+    cli("compensate", "--desired", prog, "--desired-column", "command_m", "--model", model,
+        "-o", command_path)
+    history_path = tmp_path / "history.json"
+    history = None
+    rms = []
+    for run in (1, 2, 3):
+        run_path = tmp_path / f"run{run}.csv"
+        cli("simulate", "--command", command_path, "--params", params, "--effects", effects,
+            "--seed", run, "-o", run_path)
+        next_path, summary_path = tmp_path / f"cmd{run + 1}.csv", tmp_path / f"s{run}.json"
+        cli("compensate", "--desired", prog, "--desired-column", "command_m", "--model", model,
+            "--measured", run_path, "--history", history_path, "-o", next_path,
+            "--summary", summary_path)
+        c, summary = read_csv(next_path), read_json(summary_path)
+        out = feedid.learn(t, desired, model, run_path, history=history)
+        assert out["run"] == run == summary["run"]
+        scale = float(np.ptp(desired))
+        assert np.max(np.abs(out["command"] - c["command_m"])) <= 1e-12 * scale
+        assert np.max(np.abs(out["predicted"] - c["predicted_m"])) <= 1e-12 * scale
+        keys = set(out) - {"command", "predicted", "history"}
+        assert keys and keys <= set(summary), keys - set(summary)
+        for key in keys:
+            assert json.dumps(out[key], sort_keys=True) == json.dumps(summary[key], sort_keys=True), key
+        # the history the CLI keeps is the one Python returns
+        assert out["history"] == read_json(history_path)
+        history = out["history"]
+        rms.append(out["measured"]["rms"])
+        command_path = next_path
+    assert rms[2] < rms[0], rms
+    # a history from the file, and the arrays form
+    run_path = tmp_path / "run3.csv"
+    rec = feedid.read(run_path)
+    a = feedid.learn(t, desired, model, np.asarray(rec.position), sent=np.asarray(rec.command),
+                     history=tmp_path / "history.json")
+    assert a["run"] == 4
+    with pytest.raises(feedid.InputError, match="sent="):
+        feedid.learn(t, desired, model, np.asarray(rec.position))
+    with pytest.raises(feedid.InputError, match="learning gain"):
+        feedid.learn(t, desired, model, rec, gain=3.0)

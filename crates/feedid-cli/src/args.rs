@@ -129,7 +129,12 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "cmd.csv", conflicts_with_all = ["scenario", "rate", "duration"])]
     pub command: Option<PathBuf>,
     /// Column of the command in --command, by name or 1-based index.
-    #[arg(long, value_name = "NAME|N", default_value = "command_m", requires = "command")]
+    #[arg(
+        long,
+        value_name = "NAME|N",
+        default_value = "command_m",
+        requires = "command"
+    )]
     pub command_column: String,
     /// Rig parameters (TOML); default: the built-in default rig.
     #[arg(long, value_name = "rig.toml")]
@@ -574,7 +579,12 @@ pub struct CompensateArgs {
     #[arg(long, value_name = "comp.json")]
     pub summary: Option<PathBuf>,
     /// Learn from a measured run of the program (time_s,command_m,position_m on the desired trajectory's samples): the output is the next run's command (iterative learning control with the model, see docs/GUIDE.md).
-    #[arg(long, value_name = "run.csv", requires = "model", conflicts_with = "check")]
+    #[arg(
+        long,
+        value_name = "run.csv",
+        requires = "model",
+        conflicts_with = "check"
+    )]
     pub measured: Option<PathBuf>,
     /// The command sent in the measured run (a CSV with time_s and command_m, e.g. the last `compensate -o`) [default: the run's own command_m column].
     #[arg(long, value_name = "cmd.csv", requires = "measured")]
@@ -586,6 +596,11 @@ pub struct CompensateArgs {
     #[arg(long, default_value_t = 1.0, value_name = "G", requires = "measured")]
     pub learning_gain: f64,
     /// σ of the zero-phase filter of the measured error [s], or auto (as much as the run's own noise allows).
-    #[arg(long, default_value = "auto", value_name = "S|auto", requires = "measured")]
+    #[arg(
+        long,
+        default_value = "auto",
+        value_name = "S|auto",
+        requires = "measured"
+    )]
     pub noise_filter: String,
 }

@@ -100,7 +100,9 @@ enum Wrong {
 
 /// The model as a discrete `B(q)/A(q)` at interval `dt`.
 fn as_discrete(model: &LinearModel, dt: f64) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let sys = model.discrete_state_space(Some(dt)).map_err(|e| e.to_string())?;
+    let sys = model
+        .discrete_state_space(Some(dt))
+        .map_err(|e| e.to_string())?;
     let tf = StateSpace::new(sys.a.clone(), sys.b.clone(), sys.c.clone(), sys.d)
         .and_then(|s| s.to_tf())
         .map_err(|e| e.to_string())?;
@@ -238,6 +240,7 @@ fn run(
     let quality = ModelQuality {
         position_fit_percent: on_chirp.position_fit_percent,
         error_fit_percent: on_plain.error_fit_percent,
+        noise_rms_m: on_plain.noise_rms_m,
     };
     // limits the axis already accepts: the plain command's own peaks (a
     // ramp's velocity step is v/Δt) and some headroom
@@ -376,8 +379,16 @@ fn learning_summary(rows: &[Row], runs: usize) {
         );
     }
     for (name, sel) in [
-        ("fit ≥ 95 %", rows.iter().filter(|r| r.fit >= 95.0).collect::<Vec<_>>()),
-        ("fit < 95 %", rows.iter().filter(|r| r.fit.is_nan() || r.fit < 95.0).collect()),
+        (
+            "fit ≥ 95 %",
+            rows.iter().filter(|r| r.fit >= 95.0).collect::<Vec<_>>(),
+        ),
+        (
+            "fit < 95 %",
+            rows.iter()
+                .filter(|r| r.fit.is_nan() || r.fit < 95.0)
+                .collect(),
+        ),
     ] {
         let mut last: Vec<f64> = sel
             .iter()
@@ -398,7 +409,10 @@ fn learning_summary(rows: &[Row], runs: usize) {
         rows.len(),
         rows.iter().filter(|r| grows(r)).count()
     );
-    for r in missed.iter().chain(rows.iter().filter(|r| grows(r)).collect::<Vec<_>>().iter()) {
+    for r in missed
+        .iter()
+        .chain(rows.iter().filter(|r| grows(r)).collect::<Vec<_>>().iter())
+    {
         println!(
             "  #{} {} ({}): floor {:.3} µm, plain {:.3} µm, runs {} µm{}",
             r.index,
@@ -568,6 +582,32 @@ fn main() {
         summary(&format!("all, {kind}"), &k);
     }
     summary("all", &all);
+    // the model's expectation against what the axis did, where compensated
+    let comp: Vec<&Row> = rows.iter().filter(|r| r.sent == "compensated").collect();
+    let agree = comp
+        .iter()
+        .filter(|r| {
+            let q = r.predicted_benefit / (r.plain_rms / r.sent_rms);
+            (0.5..=2.0).contains(&q)
+        })
+        .count();
+    println!(
+        "\nexpected benefit within a factor 2 of the achieved one: {agree} of {} compensated axes",
+        comp.len()
+    );
+    for r in comp.iter().filter(|r| {
+        let q = r.predicted_benefit / (r.plain_rms / r.sent_rms);
+        !(0.5..=2.0).contains(&q)
+    }) {
+        println!(
+            "  #{} {}: expected {:.2}×, achieved {:.2}× (error fit {:.1} %)",
+            r.index,
+            r.label,
+            r.predicted_benefit,
+            r.plain_rms / r.sent_rms,
+            r.error_fit
+        );
+    }
     println!("\nworse than plain (rms sent > plain):");
     for r in rows
         .iter()

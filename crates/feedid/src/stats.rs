@@ -176,6 +176,82 @@ pub fn sig3(v: f64) -> String {
     }
 }
 
+/// Noise level of a signal: the median absolute deviation of its second
+/// differences, scaled to a standard deviation (`√6·σ` for white noise).
+pub fn noise_level(e: &[f64]) -> f64 {
+    if e.len() < 3 {
+        return 0.0;
+    }
+    let mut d: Vec<f64> = e.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]).collect();
+    let m = median(&mut d);
+    let mut dev: Vec<f64> = d.iter().map(|v| (v - m).abs()).collect();
+    1.4826 * median(&mut dev) / 6.0_f64.sqrt()
+}
+
+/// Noise level of a run's error or residual `e` (against its measured
+/// position `measured`): [`noise_level`], or, when
+/// the measured position is quantised (a quarter or more of its second
+/// differences exactly zero, where the median absolute deviation sees
+/// nothing), the larger of it and the rms of the second differences of `e`
+/// without their largest 2 % (corners, wild samples), scaled as for white
+/// noise (`√6`, and 0.874 for the trimmed tail).
+pub fn noise_level_of_run(e: &[f64], measured: &[f64]) -> f64 {
+    let mad = noise_level(e);
+    if e.len() < 3 || measured.len() != e.len() {
+        return mad;
+    }
+    let zero = measured
+        .windows(3)
+        .filter(|w| w[2] - 2.0 * w[1] + w[0] == 0.0)
+        .count();
+    if 4 * zero < measured.len() - 2 {
+        return mad;
+    }
+    let mut sq: Vec<f64> = e
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2))
+        .collect();
+    sq.sort_by(f64::total_cmp);
+    let keep = sq.len() - sq.len() / 50;
+    let ms = sq[..keep].iter().sum::<f64>() / keep.max(1) as f64;
+    mad.max((ms / (6.0 * 0.874)).sqrt())
+}
+
+/// The median of `v` (reordered in place; 0 when empty).
+pub fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
+    *m
+}
+
+/// The share of a following error `following` (`y − u`) that a model with
+/// free-run residual `residual` (`y − ŷ`, same samples) explains, both
+/// without a measurement noise of `noise` per sample, which no model
+/// explains: `100·(1 − √(max(0, ‖r‖² − nσ²) / (‖f − f̄‖² − nσ²)))` \[%\];
+/// `None` when the following error is no larger than the noise.
+pub fn error_fit_percent(residual: &[f64], following: &[f64], noise: f64) -> Option<f64> {
+    let n = following.len().min(residual.len());
+    if n == 0 {
+        return None;
+    }
+    let floor = noise * noise * n as f64;
+    let mean = following[..n].iter().sum::<f64>() / n as f64;
+    let sse = (residual[..n].iter().map(|r| r * r).sum::<f64>() - floor).max(0.0);
+    let ssf = following[..n]
+        .iter()
+        .map(|f| (f - mean).powi(2))
+        .sum::<f64>()
+        - floor;
+    if ssf > 0.0 && sse.is_finite() {
+        Some(100.0 * (1.0 - (sse / ssf).sqrt()))
+    } else {
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,8 +6,8 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use feedid::compensate::{
-    compensate_model, compensate_params, verify_on_rig, CompensateConfig, Compensation,
-    ModelQuality, Smoothing, StartMode, Verification, ZeroHandling,
+    compensate_model, compensate_params, verify_on_rig, CompensateConfig, Compensation, Fallback,
+    ModelErrorSource, ModelQuality, Smoothing, StartMode, Verification, ZeroHandling,
 };
 use feedid::drive::{RigEffects, VirtualRig};
 use feedid::greybox::LoopModel;
@@ -106,9 +106,14 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
                     ModelQuality::from_recording(&file.model, &r)
                         .map_err(|e| anyhow::anyhow!("{}: {e}", check.display()))?
                 }
+                // the fits on the model's own identification recording
                 None => ModelQuality {
                     position_fit_percent: file.identified_by.as_ref().map(|p| p.fit_percent),
-                    error_fit_percent: None,
+                    error_fit_percent: file
+                        .identified_by
+                        .as_ref()
+                        .and_then(|p| p.error_fit_percent),
+                    noise_rms_m: None,
                 },
             };
             let comp = compensate_model(&file.model, desired, dt, &cfg)
@@ -155,7 +160,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         rec.len(),
         rec.rate_hz()
     );
-    describe(&mut text, &comp, &cfg.quality);
+    describe(&mut text, &comp, &cfg.quality, a.check.is_some());
 
     let verification = match &verify_rig {
         Some(rig) => Some(verify_on_rig(rig, desired, &comp.command, rec.rate_hz())?),
@@ -237,7 +242,10 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     outputs.commit()?;
     print!("{text}");
     if let Some(f) = &comp.fallback {
-        eprintln!("warning: the plain desired trajectory is sent as the command: {f}");
+        eprintln!(
+            "warning: the plain desired trajectory is sent as the command: {f}; {}",
+            fallback_hint(f, a, &comp, desired)
+        );
     }
     if !comp.exact_inverse {
         eprintln!(
@@ -273,7 +281,7 @@ pub(crate) fn json_limit(v: f64) -> serde_json::Value {
     }
 }
 
-fn describe(t: &mut String, c: &Compensation, q: &ModelQuality) {
+fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checked: bool) {
     let count = |h: ZeroHandling| c.zeros.iter().filter(|z| z.handling == h).count();
     let _ = writeln!(
         t,
@@ -297,33 +305,93 @@ fn describe(t: &mut String, c: &Compensation, q: &ModelQuality) {
         fit(q.position_fit_percent),
         fit(q.error_fit_percent)
     );
-    let _ = writeln!(
-        t,
-        "  model's prediction: plain command rms {}, compensated rms {}, expected benefit {:.2}×",
-        micrometres(c.benefit.predicted_plain_rms_m),
-        micrometres(c.benefit.predicted_compensated_rms_m),
-        c.benefit.expected_benefit
-    );
-    let _ = writeln!(
-        t,
-        "  command sent: {}; smoothing σ up to {:.3} ms on {:.1} % of the samples; peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
-        match &c.fallback {
-            None => "compensated".to_string(),
-            Some(f) => format!("plain ({f})"),
-        },
-        1e3 * c.smoothing_s,
-        100.0 * c.smoothed_share,
-        c.peak_velocity,
-        c.peak_velocity_time_s,
-        c.peak_acceleration,
-        c.peak_acceleration_time_s
-    );
+    match &c.fallback {
+        None => {
+            let _ = writeln!(
+                t,
+                "  model's prediction: plain command rms {}, compensated rms {}; the model's own error here {} ({}): expected rms {}, benefit {:.2}×",
+                micrometres(c.benefit.predicted_plain_rms_m),
+                micrometres(c.benefit.predicted_compensated_rms_m),
+                micrometres(c.benefit.model_error_rms_m),
+                match c.benefit.model_error_from {
+                    ModelErrorSource::ErrorFit => if checked {
+                        "the share of the following error it does not explain on --check"
+                    } else {
+                        "the share of the following error it does not explain on its identification recording; --check run.csv measures it on this program"
+                    },
+                    ModelErrorSource::PositionFit => "its free-run fit scaled to this motion; --check run.csv measures it on the axis",
+                    ModelErrorSource::Unknown => "unknown: the model file has no fit; give --check run.csv",
+                },
+                micrometres(c.benefit.expected_compensated_rms_m),
+                c.benefit.expected_benefit
+            );
+            let _ = writeln!(
+                t,
+                "  command sent: compensated; smoothing σ up to {:.3} ms on {:.1} % of the samples{}; peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
+                1e3 * c.smoothing_s,
+                100.0 * c.smoothed_share,
+                if c.start_ease_s > 0.0 {
+                    format!(", start eased in (mean lag {:.3} ms)", 1e3 * c.start_ease_s)
+                } else {
+                    String::new()
+                },
+                c.peak_velocity,
+                c.peak_velocity_time_s,
+                c.peak_acceleration,
+                c.peak_acceleration_time_s
+            );
+        }
+        Some(f) => {
+            let _ = writeln!(
+                t,
+                "  model's prediction: plain command rms {}",
+                micrometres(c.benefit.predicted_plain_rms_m),
+            );
+            let _ = writeln!(
+                t,
+                "  command sent: the plain desired trajectory, because {f}; peak velocity {:.4} m/s, peak acceleration {:.3} m/s²",
+                c.peak_velocity, c.peak_acceleration
+            );
+        }
+    }
     let _ = writeln!(
         t,
         "  predicted − desired: rms {}, max {}",
         micrometres(c.predicted_error.rms),
         micrometres(c.predicted_error.max_abs)
     );
+}
+
+/// What would change a fall-back, in the command line's words.
+fn fallback_hint(f: &Fallback, a: &CompensateArgs, c: &Compensation, desired: &[f64]) -> String {
+    let moving_at_start = c.start == StartMode::Rest
+        && desired.len() > 2
+        && (desired[1] - desired[0]).abs()
+            > 1e-9
+                * desired
+                    .iter()
+                    .fold(0.0_f64, |m, v| m.max((v - desired[0]).abs()));
+    let start = if moving_at_start {
+        " The trajectory moves at its first sample: if it is cut from a longer program, --start moving compensates it as such."
+    } else {
+        ""
+    };
+    let text = match *f {
+        Fallback::PoorFit { .. } => format!(
+            "identify the model again on a run that excites the axis more (a chirp or PRBS, `feedid identify --model-out`), or measure its fit on this axis with --check run.csv; --min-fit (now {} %) lowers the threshold",
+            a.min_fit
+        ),
+        Fallback::SmallBenefit { .. } => format!(
+            "the model's own error leaves little to gain: a better model (--check run.csv shows how much of the following error it explains) or learning from a measured run (--measured run.csv) can; --min-benefit (now {}) lowers the threshold",
+            a.min_benefit
+        ),
+        Fallback::Limits { quantity, .. } => format!(
+            "raise --max-{quantity} (now {}) or allow more smoothing with --max-smoothing (now {} s)",
+            if quantity == "velocity" { a.max_velocity } else { a.max_acceleration },
+            a.max_smoothing
+        ),
+    };
+    format!("{text}.{start}")
 }
 
 pub(crate) fn describe_verification(t: &mut String, v: &Verification, seed: u64) {

@@ -193,7 +193,12 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
 }
 
 /// A file on the desired trajectory's samples: as many rows, the same interval.
-fn same_grid(desired: &Recording, desired_path: &Path, other: &Recording, path: &Path) -> Result<()> {
+fn same_grid(
+    desired: &Recording,
+    desired_path: &Path,
+    other: &Recording,
+    path: &Path,
+) -> Result<()> {
     if other.len() != desired.len() {
         bail!(
             "{}: {} samples, but the desired trajectory {} has {}: a run must be recorded on the program's samples",

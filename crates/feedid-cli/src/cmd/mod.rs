@@ -13,8 +13,8 @@ mod simulate;
 mod stream;
 
 mod compensate;
-mod learn;
 mod greybox;
+mod learn;
 mod report;
 mod sweep;
 pub(crate) mod zoo;

@@ -97,7 +97,9 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         Ok(())
     })?;
     outputs.commit()?;
-    let peak = command.iter().fold(0.0_f64, |m, c| m.max((c + offset).abs()));
+    let peak = command
+        .iter()
+        .fold(0.0_f64, |m, c| m.max((c + offset).abs()));
     println!(
         "{}: {} samples at {} Hz ({:.3} s), {} command, peak {:.4} mm, effects {}",
         a.output.display(),

@@ -16,19 +16,30 @@
 //! fit_e = 100·(1 − ‖y − ŷ‖ / ‖(y − u) − mean(y − u)‖)   [%]
 //! ```
 //!
-//! is the share of the axis's following error that the model explains (the
+//! is the share of the axis's following error that the model explains,
+//! both norms without the recording's measurement noise (`σ̂` per sample,
+//! the noise level of the residual: second differences, as the learning
+//! estimates it), which no model explains and the axis does not follow (the
 //! position fit, `100·(1 − ‖y − ŷ‖/‖y − ȳ‖)`, is dominated by the motion
 //! itself and says little on an axis with feed-forward, whose following
-//! error is tiny). What the model does not explain stays after compensation,
-//! so the expected rms and benefit are
+//! error is tiny). What the model does not explain stays after compensation:
+//! the expectation can never be below the model's own error, so the
+//! expected rms and benefit are
 //!
 //! ```text
-//! e_expected = rms(e_comp) + (1 − fit_e/100)·rms(e_plain)
+//! e_model    = (1 − fit_e/100)·rms(e_plain)                  (error fit known: --check)
+//!            = (1 − fit_y/100)·rms(y_d − mean(y_d))          (else: the position fit)
+//! e_expected = rms(e_comp) + e_model
 //! benefit    = rms(e_plain) / e_expected
 //! ```
 //!
-//! (with no error fit given, `e_expected = rms(e_comp)`). The plain command
-//! is sent instead — a [`Fallback`], reported with a warning — when the
+//! The second form scales the model's free-run error on its identification
+//! recording (a share `1 − fit_y` of that recording's motion) to the motion
+//! of the desired trajectory: a model that misses 0.07 % of a 20 mm move
+//! misses micrometres, whatever its prediction of the compensated error
+//! says. With neither fit known the expectation is the model's prediction
+//! alone ([`Benefit::model_error_from`] says which). The plain command is
+//! sent instead — a [`Fallback`], reported with a warning — when the
 //! position fit is below [`super::CompensateConfig::min_fit_percent`], when
 //! the benefit is below [`super::CompensateConfig::min_benefit`], or when
 //! the compensated command cannot meet the limits but the plain one does.
@@ -38,6 +49,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::ident::LinearModel;
 use crate::recording::Recording;
+use crate::stats::{error_fit_percent, noise_level_of_run};
 
 /// How well a model reproduces the axis (free run over a recording).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -46,6 +58,9 @@ pub struct ModelQuality {
     pub position_fit_percent: Option<f64>,
     /// Share of the following error the model explains \[%\] (module doc).
     pub error_fit_percent: Option<f64>,
+    /// Noise of the recording the fits were measured on \[m\] (module doc;
+    /// `None`: not measured, the fits count it as the model's error).
+    pub noise_rms_m: Option<f64>,
 }
 
 impl ModelQuality {
@@ -142,31 +157,45 @@ impl ModelQuality {
         }
         let n = command.len() as f64;
         let mean_y = position.iter().sum::<f64>() / n;
-        let mean_f = position
-            .iter()
-            .zip(command)
-            .map(|(y, u)| y - u)
-            .sum::<f64>()
-            / n;
-        let (mut sse, mut ssy, mut ssf) = (0.0, 0.0, 0.0);
+        let (mut sse, mut ssy) = (0.0, 0.0);
+        let mut residual = Vec::with_capacity(rows.len());
+        let mut following = Vec::with_capacity(rows.len());
         for (k, &i) in rows.iter().enumerate() {
             let yhat = y0 + yd[i];
+            residual.push(position[k] - yhat);
+            following.push(position[k] - command[k]);
             sse += (position[k] - yhat).powi(2);
             ssy += (position[k] - mean_y).powi(2);
-            ssf += (position[k] - command[k] - mean_f).powi(2);
         }
-        let fit = |ss: f64| {
-            if ss > 0.0 && sse.is_finite() {
-                Some(100.0 * (1.0 - (sse / ss).sqrt()))
-            } else {
-                None
-            }
+        // the measurement noise is in the residual and in the following
+        // error alike, and no model explains it: both without it
+        let noise = noise_level_of_run(&residual, position);
+        let sse = (sse - noise * noise * rows.len() as f64).max(0.0);
+        let position_fit = if ssy > 0.0 && sse.is_finite() {
+            Some(100.0 * (1.0 - (sse / ssy).sqrt()))
+        } else {
+            None
         };
         Ok(Self {
-            position_fit_percent: fit(ssy),
-            error_fit_percent: fit(ssf),
+            position_fit_percent: position_fit,
+            error_fit_percent: error_fit_percent(&residual, &following, noise),
+            noise_rms_m: Some(noise),
         })
     }
+}
+
+/// Where the model's own error in the expectation comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelErrorSource {
+    /// The share of the following error the model explains on a recording
+    /// of the axis ([`ModelQuality::error_fit_percent`]).
+    ErrorFit,
+    /// The model's free-run position fit, scaled to the desired motion
+    /// ([`ModelQuality::position_fit_percent`]).
+    PositionFit,
+    /// Neither is known: the model's prediction alone.
+    Unknown,
 }
 
 /// The model's prediction of the benefit (module doc).
@@ -176,20 +205,33 @@ pub struct Benefit {
     pub predicted_plain_rms_m: f64,
     /// Predicted rms of the compensated command's tracking error \[m\].
     pub predicted_compensated_rms_m: f64,
-    /// Expected rms after compensation, with the model's unexplained share \[m\].
+    /// The model's own error on this trajectory, the floor of the
+    /// expectation (module doc) \[m\].
+    pub model_error_rms_m: f64,
+    /// Where that floor comes from.
+    pub model_error_from: ModelErrorSource,
+    /// Expected rms after compensation: the prediction plus the floor \[m\].
     pub expected_compensated_rms_m: f64,
     /// `predicted_plain_rms_m / expected_compensated_rms_m`.
     pub expected_benefit: f64,
 }
 
 impl Benefit {
-    /// From the predicted rms errors and the model's quality.
-    pub fn new(plain_rms: f64, compensated_rms: f64, quality: &ModelQuality) -> Self {
-        let unexplained = quality
-            .error_fit_percent
-            .map(|f| (1.0 - f / 100.0).clamp(0.0, 1.0))
-            .unwrap_or(0.0);
-        let expected = compensated_rms + unexplained * plain_rms;
+    /// From the predicted rms errors, the rms of the desired motion about its
+    /// mean `motion_rms` \[m\] and the model's quality.
+    pub fn new(
+        plain_rms: f64,
+        compensated_rms: f64,
+        motion_rms: f64,
+        quality: &ModelQuality,
+    ) -> Self {
+        let share = |fit: f64| (1.0 - fit / 100.0).clamp(0.0, 1.0);
+        let (model_error, from) = match (quality.error_fit_percent, quality.position_fit_percent) {
+            (Some(f), _) => (share(f) * plain_rms, ModelErrorSource::ErrorFit),
+            (None, Some(f)) => (share(f) * motion_rms, ModelErrorSource::PositionFit),
+            (None, None) => (0.0, ModelErrorSource::Unknown),
+        };
+        let expected = compensated_rms + model_error;
         let expected_benefit = if expected > 0.0 {
             plain_rms / expected
         } else if plain_rms > 0.0 {
@@ -200,6 +242,8 @@ impl Benefit {
         Self {
             predicted_plain_rms_m: plain_rms,
             predicted_compensated_rms_m: compensated_rms,
+            model_error_rms_m: model_error,
+            model_error_from: from,
             expected_compensated_rms_m: expected,
             expected_benefit,
         }
@@ -244,7 +288,7 @@ impl std::fmt::Display for Fallback {
                 min_percent,
             } => write!(
                 f,
-                "the model's free-run fit {fit_percent:.1} % is below {min_percent} %"
+                "the model's free-run fit {fit_percent:.2} % is below {min_percent} %"
             ),
             Fallback::SmallBenefit { expected, min } => write!(
                 f,
@@ -331,12 +375,37 @@ mod tests {
         let q = ModelQuality {
             position_fit_percent: Some(99.0),
             error_fit_percent: Some(90.0),
+            noise_rms_m: None,
         };
-        let b = Benefit::new(10.0, 0.5, &q);
+        let b = Benefit::new(10.0, 0.5, 1000.0, &q);
         assert!((b.expected_compensated_rms_m - 1.5).abs() < 1e-12);
         assert!((b.expected_benefit - 10.0 / 1.5).abs() < 1e-12);
-        let b = Benefit::new(10.0, 0.5, &ModelQuality::default());
+        assert_eq!(b.model_error_from, ModelErrorSource::ErrorFit);
+        let b = Benefit::new(10.0, 0.5, 1000.0, &ModelQuality::default());
         assert!((b.expected_benefit - 20.0).abs() < 1e-12);
-        assert_eq!(Benefit::new(0.0, 0.0, &q).expected_benefit, 1.0);
+        assert_eq!(b.model_error_from, ModelErrorSource::Unknown);
+        assert_eq!(Benefit::new(0.0, 0.0, 0.0, &q).expected_benefit, 1.0);
+    }
+
+    #[test]
+    fn without_an_error_fit_the_position_fit_bounds_the_expectation() {
+        // a model that misses 0.07 % of its identification run's motion,
+        // on a trajectory of 7 mm rms: 4.9 µm, whatever it predicts
+        let q = ModelQuality {
+            position_fit_percent: Some(99.93),
+            error_fit_percent: None,
+            noise_rms_m: None,
+        };
+        let b = Benefit::new(109e-6, 0.01e-6, 7e-3, &q);
+        assert_eq!(b.model_error_from, ModelErrorSource::PositionFit);
+        assert!((b.model_error_rms_m - 4.9e-6).abs() < 1e-12, "{b:?}");
+        assert!((b.expected_benefit - 109.0 / 4.91).abs() < 1e-9, "{b:?}");
+        // a fit above 100 % or below 0 is clamped to a share in [0, 1]
+        let q = ModelQuality {
+            position_fit_percent: Some(-50.0),
+            error_fit_percent: None,
+            noise_rms_m: None,
+        };
+        assert!((Benefit::new(1.0, 0.0, 2.0, &q).model_error_rms_m - 2.0).abs() < 1e-15);
     }
 }

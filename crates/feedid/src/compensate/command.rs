@@ -809,7 +809,8 @@ fn compensate_with(
     let predicted_plain_error =
         ErrorStats::from_pairs(desired.iter().copied().zip(predicted_plain.iter().copied()));
 
-    let (candidate, sigma, sigma_p, start_tau, limit_fallback) = match search_limits(&problem, cfg)? {
+    let (candidate, sigma, sigma_p, start_tau, limit_fallback) = match search_limits(&problem, cfg)?
+    {
         Search::Met(c, s, sp, tau) => (Some(c), s, sp, tau, None),
         Search::Unreachable(best) => {
             // quote the quantity the trajectory itself exceeds, if any
@@ -862,16 +863,19 @@ fn compensate_with(
     let (mut sent_rel, mut smoothing_s, mut smoothed_share, mut pre_actuation) =
         (plain_sent.clone(), 0.0, 0.0, 0.0);
     let mut predicted_rel = yp.clone();
+    let mean = desired.iter().sum::<f64>() / n as f64;
+    let motion_rms = (desired.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
     let mut benefit = Benefit::new(
         predicted_plain_error.rms,
         predicted_plain_error.rms,
+        motion_rms,
         &cfg.quality,
     );
     let mut fallback = limit_fallback;
     if let Some(c) = candidate {
         let yc = predict(sys, &problem, &c.sent)?;
         let err = rms_error(&e, &yc, out_scale);
-        benefit = Benefit::new(predicted_plain_error.rms, err, &cfg.quality);
+        benefit = Benefit::new(predicted_plain_error.rms, err, motion_rms, &cfg.quality);
         smoothing_s = dt
             * sigma[window.clone()]
                 .iter()
@@ -1302,6 +1306,7 @@ mod tests {
             quality: ModelQuality {
                 position_fit_percent: Some(99.9),
                 error_fit_percent: Some(20.0),
+                noise_rms_m: None,
             },
             ..CompensateConfig::default()
         };
@@ -1320,6 +1325,7 @@ mod tests {
             quality: ModelQuality {
                 position_fit_percent: Some(80.0),
                 error_fit_percent: None,
+                noise_rms_m: None,
             },
             ..CompensateConfig::default()
         };

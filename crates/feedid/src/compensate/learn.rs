@@ -106,12 +106,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::command::{compensate_model, levels, model_settle, CompensateConfig, Smoothing, StartMode};
+use super::command::{
+    compensate_model, levels, model_settle, CompensateConfig, Smoothing, StartMode,
+};
 use super::smoothing::gaussian_smooth;
 use crate::error::{Error, Result};
 use crate::ident::LinearModel;
 use crate::lti::DiscreteStateSpace;
-use crate::stats::ErrorStats;
+use crate::stats::{median, noise_level_of_run, ErrorStats};
 
 /// Format name of a learning history file.
 pub const HISTORY_FORMAT: &str = "feedid-learning-history";
@@ -348,13 +350,16 @@ impl LearningHistory {
             });
         }
         let f = fingerprint(desired);
-        let scale = desired.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);
+        let scale = desired
+            .iter()
+            .fold(0.0_f64, |m, v| m.max(v.abs()))
+            .max(1e-300);
         for (what, a, b) in [
             ("first desired value (m)", self.desired_fingerprint[0], f[0]),
             ("last desired value (m)", self.desired_fingerprint[1], f[1]),
             ("mean desired value (m)", self.desired_fingerprint[2], f[2]),
         ] {
-            if !((a - b).abs() <= 1e-9 * scale) {
+            if (a - b).is_nan() || (a - b).abs() > 1e-9 * scale {
                 return Err(Error::HistoryMismatch {
                     what,
                     history: a,
@@ -533,16 +538,17 @@ pub fn learn(
 
     // the measured error, its noise and its wild samples
     let raw: Vec<f64> = desired.iter().zip(measured).map(|(d, y)| d - y).collect();
-    let noise = run_noise(&raw, measured);
+    let noise = noise_level_of_run(&raw, measured);
     let (error, wild_samples) = hold_wild(&raw, noise);
     let stats = ErrorStats::from_pairs(desired.iter().copied().zip(measured.iter().copied()));
 
     // the decision against the best run so far
     let last_gain = history.runs.last().map(|r| r.gain);
     let last_filter = history.runs.last().map(|r| r.noise_filter_s);
-    let grew = history.best.as_ref().is_some_and(|b| {
-        stats.rms > b.measured_rms_m * (1.0 + cfg.growth_tolerance) + 0.1 * noise
-    });
+    let grew = history
+        .best
+        .as_ref()
+        .is_some_and(|b| stats.rms > b.measured_rms_m * (1.0 + cfg.growth_tolerance) + 0.1 * noise);
     // the last step was to halve the error at least and left it as it was
     let stalled = history.runs.last().is_some_and(|r| {
         r.gain > 0.0
@@ -636,7 +642,11 @@ pub fn learn(
             reason: "the model's DC gain is zero or infinite; a position model must have a finite non-zero DC gain",
         });
     }
-    let out_scale = if comp_cfg.unit_dc_gain { 1.0 / g_dc } else { 1.0 };
+    let out_scale = if comp_cfg.unit_dc_gain {
+        1.0 / g_dc
+    } else {
+        1.0
+    };
     let y_base = simulate_run(&sys, &base_cmd, out_scale, g_dc, comp_cfg.start)?;
     // the share of the base run's error that the model explains scales the
     // gain: a model as wrong as the axis's own error cannot correct it
@@ -653,7 +663,9 @@ pub fn learn(
     // before the program moves the axis rests: nothing to learn there but
     // noise (and a step into the learned error would ask the inverse for an
     // unbounded command at the very start); the step eases in from there
-    let scale = desired.iter().fold(0.0_f64, |m, v| m.max((v - desired[0]).abs()));
+    let scale = desired
+        .iter()
+        .fold(0.0_f64, |m, v| m.max((v - desired[0]).abs()));
     let moves = match comp_cfg.start {
         StartMode::Rest => desired
             .iter()
@@ -666,7 +678,13 @@ pub fn learn(
     let decided_gain = gain;
     let (command, gain, step_sigma, gain_limited, held_share) = if gain > 0.0 {
         match increment(model, &base_cmd, &filtered, moves, dt, cfg, gain * trust)? {
-            Some(st) => (st.command, st.gain, st.sigma, st.gain < gain * trust, st.held_share),
+            Some(st) => (
+                st.command,
+                st.gain,
+                st.sigma,
+                st.gain < gain * trust,
+                st.held_share,
+            ),
             None => (base_cmd.clone(), 0.0, 0.0, true, 0.0),
         }
     } else {
@@ -903,7 +921,9 @@ fn held_back(
     let mut width = 4usize;
     let mut w = vec![0.0; n];
     for _ in 0..=HOLD_ROUNDS {
-        let command: Vec<f64> = (0..n).map(|k| base[k] + g * (1.0 - w[k]) * delta[k]).collect();
+        let command: Vec<f64> = (0..n)
+            .map(|k| base[k] + g * (1.0 - w[k]) * delta[k])
+            .collect();
         let bad = violations(&command, dt, comp, base_peaks);
         if bad.is_empty() {
             let share = w.iter().filter(|v| **v > 0.5).count() as f64 / n as f64;
@@ -1023,58 +1043,6 @@ fn simulate_run(
         .collect())
 }
 
-/// Noise level of a signal: the median absolute deviation of its second
-/// differences, scaled to a standard deviation (`√6·σ` for white noise).
-pub fn noise_level(e: &[f64]) -> f64 {
-    if e.len() < 3 {
-        return 0.0;
-    }
-    let mut d: Vec<f64> = e
-        .windows(3)
-        .map(|w| w[2] - 2.0 * w[1] + w[0])
-        .collect();
-    let m = median(&mut d);
-    let mut dev: Vec<f64> = d.iter().map(|v| (v - m).abs()).collect();
-    1.4826 * median(&mut dev) / 6.0_f64.sqrt()
-}
-
-/// Noise level of a run's error `e` (module doc): [`noise_level`], or, when
-/// the measured position is quantised (a quarter or more of its second
-/// differences exactly zero, where the median absolute deviation sees
-/// nothing), the larger of it and the rms of the second differences of `e`
-/// without their largest 2 % (corners, wild samples), scaled as for white
-/// noise (`√6`, and 0.874 for the trimmed tail).
-fn run_noise(e: &[f64], measured: &[f64]) -> f64 {
-    let mad = noise_level(e);
-    if e.len() < 3 || measured.len() != e.len() {
-        return mad;
-    }
-    let zero = measured
-        .windows(3)
-        .filter(|w| w[2] - 2.0 * w[1] + w[0] == 0.0)
-        .count();
-    if 4 * zero < measured.len() - 2 {
-        return mad;
-    }
-    let mut sq: Vec<f64> = e
-        .windows(3)
-        .map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2))
-        .collect();
-    sq.sort_by(f64::total_cmp);
-    let keep = sq.len() - sq.len() / 50;
-    let ms = sq[..keep].iter().sum::<f64>() / keep.max(1) as f64;
-    mad.max((ms / (6.0 * 0.874)).sqrt())
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mid = v.len() / 2;
-    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
-    *m
-}
-
 /// Hampel's identifier: samples farther than [`WILD`]·`noise` from the
 /// median of their five neighbours are replaced by it; returns the count.
 fn hold_wild(e: &[f64], noise: f64) -> (Vec<f64>, usize) {
@@ -1127,6 +1095,7 @@ fn discrepancy_sigma(e: &[f64], noise: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::stats::noise_level;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -1333,7 +1302,10 @@ mod tests {
             let y = a.simulate(&command).unwrap();
             let s = learn(&a, &desired, &command, &y, DT, &cfg, history.as_ref()).unwrap();
             let p = CommandPeaks::of(&s.command, DT, StartMode::Rest);
-            assert!(p.velocity <= cfg.compensate.max_velocity * (1.0 + 1e-9), "{p:?}");
+            assert!(
+                p.velocity <= cfg.compensate.max_velocity * (1.0 + 1e-9),
+                "{p:?}"
+            );
             assert!(
                 p.acceleration <= cfg.compensate.max_acceleration * (1.0 + 1e-9),
                 "{p:?}"
@@ -1384,10 +1356,17 @@ mod tests {
         for v in y.iter_mut().take(50) {
             *v += 1e-6;
         }
-        let s = learn(&a, &desired, &desired, &y, DT, &LearnConfig::default(), None).unwrap();
-        for k in 0..50 {
-            assert_eq!(s.command[k], desired[k], "sample {k}");
-        }
+        let s = learn(
+            &a,
+            &desired,
+            &desired,
+            &y,
+            DT,
+            &LearnConfig::default(),
+            None,
+        )
+        .unwrap();
+        assert_eq!(s.command[..50], desired[..50]);
     }
 
     #[test]
@@ -1426,7 +1405,9 @@ mod tests {
     fn the_discrepancy_filter_removes_about_the_noise() {
         let mut rng = ChaCha8Rng::seed_from_u64(9);
         let e: Vec<f64> = (0..4000)
-            .map(|k| 1e-4 * (k as f64 * 2e-3).sin() + 1e-6 * (rng.random::<f64>() - 0.5) * 12f64.sqrt())
+            .map(|k| {
+                1e-4 * (k as f64 * 2e-3).sin() + 1e-6 * (rng.random::<f64>() - 0.5) * 12f64.sqrt()
+            })
             .collect();
         let noise = noise_level(&e);
         let s = discrepancy_sigma(&e, noise);
@@ -1434,7 +1415,10 @@ mod tests {
         let mut out = vec![0.0; e.len()];
         gaussian_smooth(&e, s, &mut out);
         let removed = rms(&e.iter().zip(&out).map(|(a, b)| a - b).collect::<Vec<_>>());
-        assert!(removed <= noise && removed > 0.8 * noise, "{removed} vs {noise}");
+        assert!(
+            removed <= noise && removed > 0.8 * noise,
+            "{removed} vs {noise}"
+        );
         // noise-free: no filter
         let clean: Vec<f64> = (0..4000).map(|k| 1e-4 * (k as f64 * 2e-3).sin()).collect();
         assert_eq!(discrepancy_sigma(&clean, noise_level(&clean)), 0.0);
@@ -1445,7 +1429,16 @@ mod tests {
         let a = axis();
         let desired = program();
         let y = a.simulate(&desired).unwrap();
-        let s = learn(&a, &desired, &desired, &y, DT, &LearnConfig::default(), None).unwrap();
+        let s = learn(
+            &a,
+            &desired,
+            &desired,
+            &y,
+            DT,
+            &LearnConfig::default(),
+            None,
+        )
+        .unwrap();
         let other: Vec<f64> = desired.iter().map(|v| 2.0 * v).collect();
         let e = learn(
             &a,
@@ -1476,7 +1469,16 @@ mod tests {
         let a = axis();
         let desired = program();
         let y = a.simulate(&desired).unwrap();
-        let s = learn(&a, &desired, &desired, &y, DT, &LearnConfig::default(), None).unwrap();
+        let s = learn(
+            &a,
+            &desired,
+            &desired,
+            &y,
+            DT,
+            &LearnConfig::default(),
+            None,
+        )
+        .unwrap();
         let text = serde_json::to_string(&s.history).unwrap();
         let back: LearningHistory = serde_json::from_str(&text).unwrap();
         assert_eq!(back, s.history);

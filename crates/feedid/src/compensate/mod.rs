@@ -24,15 +24,15 @@ mod learn;
 mod smoothing;
 mod verify;
 
-pub use benefit::{Benefit, Fallback, ModelQuality};
+pub use benefit::{Benefit, Fallback, ModelErrorSource, ModelQuality};
 pub use command::{
     compensate, compensate_model, compensate_params, CompensateConfig, Compensation, Smoothing,
     StartMode,
 };
+pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
 pub use learn::{
-    learn, noise_level, BestRun, CommandPeaks, LearnConfig, LearnStatus, Learning, LearningHistory, LearningRun,
+    learn, BestRun, CommandPeaks, LearnConfig, LearnStatus, Learning, LearningHistory, LearningRun,
     NoiseFilter, HISTORY_FORMAT, HISTORY_VERSION,
 };
-pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
 pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, taper_profile};
 pub use verify::{verify_on_rig, TrackingError, Verification};

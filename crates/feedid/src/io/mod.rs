@@ -36,7 +36,8 @@ pub use self::read::{
     READ_PROGRESS_BYTES,
 };
 pub use self::source::{
-    read_small_text, read_text_up_to, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES};
+    read_small_text, read_text_up_to, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES,
+};
 pub use self::stream::{
     PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,
 };

@@ -48,7 +48,7 @@ use crate::ident::{
     fit_arx, fit_arx_segments, fit_oe, fit_oe_measured, ArxConfig, ArxOrders, LinearModel, OeConfig,
 };
 use crate::recording::Recording;
-use crate::stats::ErrorStats;
+use crate::stats::{error_fit_percent, noise_level_of_run, ErrorStats};
 
 /// Which global model to fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -180,6 +180,12 @@ pub struct ModelProvenance {
     pub fit_percent: f64,
     /// RMS of the free-run simulation error \[m\].
     pub simulation_rms_m: f64,
+    /// Share of the recording's following error `y − u` the free-run model
+    /// explains, measurement noise excluded
+    /// ([`crate::stats::error_fit_percent`]) \[%\]; what `feedid
+    /// compensate` expects the model to leave without `--check`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_fit_percent: Option<f64>,
     /// The recording's file, if known.
     #[serde(default)]
     pub source: Option<String>,
@@ -329,18 +335,31 @@ pub fn simulation_error<S: AsRef<[f64]>>(
 /// The free-run simulation of `model` on the data's command (through the
 /// gaps), compared with the measured position.
 fn simulated(model: &LinearModel, data: &Data<'_>) -> Result<ErrorStats> {
-    let (y, dt) = (data.position, data.dt);
-    Ok(match data.grid {
-        None => {
-            let sim = model.simulate_at(data.command, dt)?;
-            ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()))
-        }
+    Ok(simulated_with_fit(model, data)?.0)
+}
+
+/// [`simulated`] and the share of the following error the model explains
+/// (noise excluded, [`crate::stats::error_fit_percent`]).
+fn simulated_with_fit(model: &LinearModel, data: &Data<'_>) -> Result<(ErrorStats, Option<f64>)> {
+    let (y, u, dt) = (data.position, data.command, data.dt);
+    let sim: Vec<f64> = match data.grid {
+        None => model.simulate_at(u, dt)?,
         // through the gaps, compared where measured
         Some(g) => {
-            let sim = model.simulate_at(&g.command, dt)?;
-            ErrorStats::from_pairs(y.iter().zip(&g.measured).map(|(&v, &k)| (v, sim[k])))
+            let s = model.simulate_at(&g.command, dt)?;
+            g.measured.iter().map(|&k| s[k]).collect()
         }
-    })
+    };
+    let stats = ErrorStats::from_pairs(y.iter().copied().zip(sim.iter().copied()));
+    let residual: Vec<f64> = y.iter().zip(&sim).map(|(a, b)| a - b).collect();
+    let following: Vec<f64> = y.iter().zip(u).map(|(a, b)| a - b).collect();
+    let noise = noise_level_of_run(&residual, y);
+    let fit = if stats.rms.is_finite() {
+        error_fit_percent(&residual, &following, noise)
+    } else {
+        None
+    };
+    Ok((stats, fit))
 }
 
 /// The fitted samples.
@@ -477,7 +496,7 @@ fn fit_one(data: &Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
         }
         (GlobalModelKind::Auto, _) => return fit_data(data, kind),
     };
-    let stats = simulated(&model, data)?;
+    let (stats, error_fit) = simulated_with_fit(&model, data)?;
     if !(stats.rms.is_finite()) {
         return Err(Error::InvalidModel {
             reason: "the global model's simulation is not finite",
@@ -493,6 +512,7 @@ fn fit_one(data: &Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
             sample_time_s: dt,
             fit_percent: stats.fit_percent,
             simulation_rms_m: stats.rms,
+            error_fit_percent: error_fit,
             source: None,
             candidates: Vec::new(),
         }),

@@ -96,7 +96,7 @@ use serde::Serialize;
 
 use super::benefit::{Benefit, Fallback, ModelQuality};
 use super::inverse::{StableInverse, ZeroInfo};
-use super::smoothing::{gaussian_smooth_profile, taper_profile};
+use super::smoothing::{gaussian_smooth_profile, smooth_step, taper_profile};
 use crate::drive::RigParams;
 use crate::error::{Error, Result};
 use crate::greybox::{linear_discrete, LoopModel};
@@ -526,20 +526,6 @@ impl Problem<'_> {
 
 /// First-order lags of the eased start ([`Problem::eased`]).
 const START_LAGS: usize = 4;
-
-/// A step from 0 (x ≤ 0) to 1 (x ≥ 1) with every derivative continuous:
-/// `φ(x)/(φ(x) + φ(1 − x))`, `φ(x) = exp(−1/x)`.
-fn smooth_step(x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    let a = (-1.0 / x).exp();
-    let b = (-1.0 / (1.0 - x)).exp();
-    a / (a + b)
-}
 
 /// Build the extended grid: `pre` samples before (rest, or the first
 /// velocity held backwards) and `post` after (the end velocity held).

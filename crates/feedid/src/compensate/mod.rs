@@ -19,9 +19,11 @@
 
 mod benefit;
 mod command;
+mod history;
 mod inverse;
 mod learn;
 mod smoothing;
+mod step;
 mod verify;
 
 pub use benefit::{Benefit, Fallback, ModelErrorSource, ModelQuality};
@@ -29,10 +31,11 @@ pub use command::{
     compensate, compensate_model, compensate_params, CompensateConfig, Compensation, Smoothing,
     StartMode,
 };
-pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
-pub use learn::{
-    learn, BestRun, CommandPeaks, LearnConfig, LearnStatus, Learning, LearningHistory, LearningRun,
-    NoiseFilter, HISTORY_FORMAT, HISTORY_VERSION,
+pub use history::{
+    BestRun, LearnStatus, LearningHistory, LearningRun, HISTORY_FORMAT, HISTORY_VERSION,
 };
-pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, taper_profile};
+pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
+pub use learn::{learn, LearnConfig, Learning, NoiseFilter};
+pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, smooth_step, taper_profile};
+pub use step::CommandPeaks;
 pub use verify::{verify_on_rig, TrackingError, Verification};

@@ -101,6 +101,20 @@ pub fn taper_profile(sigma: &mut [f64]) {
     }
 }
 
+/// A step from 0 (x ≤ 0) to 1 (x ≥ 1) with every derivative continuous:
+/// `φ(x)/(φ(x) + φ(1 − x))`, `φ(x) = exp(−1/x)`.
+pub fn smooth_step(x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let a = (-1.0 / x).exp();
+    let b = (-1.0 / (1.0 - x)).exp();
+    a / (a + b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -288,12 +288,24 @@ fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
         t,
         "  model: explains {:.1} % of the run's error{}",
         100.0 * s.explained_share,
-        if s.gain > 0.0 && s.explained_share < 1.0 {
+        if s.gain > 0.0 && s.explained_share < 1.0 && s.response_ratio.is_none() {
             " (the step's gain is scaled by it, at least ½)"
         } else {
             ""
         }
     );
+    if let Some(r) = s.response_ratio {
+        let _ = writeln!(
+            t,
+            "  the axis answered the last step {:.2}× as strongly as the model predicted{}",
+            r,
+            if s.gain > 0.0 {
+                " (this step is scaled by its inverse, ½…2)"
+            } else {
+                ""
+            }
+        );
+    }
     if s.gain > 0.0 {
         let _ = writeln!(
             t,

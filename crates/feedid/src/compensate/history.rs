@@ -61,6 +61,10 @@ pub struct LearningRun {
     pub noise_filter_s: f64,
     /// The model's prediction of the next run's rms, noise-free \[m\].
     pub predicted_next_rms_m: f64,
+    /// The axis's measured response to the step before, relative to the
+    /// model's (`None`: not measurable).
+    #[serde(default)]
+    pub response_ratio: Option<f64>,
 }
 
 /// The best run so far: what a damped step starts from.
@@ -93,6 +97,10 @@ pub struct LearningHistory {
     pub runs: Vec<LearningRun>,
     /// The best run so far.
     pub best: Option<BestRun>,
+    /// The run before this one (its command and error): how the axis
+    /// answered the last step.
+    #[serde(default)]
+    pub last: Option<BestRun>,
 }
 
 impl LearningHistory {
@@ -106,6 +114,7 @@ impl LearningHistory {
             desired_fingerprint: fingerprint(desired),
             runs: Vec::new(),
             best: None,
+            last: None,
         }
     }
 
@@ -151,10 +160,11 @@ impl LearningHistory {
                 });
             }
         }
-        if let Some(b) = &self.best {
+        for (what, run) in [("best run", &self.best), ("run before", &self.last)] {
+            let Some(b) = run else { continue };
             if b.command.len() != desired.len() || b.error.len() != desired.len() {
                 return Err(Error::HistoryMismatch {
-                    what: "samples of the best run",
+                    what: "samples of a run kept",
                     history: b.command.len().min(b.error.len()) as f64,
                     actual: desired.len() as f64,
                 });
@@ -166,7 +176,7 @@ impl LearningHistory {
                 .position(|v| !v.is_finite())
             {
                 return Err(Error::NonFinite {
-                    channel: "learning history's best run".to_string(),
+                    channel: format!("learning history's {what}"),
                     index: i % desired.len(),
                     value: f64::NAN,
                 });

@@ -353,3 +353,48 @@ fn simulate_runs_a_command_from_a_file_at_its_own_rate() {
     ]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[cfg(unix)]
+#[test]
+fn a_history_that_is_not_a_regular_file_is_refused_and_left_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let prog = d.join("prog.csv");
+    run_ok(&["simulate", "--scenario", "scurve", "-o", p(&prog)]);
+    let model = d.join("m.json");
+    run_ok(&[
+        "identify",
+        p(&prog),
+        "-o",
+        p(&d.join("pred.csv")),
+        "--model-out",
+        p(&model),
+    ]);
+    let target = d.join("precious.txt");
+    std::fs::write(&target, "keep me").unwrap();
+    let link = d.join("h.json");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let out = d.join("next.csv");
+    let o = feedid(&[
+        "compensate",
+        "--desired",
+        p(&prog),
+        "--desired-column",
+        "command_m",
+        "--model",
+        p(&model),
+        "--measured",
+        p(&prog),
+        "--history",
+        p(&link),
+        "-o",
+        p(&out),
+    ]);
+    assert_fails(&o, &["h.json", "not a regular file"]);
+    assert!(!out.exists());
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep me");
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+}

@@ -3,6 +3,7 @@
 //! verified on the nonlinear virtual rig.
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use anyhow::Result;
 use feedid::compensate::{
@@ -171,70 +172,21 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     }
 
     let mut outputs = Outputs::default();
-    outputs.add(&a.output, |w| {
-        writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
-        for (((t, u), d), y) in rec
-            .time()
-            .iter()
-            .zip(&comp.command)
-            .zip(desired)
-            .zip(&comp.predicted)
-        {
-            writeln!(
-                w,
-                "{},{},{},{}",
-                cell(Some(*t)),
-                cell(Some(*u)),
-                cell(Some(*d)),
-                cell(Some(*y))
-            )?;
-        }
-        Ok(())
-    })?;
+    add_command_csv(
+        &mut outputs,
+        &a.output,
+        rec.time(),
+        &comp.command,
+        desired,
+        &comp.predicted,
+    )?;
     if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
-        outputs.add(p, |w| {
-            writeln!(
-                w,
-                "time_s,desired_m,position_uncompensated_m,position_compensated_m"
-            )?;
-            for (((t, d), a), b) in rec
-                .time()
-                .iter()
-                .zip(desired)
-                .zip(&v.position_uncompensated)
-                .zip(&v.position_compensated)
-            {
-                writeln!(
-                    w,
-                    "{},{},{},{}",
-                    cell(Some(*t)),
-                    cell(Some(*d)),
-                    cell(Some(*a)),
-                    cell(Some(*b))
-                )?;
-            }
-            Ok(())
-        })?;
+        add_verification_csv(&mut outputs, p, rec.time(), desired, v)?;
     }
     if let Some(p) = &a.summary {
         let mut v = serde_json::to_value(&comp)?;
         if let Some(obj) = v.as_object_mut() {
-            obj.insert("desired".into(), a.desired.display().to_string().into());
-            obj.insert("model".into(), source.clone().into());
-            obj.insert("samples".into(), rec.len().into());
-            obj.insert("rate_hz".into(), rec.rate_hz().into());
-            obj.insert("max_velocity_limit".into(), json_limit(a.max_velocity));
-            obj.insert(
-                "max_acceleration_limit".into(),
-                json_limit(a.max_acceleration),
-            );
-            if let Some(ver) = &verification {
-                let mut vv = serde_json::to_value(ver)?;
-                if let Some(o) = vv.as_object_mut() {
-                    o.insert("seed".into(), a.seed.into());
-                }
-                obj.insert("verification".into(), vv);
-            }
+            add_summary_context(obj, a, &source, &rec, verification.as_ref())?;
         }
         let json = serde_json::to_string_pretty(&v)?;
         outputs.add_text(p, format!("{json}\n"))?;
@@ -263,6 +215,86 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     Ok(())
 }
 
+/// `command.csv`: `time_s,command_m,desired_m,predicted_m`.
+pub(crate) fn add_command_csv<'a>(
+    outputs: &mut Outputs<'a>,
+    path: &Path,
+    time: &'a [f64],
+    command: &'a [f64],
+    desired: &'a [f64],
+    predicted: &'a [f64],
+) -> Result<()> {
+    outputs.add(path, move |w| {
+        writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
+        for k in 0..time.len() {
+            writeln!(
+                w,
+                "{},{},{},{}",
+                cell(Some(time[k])),
+                cell(Some(command[k])),
+                cell(Some(desired[k])),
+                cell(Some(predicted[k]))
+            )?;
+        }
+        Ok(())
+    })
+}
+
+/// `--verify-out`: `time_s,desired_m,position_uncompensated_m,position_compensated_m`.
+pub(crate) fn add_verification_csv<'a>(
+    outputs: &mut Outputs<'a>,
+    path: &Path,
+    time: &'a [f64],
+    desired: &'a [f64],
+    v: &'a Verification,
+) -> Result<()> {
+    outputs.add(path, move |w| {
+        writeln!(
+            w,
+            "time_s,desired_m,position_uncompensated_m,position_compensated_m"
+        )?;
+        for k in 0..time.len() {
+            writeln!(
+                w,
+                "{},{},{},{}",
+                cell(Some(time[k])),
+                cell(Some(desired[k])),
+                cell(Some(v.position_uncompensated[k])),
+                cell(Some(v.position_compensated[k]))
+            )?;
+        }
+        Ok(())
+    })
+}
+
+/// The summary's context: the files, samples, rate, limits and the
+/// verification with its seed.
+pub(crate) fn add_summary_context(
+    obj: &mut serde_json::Map<String, serde_json::Value>,
+    a: &CompensateArgs,
+    model: &str,
+    rec: &feedid::Recording,
+    verification: Option<&Verification>,
+) -> Result<()> {
+    obj.insert("desired".into(), a.desired.display().to_string().into());
+    obj.insert("model".into(), model.into());
+    obj.insert("samples".into(), rec.len().into());
+    obj.insert("rate_hz".into(), rec.rate_hz().into());
+    obj.insert("max_velocity_limit".into(), json_limit(a.max_velocity));
+    obj.insert(
+        "max_acceleration_limit".into(),
+        json_limit(a.max_acceleration),
+    );
+    if let Some(ver) = verification {
+        let mut vv = serde_json::to_value(ver)?;
+        if let Some(o) = vv.as_object_mut() {
+            o.insert("seed".into(), a.seed.into());
+        }
+        obj.insert("verification".into(), vv);
+    }
+    Ok(())
+}
+
 /// A length in µm, in scientific notation when below 1 nm.
 pub(crate) fn micrometres(m: f64) -> String {
     if m != 0.0 && m.abs() < 1e-9 {
@@ -273,7 +305,7 @@ pub(crate) fn micrometres(m: f64) -> String {
 }
 
 /// A limit for JSON (∞ as null).
-pub(crate) fn json_limit(v: f64) -> serde_json::Value {
+fn json_limit(v: f64) -> serde_json::Value {
     if v.is_finite() {
         v.into()
     } else {

@@ -9,10 +9,13 @@ use anyhow::{bail, Context, Result};
 use feedid::compensate::{
     learn, verify_on_rig, LearnConfig, LearnStatus, Learning, LearningHistory, NoiseFilter,
 };
-use feedid::io::{cell, read_recording, read_text_up_to, ChannelRef, ReadOptions};
+use feedid::io::{read_recording, read_text_up_to, ChannelRef, ReadOptions};
 use feedid::Recording;
 
-use super::compensate::{config, describe_verification, json_limit, micrometres, read_desired};
+use super::compensate::{
+    add_command_csv, add_summary_context, add_verification_csv, config, describe_verification,
+    micrometres, read_desired,
+};
 use crate::args::CompensateArgs;
 use crate::cmd::{check_distinct, Outputs};
 
@@ -105,54 +108,21 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     }
 
     let mut outputs = Outputs::default();
-    let command = step.command.clone();
-    let predicted = step.predicted.clone();
-    let time = rec.time().to_vec();
-    let desired_v = desired.to_vec();
-    outputs.add(&a.output, move |w| {
-        writeln!(w, "time_s,command_m,desired_m,predicted_m")?;
-        for k in 0..time.len() {
-            writeln!(
-                w,
-                "{},{},{},{}",
-                cell(Some(time[k])),
-                cell(Some(command[k])),
-                cell(Some(desired_v[k])),
-                cell(Some(predicted[k]))
-            )?;
-        }
-        Ok(())
-    })?;
+    add_command_csv(
+        &mut outputs,
+        &a.output,
+        rec.time(),
+        &step.command,
+        desired,
+        &step.predicted,
+    )?;
     if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
-        let time = rec.time().to_vec();
-        let desired_v = desired.to_vec();
-        let (pu, pc) = (
-            v.position_uncompensated.clone(),
-            v.position_compensated.clone(),
-        );
-        outputs.add(p, move |w| {
-            writeln!(
-                w,
-                "time_s,desired_m,position_uncompensated_m,position_compensated_m"
-            )?;
-            for k in 0..time.len() {
-                writeln!(
-                    w,
-                    "{},{},{},{}",
-                    cell(Some(time[k])),
-                    cell(Some(desired_v[k])),
-                    cell(Some(pu[k])),
-                    cell(Some(pc[k]))
-                )?;
-            }
-            Ok(())
-        })?;
+        add_verification_csv(&mut outputs, p, rec.time(), desired, v)?;
     }
     if let Some(p) = &a.summary {
         let mut v = serde_json::to_value(&step)?;
         if let Some(obj) = v.as_object_mut() {
-            obj.insert("desired".into(), a.desired.display().to_string().into());
-            obj.insert("model".into(), source.clone().into());
+            add_summary_context(obj, a, &source, &rec, verification.as_ref())?;
             obj.insert(
                 "measured_run".into(),
                 measured_path.display().to_string().into(),
@@ -166,20 +136,6 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
                     .to_string()
                     .into(),
             );
-            obj.insert("samples".into(), rec.len().into());
-            obj.insert("rate_hz".into(), rec.rate_hz().into());
-            obj.insert("max_velocity_limit".into(), json_limit(a.max_velocity));
-            obj.insert(
-                "max_acceleration_limit".into(),
-                json_limit(a.max_acceleration),
-            );
-            if let Some(ver) = &verification {
-                let mut vv = serde_json::to_value(ver)?;
-                if let Some(o) = vv.as_object_mut() {
-                    o.insert("seed".into(), a.seed.into());
-                }
-                obj.insert("verification".into(), vv);
-            }
         }
         outputs.add_text(p, format!("{}\n", serde_json::to_string_pretty(&v)?))?;
     }

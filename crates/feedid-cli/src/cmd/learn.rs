@@ -240,12 +240,19 @@ fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
         ),
     };
     let _ = writeln!(t, "  learning: {status}");
+    let share = if s.explained_share > 0.0 {
+        format!(
+            "explains {:.1} % of the run's error",
+            100.0 * s.explained_share
+        )
+    } else {
+        "explains none of the run's error (its own error on the run is larger)".to_string()
+    };
     let _ = writeln!(
         t,
-        "  model: explains {:.1} % of the run's error{}",
-        100.0 * s.explained_share,
+        "  model: {share}{}",
         if s.gain > 0.0 && s.explained_share < 1.0 && s.response_ratio.is_none() {
-            " (the step's gain is scaled by it, at least ½)"
+            "; the step's gain is scaled by it (at least ½)"
         } else {
             ""
         }

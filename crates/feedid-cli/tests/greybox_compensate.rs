@@ -707,3 +707,52 @@ fn compensate_succeeds_on_segments_moving_at_their_end_or_from_their_first_sampl
         ],
     );
 }
+
+#[test]
+fn a_fall_back_to_a_plain_command_over_a_limit_says_so_with_its_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let prbs = simulate(
+        dir.path(),
+        "prbs.csv",
+        &["--scenario", "prbs", "--seed", "2"],
+    );
+    let model = dir.path().join("m.json");
+    run_ok(&[
+        "identify",
+        p(&prbs),
+        "-o",
+        p(&dir.path().join("pred.csv")),
+        "--model-out",
+        p(&model),
+    ]);
+    // the paper's ramp: a velocity step of 50 mm/s in one sample, 250 m/s²
+    let ramp = simulate(dir.path(), "ramp.csv", &["--scenario", "ramp", "--linear"]);
+    let out = dir.path().join("cmd.csv");
+    let o = feedid(&[
+        "compensate",
+        "--desired",
+        p(&ramp),
+        "--desired-column",
+        "command_m",
+        "--model",
+        p(&model),
+        "--min-fit",
+        "100",
+        "-o",
+        p(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("below 100 %"), "{err}");
+    assert!(
+        err.contains("peaks at 250.0000 m/s²") && err.contains("above --max-acceleration 30"),
+        "{err}"
+    );
+    // no compensated figures for a command that is not sent
+    let text = stdout(&o);
+    assert!(!text.contains("compensated rms"), "{text}");
+    assert!(
+        text.contains("command sent: the plain desired trajectory"),
+        "{text}"
+    );
+}

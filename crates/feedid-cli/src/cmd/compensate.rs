@@ -198,6 +198,29 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             "warning: the plain desired trajectory is sent as the command: {f}; {}",
             fallback_hint(f, a, &comp, desired)
         );
+        // the plain trajectory is sent as it is: say where it exceeds a limit
+        for (quantity, peak, at, limit, unit) in [
+            (
+                "velocity",
+                comp.peak_velocity,
+                comp.peak_velocity_time_s,
+                a.max_velocity,
+                "m/s",
+            ),
+            (
+                "acceleration",
+                comp.peak_acceleration,
+                comp.peak_acceleration_time_s,
+                a.max_acceleration,
+                "m/s²",
+            ),
+        ] {
+            if peak > limit * (1.0 + 1e-9) {
+                eprintln!(
+                    "warning: the command sent, the desired trajectory itself, peaks at {peak:.4} {unit} at t = {at:.4} s, above --max-{quantity} {limit} {unit}: the limit is the trajectory's to meet (slow or smooth it)"
+                );
+            }
+        }
     }
     if !comp.exact_inverse {
         eprintln!(

@@ -26,9 +26,12 @@ pub struct CommandPeaks {
 }
 
 impl CommandPeaks {
-    /// The peaks of `u` at interval `dt` \[s\].
+    /// The peaks of `u` at interval `dt` \[s\] (all 0 for no samples).
     pub fn of(u: &[f64], dt: f64, start: StartMode) -> Self {
         let n = u.len();
+        if n == 0 {
+            return Self::default();
+        }
         let before = match start {
             StartMode::Rest => u[0],
             StartMode::Moving if n > 1 => 2.0 * u[0] - u[1],
@@ -228,6 +231,9 @@ fn held_back(
 /// where those exceed them).
 fn violations(u: &[f64], dt: f64, comp: &CompensateConfig, base: &CommandPeaks) -> Vec<usize> {
     let n = u.len();
+    if n == 0 {
+        return Vec::new();
+    }
     let before = match comp.start {
         StartMode::Rest => u[0],
         StartMode::Moving if n > 1 => 2.0 * u[0] - u[1],

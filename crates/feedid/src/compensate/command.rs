@@ -310,17 +310,17 @@ fn peaks(u: &[f64], dt: f64) -> ((f64, usize), (f64, usize)) {
 
 /// Peaks of a command sent from extended index `from` on.
 #[derive(Debug, Clone, Copy, Default)]
-struct Peaks {
-    velocity: f64,
-    velocity_at: usize,
-    acceleration: f64,
-    acceleration_at: usize,
+pub(super) struct Peaks {
+    pub(super) velocity: f64,
+    pub(super) velocity_at: usize,
+    pub(super) acceleration: f64,
+    pub(super) acceleration_at: usize,
 }
 
 impl Peaks {
     /// Velocities `(s[i] − s[i−1])/dt` for `i ≥ from` and accelerations at
     /// `i ≥ from − 1` (the step from the rest before the first sample counts).
-    fn of(s: &[f64], from: usize, dt: f64) -> Self {
+    pub(super) fn of(s: &[f64], from: usize, dt: f64) -> Self {
         let mut p = Peaks::default();
         for i in from.max(1)..s.len() {
             let v = ((s[i] - s[i - 1]) / dt).abs();

@@ -124,7 +124,7 @@ use super::step::{increment, CommandPeaks};
 use crate::error::{Error, Result};
 use crate::ident::LinearModel;
 use crate::lti::DiscreteStateSpace;
-use crate::stats::{median, noise_level_of_run, ErrorStats};
+use crate::stats::{error_fit_percent, median, noise_level_of_run, ErrorStats};
 
 /// How the measured error is filtered before it is learned.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -295,19 +295,10 @@ const AT_NOISE: f64 = 1.25;
 /// `1 − ‖y − ŷ‖ / ‖e − ē‖` with the run's position `y = y_d − e` and the
 /// model's `ŷ` for its command (`−∞…1`; 1 when there is no error).
 fn explained_share(desired: &[f64], error: &[f64], model: &[f64]) -> f64 {
-    let n = error.len() as f64;
-    let mean = error.iter().sum::<f64>() / n;
-    let (mut sr, mut se) = (0.0, 0.0);
-    for k in 0..error.len() {
-        let y = desired[k] - error[k];
-        sr += (y - model[k]).powi(2);
-        se += (error[k] - mean).powi(2);
-    }
-    if se > 0.0 {
-        1.0 - (sr / se).sqrt()
-    } else {
-        1.0
-    }
+    let residual: Vec<f64> = (0..error.len())
+        .map(|k| desired[k] - error[k] - model[k])
+        .collect();
+    error_fit_percent(&residual, error, 0.0).map_or(1.0, |f| f / 100.0)
 }
 
 /// A response ratio at or below this is no answer to scale a step by (the
@@ -766,6 +757,26 @@ mod tests {
             .collect()
     }
 
+    /// `model` with its gain times `k` (a wrong model).
+    fn scaled(model: &LinearModel, k: f64) -> LinearModel {
+        let LinearModel::Discrete { b, a, dt } = model.clone() else {
+            unreachable!()
+        };
+        LinearModel::discrete(b.iter().map(|v| k * v).collect(), a, dt).unwrap()
+    }
+
+    /// [`LearnConfig::exact`] with the model's gain as it is (not rescaled
+    /// to unit DC gain, so that a wrong gain stays wrong).
+    fn exact_keeping_gain() -> LearnConfig {
+        LearnConfig {
+            compensate: CompensateConfig {
+                unit_dc_gain: false,
+                ..LearnConfig::exact().compensate
+            },
+            ..LearnConfig::exact()
+        }
+    }
+
     fn rms(v: &[f64]) -> f64 {
         (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
     }
@@ -834,17 +845,8 @@ mod tests {
         // with half the predicted change (ρ = ½), so the second step is
         // doubled and removes the rest
         let a = axis();
-        let LinearModel::Discrete { b, a: den, dt } = a.clone() else {
-            unreachable!()
-        };
-        let double = LinearModel::discrete(b.iter().map(|v| 2.0 * v).collect(), den, dt).unwrap();
-        let cfg = LearnConfig {
-            compensate: CompensateConfig {
-                unit_dc_gain: false,
-                ..LearnConfig::exact().compensate
-            },
-            ..LearnConfig::exact()
-        };
+        let double = scaled(&a, 2.0);
+        let cfg = exact_keeping_gain();
         let (_, truth, _) = runs(&a, &double, &cfg, 0.0, 4);
         let r = truth[1] / truth[0];
         assert!((r - 0.5).abs() < 1e-9, "ratio {r}");
@@ -870,17 +872,10 @@ mod tests {
         // P = 2G: with α = 1 the error flips sign and keeps its size
         // (1 − 2 = −1); the check halves the gain (1 − 2·½ = 0)
         let a = axis();
-        let LinearModel::Discrete { b, a: den, dt } = a.clone() else {
-            unreachable!()
-        };
-        let half = LinearModel::discrete(b.iter().map(|v| 0.5 * v).collect(), den, dt).unwrap();
+        let half = scaled(&a, 0.5);
         let cfg = LearnConfig {
-            compensate: CompensateConfig {
-                unit_dc_gain: false,
-                ..LearnConfig::exact().compensate
-            },
             growth_tolerance: 0.0,
-            ..LearnConfig::exact()
+            ..exact_keeping_gain()
         };
         let (measured, truth, status) = runs(&a, &half, &cfg, 0.0, 6);
         assert!(
@@ -905,17 +900,8 @@ mod tests {
     fn a_model_that_cannot_learn_stops_and_sends_the_best_command_again() {
         // the model's sign is wrong: every step makes it worse
         let a = axis();
-        let LinearModel::Discrete { b, a: den, dt } = a.clone() else {
-            unreachable!()
-        };
-        let wrong = LinearModel::discrete(b.iter().map(|v| -v).collect(), den, dt).unwrap();
-        let cfg = LearnConfig {
-            compensate: CompensateConfig {
-                unit_dc_gain: false,
-                ..LearnConfig::exact().compensate
-            },
-            ..LearnConfig::exact()
-        };
+        let wrong = scaled(&a, -1.0);
+        let cfg = exact_keeping_gain();
         let desired = program();
         let mut command = desired.clone();
         let mut history = None;

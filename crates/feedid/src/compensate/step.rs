@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use super::command::{compensate_model, levels, CompensateConfig, Smoothing, StartMode};
+use super::command::{compensate_model, levels, CompensateConfig, Peaks, Smoothing, StartMode};
 use super::learn::LearnConfig;
 use super::smoothing::smooth_step;
 use crate::error::Result;
@@ -37,23 +37,17 @@ impl CommandPeaks {
             StartMode::Moving if n > 1 => 2.0 * u[0] - u[1],
             StartMode::Moving => u[0],
         };
-        let at = |k: isize| if k < 0 { before } else { u[k as usize] };
-        let mut p = CommandPeaks::default();
-        for k in 0..n as isize {
-            let v = ((at(k) - at(k - 1)) / dt).abs();
-            if v > p.velocity {
-                p.velocity = v;
-                p.velocity_time_s = k as f64 * dt;
-            }
-            if (k as usize) + 1 < n {
-                let a = ((at(k + 1) - 2.0 * at(k) + at(k - 1)) / (dt * dt)).abs();
-                if a > p.acceleration {
-                    p.acceleration = a;
-                    p.acceleration_time_s = k as f64 * dt;
-                }
-            }
+        // the command from the sample before the first (index 0 of `ext`)
+        let mut ext = Vec::with_capacity(n + 1);
+        ext.push(before);
+        ext.extend_from_slice(u);
+        let p = Peaks::of(&ext, 1, dt);
+        CommandPeaks {
+            velocity: p.velocity,
+            velocity_time_s: p.velocity_at.saturating_sub(1) as f64 * dt,
+            acceleration: p.acceleration,
+            acceleration_time_s: p.acceleration_at.saturating_sub(1) as f64 * dt,
         }
-        p
     }
 }
 

@@ -382,11 +382,19 @@ fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checked: bool) {
             );
             let _ = writeln!(
                 t,
-                "  command sent: compensated; smoothing σ up to {:.3} ms on {:.1} % of the samples{}; peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
+                "  command sent: compensated; smoothing σ up to {:.3} ms on {:.1} % of the samples{}{}; peak velocity {:.4} m/s at t = {:.4} s, peak acceleration {:.3} m/s² at t = {:.4} s",
                 1e3 * c.smoothing_s,
                 100.0 * c.smoothed_share,
                 if c.start_ease_s > 0.0 {
                     format!(", start eased in (mean lag {:.3} ms)", 1e3 * c.start_ease_s)
+                } else {
+                    String::new()
+                },
+                if c.held_back_share > 0.0 {
+                    format!(
+                        "; the correction held back on {:.1} % of the samples, where no smoothing up to --max-smoothing meets the limits",
+                        100.0 * c.held_back_share
+                    )
                 } else {
                     String::new()
                 },

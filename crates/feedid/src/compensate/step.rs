@@ -162,7 +162,7 @@ pub(super) struct Step {
 /// `base + g·(1 − W)·delta` within the limits (or no worse than `base`),
 /// with `W` as small as the rounds allow, and the share held back; `None`
 /// when even the widest hold does not meet them.
-fn held_back(
+pub(super) fn held_back(
     base: &[f64],
     delta: &[f64],
     g: f64,

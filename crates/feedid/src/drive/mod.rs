@@ -18,6 +18,8 @@ pub use params::{
     equivalent_stiffness, screw_inertia, screw_stiffness, total_inertia, Control, Damping,
     Geometry, Inertia, Material, Motor, RigParams, Stiffness, Table,
 };
-pub use rig::{Friction, PositionLoop, RigEffects, RigOutput, VirtualRig, DEFAULT_MAX_STEP};
+pub use rig::{
+    Friction, PositionLoop, RigEffects, RigOutput, RigStepper, VirtualRig, DEFAULT_MAX_STEP,
+};
 pub use stability::{check_model, require_stable, ModelCheck};
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

@@ -145,9 +145,6 @@
 //! assert!((out.command[k] - out.true_position[k] - 71.4e-6).abs() < 5e-6);
 //! ```
 
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
 use super::params::RigParams;
@@ -504,118 +501,31 @@ impl VirtualRig {
                 value,
             });
         }
-        self.params.validate()?;
-        self.effects.validate()?;
-
-        let fx = &self.effects;
-        let plant = Plant::new(&self.params, fx);
         let n = command.len();
         out.resize(n);
         let dt = 1.0 / rate_hz;
-        let sub = self.substeps(rate_hz);
-        let h = dt / sub as f64;
-        let kv = self.params.control.kv;
-        let quantise = |x: f64| {
-            if fx.quantisation {
-                (x / fx.resolution).round() * fx.resolution
-            } else {
-                x
-            }
-        };
-        let noise = Normal::new(0.0, fx.noise_std).map_err(|_| Error::InvalidParameter {
-            name: "noise_std",
-            value: fx.noise_std,
-            reason: "must be finite and >= 0",
-        })?;
-        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
-        // the command the loop acts on: delayed by the dead time, constant
-        // before the first sample (so there is no feed-forward kick at k = 0)
-        let delay = fx.dead_time;
-        let loop_command = |k: usize| command[k.saturating_sub(delay).min(n - 1)];
-        let ff = plant.feed_forward;
-
-        let mut x = [0.0f64; 7];
+        let mut stepper = self.stepper(rate_hz, command[0])?;
         let every = (n / 500).max(1);
         for (k, &xs) in command.iter().enumerate() {
             if let Some(p) = progress.filter(|_| k % every == 0) {
                 p(k as u64, n as u64);
             }
-            if x.iter().any(|v| !v.is_finite()) {
-                return Err(Error::InvalidModel {
-                    reason: "virtual rig simulation diverged (non-finite state)",
-                });
+            if k > 0 {
+                stepper.advance(xs)?;
             }
-            let measured = quantise(x[5]);
             out.time[k] = k as f64 * dt;
             out.command[k] = xs;
-            out.true_position[k] = x[5];
-            out.motor_current[k] = x[2];
-            out.velocity[k] = x[6];
-            out.position[k] = if fx.noise {
-                measured + noise.sample(&mut rng)
-            } else {
-                measured
-            };
-            if k + 1 == n {
-                break;
-            }
-            let xl = loop_command(k);
-            let next = loop_command(k + 1);
-            let input = match fx.position_loop {
-                PositionLoop::Sampled if ff.active => {
-                    // the set-point generator's velocity over the coming interval
-                    // and the change of velocity from the previous one, held
-                    let prev = loop_command(k.saturating_sub(1));
-                    let v = (next - xl) * rate_hz;
-                    let a = (next - 2.0 * xl + prev) * rate_hz * rate_hz;
-                    Input::Held {
-                        vc: kv * (xl - measured) + ff.kvff * v,
-                        iff: ff.current_gain * a,
-                    }
-                }
-                PositionLoop::Sampled => Input::Held {
-                    vc: kv * (xl - measured),
-                    iff: 0.0,
-                },
-                PositionLoop::Continuous => {
-                    if ff.active {
-                        // ẋ_s, ẍ_s of the held command are impulses at t_k:
-                        // the exact state jump (A·b₂ + b₁)·Δx_s
-                        let prev = loop_command(k.saturating_sub(1));
-                        ff.jump(&mut x, &ff.ramp_jump, xl - prev);
-                    }
-                    Input::Command {
-                        start: xl,
-                        slope: 0.0,
-                        vff: 0.0,
-                    }
-                }
-                PositionLoop::Interpolated => {
-                    let slope = (next - xl) * rate_hz;
-                    if ff.active {
-                        // ẍ_s of the interpolated command is an impulse at t_k:
-                        // the exact state jump b₂·Δẋ_s
-                        let prev = loop_command(k.saturating_sub(1));
-                        let prev_slope = (xl - prev) * rate_hz;
-                        ff.jump(&mut x, &ff.slope_jump, slope - prev_slope);
-                    }
-                    Input::Command {
-                        start: xl,
-                        slope,
-                        vff: ff.kvff * slope,
-                    }
-                }
-            };
-            for j in 0..sub {
-                plant.rk4(&mut x, input, j as f64 * h, h);
-            }
+            out.true_position[k] = stepper.true_position();
+            out.motor_current[k] = stepper.motor_current();
+            out.velocity[k] = stepper.velocity();
+            out.position[k] = stepper.position();
         }
         Ok(())
     }
 }
 
 /// Feed-forward of the rig: gains and the state jumps of the continuous modes.
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 struct FeedForward {
     /// Any feed-forward gain non-zero.
     active: bool,
@@ -697,6 +607,7 @@ enum Input {
 }
 
 /// Constants of the right-hand side, precomputed once per simulation.
+#[derive(Debug, Clone)]
 struct Plant {
     r: f64,
     kv: f64,
@@ -884,6 +795,10 @@ fn non_negative(name: &'static str, value: f64) -> Result<()> {
     }
     Ok(())
 }
+
+mod stepper;
+
+pub use stepper::RigStepper;
 
 #[cfg(test)]
 mod extension_tests;

@@ -62,7 +62,7 @@ pub use family::{
     STANDARD_REGULAR, ZOO_SEED,
 };
 pub use member::ZooMember;
-pub use plant::PlantRun;
+pub use plant::{PlantRun, PlantStepper};
 pub use spec::{
     AxisClass, CommandSpec, Glitch, MemberSpec, PlantKind, RigSetup, ServoSetup, Stability,
 };

@@ -16,12 +16,17 @@
 //! * [`learn`]: iterative learning control from measured runs of a repeated
 //!   program, the model as learning filter, convergence checked run by run.
 //! * [`verify_on_rig`]: tracking error on the virtual rig before and after.
+//! * [`OnlineCompensator`]: online compensation, each command corrected
+//!   from a model identified while the axis runs, before the drive needs
+//!   it; [`co_simulate`]: the axis stepped with the compensator in the loop.
 
 mod benefit;
 mod command;
+mod cosim;
 mod history;
 mod inverse;
 mod learn;
+mod online;
 mod smoothing;
 mod step;
 mod verify;
@@ -31,11 +36,13 @@ pub use command::{
     compensate, compensate_model, compensate_params, CompensateConfig, Compensation, Smoothing,
     StartMode,
 };
+pub use cosim::{co_simulate, CoSimulation, PassError, SteppedAxis};
 pub use history::{
     BestRun, LearnStatus, LearningHistory, LearningRun, HISTORY_FORMAT, HISTORY_VERSION,
 };
 pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
 pub use learn::{learn, LearnConfig, Learning, NoiseFilter};
+pub use online::{OnlineCompensator, OnlineConfig, OnlineState, OnlineStats, MAX_PREVIEW};
 pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, smooth_step, taper_profile};
 pub use step::CommandPeaks;
 pub use verify::{verify_on_rig, TrackingError, Verification};

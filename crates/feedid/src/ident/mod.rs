@@ -33,6 +33,7 @@ pub use methods::{
     PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig, RlsEstimator, SimplexSettings,
     SimplexStart, Solver, TimeOrigin, MAX_ARX_ORDER, SHIFT_AMPLIFICATION_WARNING,
 };
+pub(crate) use methods::{fold_scale, has_avx2, rls_update};
 pub use model::{
     fit_global_model, simulation_error, GlobalModelKind, LinearModel, ModelFile, ModelProvenance,
     GLOBAL_FIT_SAMPLES,

@@ -333,8 +333,8 @@ mod tests {
             let run = spec.run_plant(&cmd, 7).unwrap();
             let mut axis = spec.stepper(cmd[0], 7).unwrap();
             assert_eq!(axis.position(), run.position[0], "member {i}");
-            for k in 1..cmd.len() {
-                let y = axis.advance(cmd[k]).unwrap();
+            for (k, &c) in cmd.iter().enumerate().skip(1) {
+                let y = axis.advance(c).unwrap();
                 assert_eq!(y, run.position[k], "member {i} sample {k}");
                 assert_eq!(axis.true_position(), run.truth[k], "member {i} sample {k}");
             }

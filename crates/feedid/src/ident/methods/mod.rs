@@ -20,4 +20,5 @@ pub use paper::{
 };
 pub(crate) use regressor::regressor;
 pub use regressor::{ArxOrders, MAX_ARX_ORDER};
+pub(crate) use rls::{fold_scale, has_avx2, rls_update};
 pub use rls::{RlsConfig, RlsEstimator};

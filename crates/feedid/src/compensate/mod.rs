@@ -18,7 +18,9 @@
 //! * [`verify_on_rig`]: tracking error on the virtual rig before and after.
 //! * [`OnlineCompensator`]: online compensation, each command corrected
 //!   from a model identified while the axis runs, before the drive needs
-//!   it; [`co_simulate`]: the axis stepped with the compensator in the loop.
+//!   it; [`CommandStream`]: the same fed line by line with a command lead
+//!   (`feedid stream --compensate`); [`co_simulate`]: the axis stepped with
+//!   the compensator in the loop.
 
 mod benefit;
 mod command;
@@ -27,6 +29,7 @@ mod history;
 mod inverse;
 mod learn;
 mod online;
+mod online_stream;
 mod smoothing;
 mod step;
 mod verify;
@@ -43,6 +46,7 @@ pub use history::{
 pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
 pub use learn::{learn, LearnConfig, Learning, NoiseFilter};
 pub use online::{OnlineCompensator, OnlineConfig, OnlineState, OnlineStats, MAX_PREVIEW};
+pub use online_stream::{CommandRow, CommandStream};
 pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, smooth_step, taper_profile};
 pub use step::CommandPeaks;
 pub use verify::{verify_on_rig, TrackingError, Verification};

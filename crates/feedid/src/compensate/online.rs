@@ -259,9 +259,10 @@ pub struct OnlineStats {
 pub struct OnlineCompensator {
     cfg: OnlineConfig,
     dt: f64,
-    /// Desired, sent and measured by absolute sample (rings).
+    /// Desired, issued, received (sent) and measured by absolute sample (rings).
     r: Vec<f64>,
     u: Vec<f64>,
+    s: Vec<f64>,
     y: Vec<f64>,
     /// Desired samples pushed; whether the trajectory has ended.
     nr: usize,
@@ -324,6 +325,7 @@ impl OnlineCompensator {
             dt,
             r: vec![0.0; RING],
             u: vec![0.0; RING],
+            s: vec![0.0; RING],
             y: vec![0.0; RING],
             nr: 0,
             finished: false,
@@ -367,6 +369,7 @@ impl OnlineCompensator {
         self.nu = 0;
         self.r.fill(0.0);
         self.u.fill(0.0);
+        self.s.fill(0.0);
         self.y.fill(0.0);
         self.reset_model();
         self.scale = 0.0;
@@ -498,6 +501,7 @@ impl OnlineCompensator {
         }
         let r0 = self.r[0];
         self.u[0] = r0;
+        self.s[0] = r0;
         self.nu = 1;
         self.stats.commands = 1;
         Ok(r0)
@@ -515,15 +519,39 @@ impl OnlineCompensator {
         }
     }
 
-    /// Command sent at absolute sample `i` (rest at the first before 0).
-    fn sent(&self, i: isize) -> f64 {
+    /// Command issued for absolute sample `i` (rest at the first before 0).
+    fn issued(&self, i: isize) -> f64 {
         self.u[i.max(0) as usize & MASK]
+    }
+
+    /// Command the axis received at absolute sample `i` (rest at the first
+    /// before 0): the one issued, or the one [`OnlineCompensator::step_sent`]
+    /// was told.
+    fn sent(&self, i: isize) -> f64 {
+        self.s[i.max(0) as usize & MASK]
     }
 
     /// Measure `y[k]` (the position at the sample of the last command) and
     /// get the command of sample `k + 1` \[m\].
     pub fn step(&mut self, measured: f64) -> Result<f64> {
         let k = self.ny;
+        let sent = self.u[k & MASK];
+        self.step_sent(measured, sent)
+    }
+
+    /// As [`OnlineCompensator::step`] when the axis received another
+    /// command than the one issued for sample `k` (a recorded run replayed:
+    /// its own command): the model learns from what the axis received; the
+    /// commands issued stay within the limits from the ones issued before.
+    pub fn step_sent(&mut self, measured: f64, sent: f64) -> Result<f64> {
+        let k = self.ny;
+        if !sent.is_finite() {
+            return Err(Error::NonFinite {
+                channel: "command sent".to_string(),
+                index: k,
+                value: sent,
+            });
+        }
         if !measured.is_finite() {
             return Err(Error::NonFinite {
                 channel: "position".to_string(),
@@ -548,6 +576,7 @@ impl OnlineCompensator {
             });
         }
         self.y[k & MASK] = measured;
+        self.s[k & MASK] = sent;
         self.ny = k + 1;
         self.learn(k);
         self.judge();
@@ -591,7 +620,7 @@ impl OnlineCompensator {
         if k < 4 {
             return;
         }
-        let moved = self.u[k & MASK] != self.u[(k - 1) & MASK];
+        let moved = self.s[k & MASK] != self.s[(k - 1) & MASK];
         self.still = if moved {
             0
         } else {
@@ -604,7 +633,7 @@ impl OnlineCompensator {
         }
         let m = k as isize - 2;
         let du = self.derivatives(|i| self.sent(i), m);
-        let e = self.u[m as usize & MASK] - self.y[m as usize & MASK];
+        let e = self.s[m as usize & MASK] - self.y[m as usize & MASK];
         if self.scale == 0.0 {
             // the time scale of the derivatives: the lag on the first moves
             if du[0] != 0.0 {
@@ -661,7 +690,10 @@ impl OnlineCompensator {
             self.reset_model();
             return;
         }
-        if counted && self.weight >= 0.5 {
+        // (only where the axis received the commands issued: a replayed
+        // run's positions answer its own command)
+        let received = self.s[m as usize & MASK] == self.u[m as usize & MASK];
+        if counted && received && self.weight >= 0.5 {
             // what the compensation achieves against what the model says
             // the plain command would have left, same samples, same scale
             let [a1, a2, a3] = self.following_error_model();
@@ -744,7 +776,7 @@ impl OnlineCompensator {
     fn limited(&mut self, j: usize, r: f64, target: f64) -> f64 {
         let dt = self.dt;
         let j = j as isize;
-        let (u1, u2) = (self.sent(j - 1), self.sent(j - 2));
+        let (u1, u2) = (self.issued(j - 1), self.issued(j - 2));
         let (r1, r2) = (self.desired(j - 1), self.desired(j - 2));
         let (d1, d2) = (u1 - r1, u2 - r2);
         let vr = r - r1;

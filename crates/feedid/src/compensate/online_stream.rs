@@ -229,8 +229,8 @@ mod tests {
         // the same commands as the co-simulation, sample for sample
         let m = commands.len().min(sim.command.len());
         assert!(m > n - 2 * lead, "{m}");
-        for k in 0..m {
-            assert_eq!(commands[k], sim.command[k], "sample {k}");
+        for (k, (a, b)) in commands.iter().zip(&sim.command).enumerate() {
+            assert_eq!(a, b, "sample {k}");
         }
     }
 

@@ -36,6 +36,7 @@ __all__ = [
     "Recording",
     "Identification",
     "Streamer",
+    "OnlineCompensator",
     "read",
     "identify",
     "simulate",
@@ -519,6 +520,73 @@ class Streamer:
     def dt(self) -> Optional[float]:
         """The sampling interval in use [s] (None before two samples)."""
         return self._s.dt
+
+
+class OnlineCompensator:
+    """Online compensation: push one line ``(t, u, y)`` at a time and get
+    the corrected command of the coming sample before the drive needs it
+    (``feedid stream --compensate`` as a library call).
+
+    The model is the axis's following error as velocity and acceleration
+    feed-forward time constants, identified while it runs (recursive least
+    squares with forgetting); the command is the desired position plus
+    their correction, switched off (the plain command) while the model is
+    implausible, within the velocity and acceleration limits.
+
+    Parameters
+    ----------
+    rate : float
+        Sampling rate [Hz].
+    command_lead : int
+        Online: the command on each pushed line is the desired position of
+        the sample this many lines later (at least 3).
+    replay : bool
+        The lines are a recorded run (command and position of the same
+        sample; the positions answer the recording's own command): the
+        commands returned are what the compensation would have sent.
+        Default False (online: the positions answer the commands returned).
+    max_velocity, max_acceleration : float
+        Command limits [m/s], [m/s²]; defaults 1.0 and 30.0.
+
+    ``push`` returns ``None`` or ``(time [s], desired [m], command [m])``
+    of the sample the command is for; ``push_many`` a list of them.
+    """
+
+    def __init__(
+        self,
+        rate: float,
+        command_lead: int,
+        *,
+        replay: bool = False,
+        max_velocity: float = 1.0,
+        max_acceleration: float = 30.0,
+    ):
+        self._c = _feedid.OnlineCompensator(
+            rate=float(rate),
+            command_lead=int(command_lead),
+            replay=bool(replay),
+            max_velocity=float(max_velocity),
+            max_acceleration=float(max_acceleration),
+        )
+
+    def push(self, t: float, u: float, y: float) -> Optional[Tuple[float, float, float]]:
+        """Push one line: time ``t`` [s], command ``u`` [m], measured
+        position ``y`` [m]; returns the command due next, if any."""
+        return self._c.push(float(t), float(u), float(y))
+
+    def push_many(self, t: Any, u: Any, y: Any) -> List[Tuple[float, float, float]]:
+        """Push many lines at once (equal-length arrays; GIL released);
+        returns the commands that became due, in order."""
+        return self._c.push_many(_array(t, "t"), _array(u, "u"), _array(y, "y"))
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        """Counters (commands, compensated, limited, model_updates,
+        implausible, withheld, segments), the guard's ``state``
+        (``learning``, ``unexplained``, ``invalid``, ``worse``, ``active``),
+        ``time_constants`` [T1 s, T2 s², T3 s³] in use, the identified
+        ``following_error_model`` and the correction's ``weight``."""
+        return self._c.stats
 
 
 def simulate(

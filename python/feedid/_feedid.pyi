@@ -50,6 +50,26 @@ class Recording:
     def __getattr__(self, name: str) -> npt.NDArray[np.float64]: ...
     def __len__(self) -> int: ...
 
+class OnlineCompensator:
+    def __init__(
+        self,
+        *,
+        rate: float,
+        command_lead: int,
+        replay: bool = False,
+        max_velocity: float = 1.0,
+        max_acceleration: float = 30.0,
+    ) -> None: ...
+    def push(self, t: float, u: float, y: float) -> Optional[Tuple[float, float, float]]: ...
+    def push_many(
+        self,
+        t: npt.NDArray[np.float64],
+        u: npt.NDArray[np.float64],
+        y: npt.NDArray[np.float64],
+    ) -> List[Tuple[float, float, float]]: ...
+    @property
+    def stats(self) -> Dict[str, Any]: ...
+
 class Streamer:
     def __init__(
         self,

@@ -10,6 +10,7 @@ mod errors;
 mod identify;
 mod learn;
 mod method;
+mod online;
 mod params;
 mod recording;
 mod rig;
@@ -22,6 +23,7 @@ use pyo3::prelude::*;
 fn _feedid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<recording::PyRecording>()?;
     m.add_class::<stream::PyStreamer>()?;
+    m.add_class::<online::PyOnlineCompensator>()?;
     m.add_function(wrap_pyfunction!(recording::read, m)?)?;
     m.add_function(wrap_pyfunction!(identify::identify, m)?)?;
     m.add_function(wrap_pyfunction!(rig::simulate, m)?)?;

@@ -207,3 +207,37 @@ def test_learning_from_runs_equals_the_cli_step_by_step(cli, tmp_path):
         feedid.learn(t, desired, model, np.asarray(rec.position))
     with pytest.raises(feedid.InputError, match="learning gain"):
         feedid.learn(t, desired, model, rec, gain=3.0)
+
+
+def test_online_compensation_equals_the_cli_stream_line_by_line(cli, tmp_path):
+    rec_path = tmp_path / "sc.csv"
+    cli("simulate", "--scenario", "scurve", "-o", rec_path)
+    rec = feedid.read(rec_path)
+    t, u, y = (np.asarray(rec.time), np.asarray(rec.command), np.asarray(rec.position))
+    import subprocess
+
+    # what `feedid simulate` writes streams with no reading options
+    r = subprocess.run([cli.exe, "stream", "--compensate", "--replay", "--command-lead", "4"],
+                       input=rec_path.read_text(), capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.strip().splitlines()
+    assert lines[0] == "time_s,desired_m,command_m"
+    cli_rows = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    comp = feedid.OnlineCompensator(rate=5000.0, command_lead=4, replay=True)
+    rows = [row for k in range(len(t)) if (row := comp.push(t[k], u[k], y[k])) is not None]
+    py_rows = np.array(rows)
+    assert py_rows.shape == cli_rows.shape
+    scale = float(np.ptp(u))
+    assert np.max(np.abs(py_rows[:, 1:] - cli_rows[:, 1:])) <= 1e-12 * scale
+    assert np.max(np.abs(py_rows[:, 0] - cli_rows[:, 0])) <= 1e-9
+    stats = comp.stats
+    assert stats["state"] == "active"
+    assert stats["compensated"] > 0.5 * stats["commands"]
+    assert 0.5e-3 < stats["time_constants"][0] < 5e-3
+    # many lines at once: the same commands
+    many = feedid.OnlineCompensator(5000.0, 4, replay=True).push_many(t, u, y)
+    assert np.array_equal(np.array(many), py_rows)
+    with pytest.raises(feedid.InputError, match="at least 3 samples ahead"):
+        feedid.OnlineCompensator(5000.0, 2)
+    with pytest.raises(feedid.InputError, match="different lengths"):
+        comp.push_many(t, u[:-1], y)

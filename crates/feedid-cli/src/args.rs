@@ -371,6 +371,29 @@ pub struct StreamArgs {
     /// [default: acceleration].
     #[arg(long, value_name = "HOW")]
     pub extrapolate: Option<String>,
+    /// Online compensation instead of predictions: each line's command is
+    /// the desired program, --command-lead N ≥ 3 lines ahead; for each
+    /// coming sample the corrected command is written (time_s, desired_m,
+    /// command_m) as soon as the line before it is read, from feed-forward
+    /// time constants identified while the axis runs (the method and window
+    /// options do not apply).
+    #[arg(long)]
+    pub compensate: bool,
+    /// With --compensate: the positions answer the input's own command
+    /// column (a recorded run replayed), not the commands written.
+    #[arg(long, requires = "compensate")]
+    pub replay: bool,
+    /// With --compensate: command velocity limit [m/s] (inf: none).
+    #[arg(long, value_name = "V", default_value_t = 1.0, requires = "compensate")]
+    pub max_velocity: f64,
+    /// With --compensate: command acceleration limit [m/s²] (inf: none).
+    #[arg(
+        long,
+        value_name = "A",
+        default_value_t = 30.0,
+        requires = "compensate"
+    )]
+    pub max_acceleration: f64,
 }
 
 /// `feedid report`.

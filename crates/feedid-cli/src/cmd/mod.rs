@@ -11,6 +11,7 @@ mod reproduce;
 mod simulate;
 
 mod stream;
+mod stream_compensate;
 
 mod compensate;
 mod greybox;

@@ -31,7 +31,7 @@ use crate::cmd::method::OrderOption;
 use crate::cmd::recording::read_options;
 
 /// Messages of one kind printed at most (the summary counts them all).
-const MAX_MESSAGES: usize = 100;
+pub(super) const MAX_MESSAGES: usize = 100;
 
 /// Run on the process's standard streams.
 pub fn run(a: &StreamArgs) -> Result<()> {
@@ -110,7 +110,7 @@ struct Lines {
 }
 
 /// Why writing stopped.
-enum Output {
+pub(super) enum Output {
     Open,
     /// The reader closed the pipe: stop quietly.
     Closed,
@@ -122,7 +122,7 @@ fn write<W: Write>(rows: &mut PredictionRows<W>, p: &Prediction<'_>) -> Result<O
 }
 
 /// A closed pipe ends the stream quietly, other write failures are errors.
-fn check(r: std::io::Result<()>) -> Result<Output> {
+pub(super) fn check(r: std::io::Result<()>) -> Result<Output> {
     match r {
         Ok(()) => Ok(Output::Open),
         Err(e) if e.kind() == ErrorKind::BrokenPipe => Ok(Output::Closed),
@@ -130,12 +130,15 @@ fn check(r: std::io::Result<()>) -> Result<Output> {
     }
 }
 
-fn run_on<R: BufRead, W: Write, E: Write>(
+pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
     a: &StreamArgs,
     input: R,
     out: W,
     mut err: E,
 ) -> Result<()> {
+    if a.compensate {
+        return super::stream_compensate::run_on(a, input, out, err);
+    }
     let opts = read_options(&a.recording)?;
     let mut s = streamer(a, opts.rate_hz)?;
     let mut reader = StreamReader::new(input, Path::new("stdin"), &opts)?;

@@ -13,10 +13,12 @@
 //! expected one starts the compensation again (a gap).
 //!
 //! **Online or replayed.** Online, the positions answer the commands this
-//! stream writes, and the model learns from those; replaying a recorded
-//! run ([`CommandStream::new`] `replay`), they answer the recording's own
-//! command, and the model learns from that — the commands written are then
-//! what the compensation would have sent.
+//! stream writes, and the model learns from those. Replaying a recorded
+//! run ([`CommandStream::new`] `replay`), each line carries the command and
+//! the position of its own sample, as recorded: the stream holds the
+//! positions back `lead` lines to pair them as above, the positions answer
+//! the recording's own command and the model learns from that — the
+//! commands written are then what the compensation would have sent.
 
 use serde::Serialize;
 
@@ -50,6 +52,10 @@ pub struct CommandStream {
     segments: usize,
     /// Counters of the finished segments.
     done: OnlineStats,
+    /// Replay: the last `lead + 1` lines' times and positions, and the
+    /// lines read.
+    held: Vec<(f64, f64)>,
+    read: usize,
 }
 
 impl CommandStream {
@@ -79,6 +85,8 @@ impl CommandStream {
             pending: vec![0.0; 2 * lead + 2],
             segments: 0,
             done: OnlineStats::default(),
+            held: vec![(0.0, 0.0); lead + 1],
+            read: 0,
         })
     }
 
@@ -125,15 +133,37 @@ impl CommandStream {
         self.lines = 0;
     }
 
-    /// One line: its time \[s\], the desired position of the sample `lead`
-    /// lines later \[m\] and the measured position of its own sample \[m\].
-    /// Returns the command due next, if any.
-    pub fn push(
-        &mut self,
-        time: f64,
-        desired_ahead: f64,
-        position: f64,
-    ) -> Result<Option<CommandRow>> {
+    /// One line: its time \[s\], the command \[m\] — online the desired
+    /// position of the sample `lead` lines later, replayed the recorded
+    /// command of its own sample — and the measured position of its own
+    /// sample \[m\]. Returns the command due next, if any.
+    pub fn push(&mut self, time: f64, command: f64, position: f64) -> Result<Option<CommandRow>> {
+        if !self.replay {
+            return self.feed(time, command, position);
+        }
+        for (channel, v) in [("time", time), ("position", position)] {
+            if !v.is_finite() {
+                return Err(Error::NonFinite {
+                    channel: channel.to_string(),
+                    index: self.read,
+                    value: v,
+                });
+            }
+        }
+        // this line's command is the desired position `lead` lines after
+        // the line held back longest
+        let ring = self.held.len();
+        self.held[self.read % ring] = (time, position);
+        self.read += 1;
+        if self.read <= self.lead {
+            return Ok(None);
+        }
+        let (t, y) = self.held[(self.read - 1 - self.lead) % ring];
+        self.feed(t, command, y)
+    }
+
+    /// One line as the online stream reads it (module doc).
+    fn feed(&mut self, time: f64, desired_ahead: f64, position: f64) -> Result<Option<CommandRow>> {
         for (channel, v) in [
             ("time", time),
             ("command", desired_ahead),
@@ -258,9 +288,10 @@ mod tests {
         };
         let mut stream = CommandStream::new(free, lead, dt, true).unwrap();
         let mut rows = Vec::new();
-        for i in 0..desired.len() - lead {
+        // the recording as it is: command and position of each sample
+        for i in 0..desired.len() {
             if let Some(r) = stream
-                .push(i as f64 * dt, desired[i + lead], out.position[i])
+                .push(i as f64 * dt, desired[i], out.position[i])
                 .unwrap()
             {
                 rows.push(r);
@@ -308,7 +339,7 @@ mod tests {
     #[test]
     fn a_gap_restarts_and_a_short_lead_is_refused() {
         assert!(CommandStream::new(OnlineConfig::default(), 2, 1e-3, false).is_err());
-        let mut s = CommandStream::new(OnlineConfig::default(), 3, 1e-3, true).unwrap();
+        let mut s = CommandStream::new(OnlineConfig::default(), 3, 1e-3, false).unwrap();
         for i in 0..10 {
             s.push(i as f64 * 1e-3, 0.0, 0.0).unwrap();
         }

@@ -39,7 +39,8 @@ pub use self::source::{
     read_small_text, read_text_up_to, MAX_LINE_BYTES, MAX_SMALL_FILE_BYTES, MAX_STREAM_BYTES,
 };
 pub use self::stream::{
-    PredictionRows, StreamLine, StreamReader, MAX_STREAM_LINE, PREDICTION_COLUMNS,
+    CommandRows, PredictionRows, StreamLine, StreamReader, COMMAND_COLUMNS, MAX_STREAM_LINE,
+    PREDICTION_COLUMNS,
 };
 pub use self::table::{
     cell, write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,

@@ -286,6 +286,46 @@ impl<W: Write> PredictionRows<W> {
     }
 }
 
+/// Columns of the rows of an online compensation (`feedid stream
+/// --compensate`), in order: the time of the sample the command is for, its
+/// desired position and the command to send.
+pub const COMMAND_COLUMNS: [&str; 3] = ["time_s", "desired_m", "command_m"];
+
+/// Writes the commands of an online compensation as CSV rows
+/// ([`COMMAND_COLUMNS`]; shortest round-trip numbers), flushing after each
+/// so that the drive has it at once. Writes nothing else.
+#[derive(Debug)]
+pub struct CommandRows<W: Write> {
+    out: W,
+    rows: usize,
+}
+
+impl<W: Write> CommandRows<W> {
+    /// A writer to `out`; nothing is written yet.
+    pub fn new(out: W) -> Self {
+        Self { out, rows: 0 }
+    }
+
+    /// Write the header line and flush.
+    pub fn header(&mut self) -> std::io::Result<()> {
+        writeln!(self.out, "{}", COMMAND_COLUMNS.join(","))?;
+        self.out.flush()
+    }
+
+    /// Write one command — its sample's time \[s\], desired position \[m\]
+    /// and the command \[m\] — and flush.
+    pub fn write(&mut self, time: f64, desired: f64, command: f64) -> std::io::Result<()> {
+        writeln!(self.out, "{time},{desired},{command}")?;
+        self.rows += 1;
+        self.out.flush()
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

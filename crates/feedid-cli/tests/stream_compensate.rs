@@ -88,9 +88,9 @@ fn a_replayed_recording_gives_the_librarys_command_stream() {
     let mut input = String::from("time_s,command_m,position_m\n");
     let mut lib = CommandStream::new(OnlineConfig::default(), 5, dt, true).unwrap();
     let mut expected = String::from("time_s,desired_m,command_m\n");
-    for k in 0..command.len() {
-        input += &format!("{},{},{}\n", out.time[k], command[k], out.position[k]);
-        if let Some(r) = lib.push(out.time[k], command[k], out.position[k]).unwrap() {
+    for ((&t, &u), &y) in out.time.iter().zip(&command).zip(&out.position) {
+        input += &format!("{t},{u},{y}\n");
+        if let Some(r) = lib.push(t, u, y).unwrap() {
             expected += &format!("{},{},{}\n", r.time, r.desired, r.command);
         }
     }

@@ -289,11 +289,8 @@ mod tests {
         let mut stream = CommandStream::new(free, lead, dt, true).unwrap();
         let mut rows = Vec::new();
         // the recording as it is: command and position of each sample
-        for i in 0..desired.len() {
-            if let Some(r) = stream
-                .push(i as f64 * dt, desired[i], out.position[i])
-                .unwrap()
-            {
+        for (i, (&u, &y)) in desired.iter().zip(&out.position).enumerate() {
+            if let Some(r) = stream.push(i as f64 * dt, u, y).unwrap() {
                 rows.push(r);
             }
         }

@@ -107,11 +107,16 @@ fn main() {
             "--preview" => base.preview = value.parse().unwrap_or(base.preview),
             "--terms" => base.terms = value.parse().unwrap_or(base.terms),
             "--lambda" => base.lambda = value.parse().unwrap_or(base.lambda),
+            "--share" => {
+                base.max_unexplained_share = value.parse().unwrap_or(base.max_unexplained_share)
+            }
+            "--min-updates" => base.min_updates = value.parse().unwrap_or(base.min_updates),
+            "--blend" => base.blend_samples = value.parse().unwrap_or(base.blend_samples),
             "--passes" => passes = value.parse().unwrap_or(passes).max(1),
             "--csv" => csv = Some(value),
             other => {
                 eprintln!(
-                    "unknown argument {other}; use --limit N, --preview P, --terms T, --lambda L, --passes K, --csv FILE"
+                    "unknown argument {other}; use --limit N, --preview P, --terms T, --lambda L, --share S, --min-updates N, --blend N, --passes K, --csv FILE"
                 );
                 std::process::exit(2);
             }

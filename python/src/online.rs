@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{input, IntoPy};
-use crate::recording::slice;
+use crate::recording::lines;
 
 /// One command: the time of its sample [s], desired position [m], command [m].
 type Row = (f64, f64, f64);
@@ -75,15 +75,7 @@ impl PyOnlineCompensator {
         u: PyReadonlyArray1<'_, f64>,
         y: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Vec<Row>> {
-        let (t, u, y) = (slice(&t, "t")?, slice(&u, "u")?, slice(&y, "y")?);
-        if t.len() != u.len() || t.len() != y.len() {
-            return Err(input(format!(
-                "push_many: arrays of different lengths ({}, {}, {})",
-                t.len(),
-                u.len(),
-                y.len()
-            )));
-        }
+        let (t, u, y) = lines(&t, &u, &y)?;
         let mut s = self.lock()?;
         let s = &mut *s;
         py.detach(move || {

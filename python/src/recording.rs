@@ -40,6 +40,26 @@ pub fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [
         .map_err(|_| input(format!("{name}: expected a contiguous float64 array")))
 }
 
+/// The three arrays of a `push_many` (time, command, position) as slices
+/// of equal length.
+#[allow(clippy::type_complexity)]
+pub fn lines<'a>(
+    t: &'a PyReadonlyArray1<'_, f64>,
+    u: &'a PyReadonlyArray1<'_, f64>,
+    y: &'a PyReadonlyArray1<'_, f64>,
+) -> PyResult<(&'a [f64], &'a [f64], &'a [f64])> {
+    let (t, u, y) = (slice(t, "t")?, slice(u, "u")?, slice(y, "y")?);
+    if t.len() != u.len() || t.len() != y.len() {
+        return Err(input(format!(
+            "push_many: arrays of different lengths ({}, {}, {})",
+            t.len(),
+            u.len(),
+            y.len()
+        )));
+    }
+    Ok((t, u, y))
+}
+
 #[pymethods]
 impl PyRecording {
     /// Check and store time [s], command [m] and measured position [m]

@@ -12,7 +12,7 @@ use pyo3::types::PyDict;
 
 use crate::errors::{input, IntoPy};
 use crate::method::{MethodOptions, OrderOption};
-use crate::recording::slice;
+use crate::recording::lines;
 
 /// One predicted sample: time [s], predicted position [m], interval lower
 /// and upper bounds [m] (NaN where the method gives none).
@@ -170,15 +170,7 @@ impl PyStreamer {
         u: PyReadonlyArray1<'_, f64>,
         y: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Vec<Row>> {
-        let (t, u, y) = (slice(&t, "t")?, slice(&u, "u")?, slice(&y, "y")?);
-        if t.len() != u.len() || t.len() != y.len() {
-            return Err(input(format!(
-                "push_many: arrays of different lengths ({}, {}, {})",
-                t.len(),
-                u.len(),
-                y.len()
-            )));
-        }
+        let (t, u, y) = lines(&t, &u, &y)?;
         let mut s = self.lock()?;
         let s = &mut *s;
         py.detach(move || {

@@ -163,35 +163,14 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     );
     describe(&mut text, &comp, &cfg.quality, a.check.is_some());
 
-    let verification = match &verify_rig {
-        Some(rig) => Some(verify_on_rig(rig, desired, &comp.command, rec.rate_hz())?),
-        None => None,
+    let command = Command {
+        rec: &rec,
+        command: &comp.command,
+        predicted: &comp.predicted,
+        summary: serde_json::to_value(&comp)?,
+        model: &source,
     };
-    if let Some(v) = &verification {
-        describe_verification(&mut text, v, a.seed);
-    }
-
-    let mut outputs = Outputs::default();
-    add_command_csv(
-        &mut outputs,
-        &a.output,
-        rec.time(),
-        &comp.command,
-        desired,
-        &comp.predicted,
-    )?;
-    if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
-        add_verification_csv(&mut outputs, p, rec.time(), desired, v)?;
-    }
-    if let Some(p) = &a.summary {
-        let mut v = serde_json::to_value(&comp)?;
-        if let Some(obj) = v.as_object_mut() {
-            add_summary_context(obj, a, &source, &rec, verification.as_ref())?;
-        }
-        let json = serde_json::to_string_pretty(&v)?;
-        outputs.add_text(p, format!("{json}\n"))?;
-    }
-    outputs.commit()?;
+    write_command(a, verify_rig.as_ref(), &mut text, command, &[], |_| Ok(()))?;
     print!("{text}");
     if let Some(f) = &comp.fallback {
         eprintln!(
@@ -292,6 +271,62 @@ pub(crate) fn add_verification_csv<'a>(
 
 /// The summary's context: the files, samples, rate, limits and the
 /// verification with its seed.
+/// A command for the desired trajectory of `rec` and what goes with it.
+pub(crate) struct Command<'a> {
+    pub(crate) rec: &'a feedid::Recording,
+    pub(crate) command: &'a [f64],
+    pub(crate) predicted: &'a [f64],
+    /// The summary's own keys.
+    pub(crate) summary: serde_json::Value,
+    /// What the model is, for the summary.
+    pub(crate) model: &'a str,
+}
+
+/// The command run on the rig when `--verify` asks (its figures appended to
+/// `text`), and the output set written together: the command CSV, the
+/// verification CSV, the summary (with `extra` keys) and what `more` adds.
+pub(crate) fn write_command(
+    a: &CompensateArgs,
+    rig: Option<&VirtualRig>,
+    text: &mut String,
+    c: Command<'_>,
+    extra: &[(&'static str, String)],
+    more: impl FnOnce(&mut Outputs<'_>) -> Result<()>,
+) -> Result<()> {
+    let (rec, desired) = (c.rec, c.rec.position());
+    let verification = match rig {
+        Some(rig) => Some(verify_on_rig(rig, desired, c.command, rec.rate_hz())?),
+        None => None,
+    };
+    if let Some(v) = &verification {
+        describe_verification(text, v, a.seed);
+    }
+    let mut outputs = Outputs::default();
+    add_command_csv(
+        &mut outputs,
+        &a.output,
+        rec.time(),
+        c.command,
+        desired,
+        c.predicted,
+    )?;
+    if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
+        add_verification_csv(&mut outputs, p, rec.time(), desired, v)?;
+    }
+    if let Some(p) = &a.summary {
+        let mut v = c.summary;
+        if let Some(obj) = v.as_object_mut() {
+            add_summary_context(obj, a, c.model, rec, verification.as_ref())?;
+            for (k, value) in extra {
+                obj.insert((*k).into(), value.clone().into());
+            }
+        }
+        outputs.add_text(p, format!("{}\n", serde_json::to_string_pretty(&v)?))?;
+    }
+    more(&mut outputs)?;
+    outputs.commit()
+}
+
 pub(crate) fn add_summary_context(
     obj: &mut serde_json::Map<String, serde_json::Value>,
     a: &CompensateArgs,

@@ -6,18 +6,13 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use feedid::compensate::{
-    learn, verify_on_rig, LearnConfig, LearnStatus, Learning, LearningHistory, NoiseFilter,
-};
+use feedid::compensate::{learn, LearnConfig, LearnStatus, Learning, LearningHistory, NoiseFilter};
 use feedid::io::{read_recording, read_text_up_to, ChannelRef, ReadOptions};
 use feedid::Recording;
 
-use super::compensate::{
-    add_command_csv, add_summary_context, add_verification_csv, config, describe_verification,
-    micrometres, read_desired,
-};
+use super::compensate::{config, micrometres, read_desired, write_command, Command};
 use crate::args::CompensateArgs;
-use crate::cmd::{check_distinct, Outputs};
+use crate::cmd::check_distinct;
 
 /// Learn, write, verify, print.
 pub fn run(a: &CompensateArgs) -> Result<()> {
@@ -99,50 +94,32 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         rec.rate_hz()
     );
     describe(&mut text, &step, a);
-    let verification = match &verify_rig {
-        Some(rig) => Some(verify_on_rig(rig, desired, &step.command, rec.rate_hz())?),
-        None => None,
+    let sent = a.sent.as_deref().unwrap_or(measured_path);
+    let command = Command {
+        rec: &rec,
+        command: &step.command,
+        predicted: &step.predicted,
+        summary: serde_json::to_value(&step)?,
+        model: &source,
     };
-    if let Some(v) = &verification {
-        describe_verification(&mut text, v, a.seed);
-    }
-
-    let mut outputs = Outputs::default();
-    add_command_csv(
-        &mut outputs,
-        &a.output,
-        rec.time(),
-        &step.command,
-        desired,
-        &step.predicted,
+    let extra = [
+        ("measured_run", measured_path.display().to_string()),
+        ("sent", sent.display().to_string()),
+    ];
+    let history = serde_json::to_string(&step.history)?;
+    write_command(
+        a,
+        verify_rig.as_ref(),
+        &mut text,
+        command,
+        &extra,
+        |outputs| {
+            if let Some(p) = &a.history {
+                outputs.add_text(p, format!("{history}\n"))?;
+            }
+            Ok(())
+        },
     )?;
-    if let (Some(p), Some(v)) = (&a.verify_out, &verification) {
-        add_verification_csv(&mut outputs, p, rec.time(), desired, v)?;
-    }
-    if let Some(p) = &a.summary {
-        let mut v = serde_json::to_value(&step)?;
-        if let Some(obj) = v.as_object_mut() {
-            add_summary_context(obj, a, &source, &rec, verification.as_ref())?;
-            obj.insert(
-                "measured_run".into(),
-                measured_path.display().to_string().into(),
-            );
-            obj.insert(
-                "sent".into(),
-                a.sent
-                    .as_deref()
-                    .unwrap_or(measured_path)
-                    .display()
-                    .to_string()
-                    .into(),
-            );
-        }
-        outputs.add_text(p, format!("{}\n", serde_json::to_string_pretty(&v)?))?;
-    }
-    if let Some(p) = &a.history {
-        outputs.add_text(p, format!("{}\n", serde_json::to_string(&step.history)?))?;
-    }
-    outputs.commit()?;
     print!("{text}");
     warn(&step, a);
     Ok(())

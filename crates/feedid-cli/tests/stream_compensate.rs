@@ -152,6 +152,10 @@ fn a_short_lead_or_replay_without_compensate_exits_2() {
     let err = String::from_utf8(o.stderr).unwrap();
     assert!(err.contains("at least 3 lines ahead"), "{err}");
     assert!(o.stdout.is_empty());
+    let o = run(&["stream", "--compensate", "--command-lead", "40"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(err.contains("3 to 33 samples ahead"), "{err}");
     let o = run(&["stream", "--replay"]);
     assert_eq!(o.status.code(), Some(2));
     let o = run(&[
@@ -166,4 +170,78 @@ fn a_short_lead_or_replay_without_compensate_exits_2() {
     assert!(String::from_utf8(o.stderr)
         .unwrap()
         .contains("max velocity"));
+}
+
+#[test]
+fn refused_lines_are_reported_with_their_number_and_skipped() {
+    let mut input = String::new();
+    for k in 0..40 {
+        let t = k as f64 * 1e-3;
+        if k == 10 {
+            input += "0.0005,0,0\n"; // time backwards
+        } else if k == 20 {
+            input += &format!("{t},nan,0\n");
+        } else {
+            input += &format!("{t},{},0\n", 1e-4 * k as f64);
+        }
+    }
+    let mut child = Command::new(BIN)
+        .args(["stream", "--compensate", "--command-lead", "3"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(input.as_bytes())
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("stdin: line 11: time is not strictly increasing"),
+        "{err}"
+    );
+    assert!(
+        err.contains("stdin: line 21: ") && err.contains("NaN"),
+        "{err}"
+    );
+    assert!(err.contains("skipped 2"), "{err}");
+    let out = String::from_utf8(o.stdout).unwrap();
+    // every row a finite command for a later sample
+    let mut last = f64::NEG_INFINITY;
+    for l in out.lines().skip(1) {
+        let f: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+        assert!(f.iter().all(|v| v.is_finite()), "{l}");
+        assert!(f[0] > last, "{l}");
+        last = f[0];
+    }
+}
+
+#[test]
+fn an_unwritable_output_exits_2_naming_the_commands() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return; // no /dev/full here
+    };
+    let mut child = Command::new(BIN)
+        .args(["stream", "--compensate", "--command-lead", "3"])
+        .stdin(Stdio::piped())
+        .stdout(full)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let input: String = (0..20)
+        .map(|k| format!("{},0,0\n", k as f64 * 1e-3))
+        .collect();
+    let _ = child.stdin.take().unwrap().write_all(input.as_bytes());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(
+        err.contains("cannot write the commands to standard output"),
+        "{err}"
+    );
 }

@@ -122,11 +122,16 @@ fn write<W: Write>(rows: &mut PredictionRows<W>, p: &Prediction<'_>) -> Result<O
 }
 
 /// A closed pipe ends the stream quietly, other write failures are errors.
-pub(super) fn check(r: std::io::Result<()>) -> Result<Output> {
+fn check(r: std::io::Result<()>) -> Result<Output> {
+    check_writing(r, "predictions")
+}
+
+/// As [`check`], naming what could not be written.
+pub(super) fn check_writing(r: std::io::Result<()>, what: &str) -> Result<Output> {
     match r {
         Ok(()) => Ok(Output::Open),
         Err(e) if e.kind() == ErrorKind::BrokenPipe => Ok(Output::Closed),
-        Err(e) => bail!("cannot write the predictions to standard output: {e}"),
+        Err(e) => bail!("cannot write the {what} to standard output: {e}"),
     }
 }
 

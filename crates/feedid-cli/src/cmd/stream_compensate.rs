@@ -15,7 +15,7 @@ use anyhow::{bail, Result};
 use feedid::compensate::{CommandStream, OnlineConfig, OnlineState};
 use feedid::io::{CommandRows, StreamLine, StreamReader};
 
-use super::stream::{check, Output, MAX_MESSAGES};
+use super::stream::{check_writing, Output, MAX_MESSAGES};
 use crate::args::StreamArgs;
 use crate::cmd::recording::read_options;
 
@@ -50,7 +50,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
             break;
         };
         read += 1;
-        let (t, u, y) = match line {
+        let (no, t, u, y) = match line {
             StreamLine::Header { .. } => continue,
             StreamLine::Skipped { error, .. } => {
                 skipped += 1;
@@ -60,32 +60,46 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
                 continue;
             }
             StreamLine::Sample {
+                line,
                 time,
                 command,
                 position,
-                ..
-            } => (time, command, position),
+            } => (line, time, command, position),
         };
-        used += 1;
+        // a line the compensation refuses (not finite, time not after the
+        // last) is reported with its number and skipped
+        let mut refuse = |e: &dyn std::fmt::Display| {
+            skipped += 1;
+            if skipped <= MAX_MESSAGES {
+                let _ = writeln!(err, "stdin: line {no}: {e}; skipped");
+            }
+        };
         let s = match &mut stream {
             Some(s) => s,
             None => {
+                if let Some(bad) = [t, u, y].iter().find(|v| !v.is_finite()) {
+                    refuse(&format!("not finite: {bad}"));
+                    continue;
+                }
                 let dt = match (opts.rate_hz, first) {
                     (Some(r), _) => 1.0 / r,
                     (None, None) => {
                         first = Some((t, u, y));
+                        used += 1;
+                        continue;
+                    }
+                    (None, Some((t0, ..))) if t <= t0 => {
+                        refuse(&format!("time {t} s is not after {t0} s"));
                         continue;
                     }
                     (None, Some((t0, ..))) => t - t0,
                 };
-                if !(dt.is_finite() && dt > 0.0) {
-                    bail!("stdin: the first two samples are {dt} s apart: the time must increase (or give --rate)");
-                }
                 let mut s = CommandStream::new(cfg, a.command_lead, dt, a.replay)?;
-                output = check(rows.header())?;
+                output = check_writing(rows.header(), "commands")?;
                 if let Some((t0, u0, y0)) = first.take() {
                     if let Some(r) = s.push(t0, u0, y0)? {
-                        output = check(rows.write(r.time, r.desired, r.command))?;
+                        output =
+                            check_writing(rows.write(r.time, r.desired, r.command), "commands")?;
                     }
                 }
                 stream.insert(s)
@@ -94,8 +108,14 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         if let Output::Closed = output {
             break;
         }
-        if let Some(r) = s.push(t, u, y)? {
-            output = check(rows.write(r.time, r.desired, r.command))?;
+        match s.push(t, u, y) {
+            Ok(row) => {
+                used += 1;
+                if let Some(r) = row {
+                    output = check_writing(rows.write(r.time, r.desired, r.command), "commands")?;
+                }
+            }
+            Err(e) => refuse(&e),
         }
     }
     let _ = write!(

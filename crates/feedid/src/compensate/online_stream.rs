@@ -22,7 +22,7 @@
 
 use serde::Serialize;
 
-use super::online::{OnlineCompensator, OnlineConfig, OnlineState, OnlineStats};
+use super::online::{OnlineCompensator, OnlineConfig, OnlineState, OnlineStats, MAX_PREVIEW};
 use crate::error::{Error, Result};
 
 /// A command written by the stream.
@@ -56,6 +56,8 @@ pub struct CommandStream {
     /// lines read.
     held: Vec<(f64, f64)>,
     read: usize,
+    /// Time of the last line accepted.
+    last_time: Option<f64>,
 }
 
 impl CommandStream {
@@ -64,11 +66,11 @@ impl CommandStream {
     /// \[s\] apart; `replay`: the positions answer the recording's own
     /// commands, not the ones written.
     pub fn new(cfg: OnlineConfig, lead: usize, dt: f64, replay: bool) -> Result<Self> {
-        if lead < 3 {
+        if !(3..=MAX_PREVIEW + 1).contains(&lead) {
             return Err(Error::InvalidParameter {
                 name: "command lead",
                 value: lead as f64,
-                reason: "online compensation needs the command at least 3 samples ahead (2 samples of preview)",
+                reason: "online compensation needs the command 3 to 33 samples ahead (2 to 32 samples of preview)",
             });
         }
         let cfg = OnlineConfig {
@@ -87,6 +89,7 @@ impl CommandStream {
             done: OnlineStats::default(),
             held: vec![(0.0, 0.0); lead + 1],
             read: 0,
+            last_time: None,
         })
     }
 
@@ -137,11 +140,10 @@ impl CommandStream {
     /// position of the sample `lead` lines later, replayed the recorded
     /// command of its own sample — and the measured position of its own
     /// sample \[m\]. Returns the command due next, if any.
+    /// A line whose values are not finite or whose time is not after the
+    /// last accepted one is refused (nothing is stored).
     pub fn push(&mut self, time: f64, command: f64, position: f64) -> Result<Option<CommandRow>> {
-        if !self.replay {
-            return self.feed(time, command, position);
-        }
-        for (channel, v) in [("time", time), ("position", position)] {
+        for (channel, v) in [("time", time), ("command", command), ("position", position)] {
             if !v.is_finite() {
                 return Err(Error::NonFinite {
                     channel: channel.to_string(),
@@ -149,6 +151,18 @@ impl CommandStream {
                     value: v,
                 });
             }
+        }
+        if let Some(previous) = self.last_time.filter(|&p| time <= p) {
+            return Err(Error::NonMonotoneTime {
+                index: self.read,
+                previous,
+                value: time,
+            });
+        }
+        self.last_time = Some(time);
+        if !self.replay {
+            self.read += 1;
+            return self.feed(time, command, position);
         }
         // this line's command is the desired position `lead` lines after
         // the line held back longest
@@ -164,19 +178,6 @@ impl CommandStream {
 
     /// One line as the online stream reads it (module doc).
     fn feed(&mut self, time: f64, desired_ahead: f64, position: f64) -> Result<Option<CommandRow>> {
-        for (channel, v) in [
-            ("time", time),
-            ("command", desired_ahead),
-            ("position", position),
-        ] {
-            if !v.is_finite() {
-                return Err(Error::NonFinite {
-                    channel: channel.to_string(),
-                    index: self.lines,
-                    value: v,
-                });
-            }
-        }
         if self.lines > 0 {
             let expected = self.t0 + self.lines as f64 * self.dt;
             if (time - expected).abs() > 0.5 * self.dt {
@@ -347,5 +348,11 @@ mod tests {
         let row = row.unwrap();
         assert!((row.time - 0.103).abs() < 1e-12);
         assert!(s.push(0.101, f64::NAN, 0.0).is_err());
+        // a time not after the last accepted one is refused, nothing stored
+        let e = s.push(0.1, 0.0, 0.0).unwrap_err();
+        assert!(matches!(e, Error::NonMonotoneTime { .. }), "{e}");
+        s.push(0.101, 0.0, 0.0).unwrap();
+        assert_eq!(s.segments(), 2, "the refused lines made no gap");
+        assert!(CommandStream::new(OnlineConfig::default(), 34, 1e-3, false).is_err());
     }
 }

@@ -547,6 +547,10 @@ class OnlineCompensator:
         Default False (online: the positions answer the commands returned).
     max_velocity, max_acceleration : float
         Command limits [m/s], [m/s²]; defaults 1.0 and 30.0.
+    model : Identification, dict or path, optional
+        Start from this identified model (its following-error time
+        constants at ``rate``) instead of from nothing: compensated from the
+        first sample, refined as it runs (``--model``).
 
     ``push`` returns ``None`` or ``(time [s], desired [m], command [m])``
     of the sample the command is for; ``push_many`` a list of them.
@@ -560,6 +564,7 @@ class OnlineCompensator:
         replay: bool = False,
         max_velocity: float = 1.0,
         max_acceleration: float = 30.0,
+        model: Union[None, "Identification", Mapping[str, Any], PathLike] = None,
     ):
         self._c = _feedid.OnlineCompensator(
             rate=float(rate),
@@ -567,6 +572,7 @@ class OnlineCompensator:
             replay=bool(replay),
             max_velocity=float(max_velocity),
             max_acceleration=float(max_acceleration),
+            **({} if model is None else _model_kw(model, "start the compensation")),
         )
 
     def push(self, t: float, u: float, y: float) -> Optional[Tuple[float, float, float]]:

@@ -59,6 +59,8 @@ class OnlineCompensator:
         replay: bool = False,
         max_velocity: float = 1.0,
         max_acceleration: float = 30.0,
+        model_json: Optional[str] = None,
+        model_path: Optional[str] = None,
     ) -> None: ...
     def push(self, t: float, u: float, y: float) -> Optional[Tuple[float, float, float]]: ...
     def push_many(

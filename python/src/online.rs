@@ -4,7 +4,10 @@
 
 use std::sync::{Mutex, MutexGuard};
 
-use feedid::compensate::{CommandStream, OnlineConfig, OnlineState};
+use std::path::Path;
+
+use feedid::compensate::{following_error_of, CommandStream, OnlineConfig, OnlineState};
+use feedid::ident::ModelFile;
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -34,13 +37,16 @@ impl PyOnlineCompensator {
 impl PyOnlineCompensator {
     #[new]
     #[pyo3(signature = (*, rate, command_lead, replay = false, max_velocity = 1.0,
-        max_acceleration = 30.0))]
+        max_acceleration = 30.0, model_json = None, model_path = None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         rate: f64,
         command_lead: usize,
         replay: bool,
         max_velocity: f64,
         max_acceleration: f64,
+        model_json: Option<String>,
+        model_path: Option<String>,
     ) -> PyResult<Self> {
         if !(rate.is_finite() && rate > 0.0) {
             return Err(input(format!(
@@ -52,7 +58,19 @@ impl PyOnlineCompensator {
             max_acceleration,
             ..OnlineConfig::default()
         };
-        let inner = CommandStream::new(cfg, command_lead, 1.0 / rate, replay).py_err()?;
+        let mut inner = CommandStream::new(cfg, command_lead, 1.0 / rate, replay).py_err()?;
+        let file = match (model_json, model_path) {
+            (Some(text), _) => Some(ModelFile::from_json(&text).py_err()?),
+            (None, Some(path)) => {
+                let text = feedid::io::read_small_text(Path::new(&path)).py_err()?;
+                Some(ModelFile::from_json_file(&text, Path::new(&path)).py_err()?)
+            }
+            (None, None) => None,
+        };
+        if let Some(f) = file {
+            let alpha = following_error_of(&f.model, 1.0 / rate).py_err()?;
+            inner.set_prior(alpha).py_err()?;
+        }
         Ok(Self {
             inner: Mutex::new(inner),
         })

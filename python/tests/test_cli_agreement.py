@@ -105,8 +105,9 @@ def test_identify_equals_the_cli_on_emps(cli, tmp_path, emps):
     [
         ({}, [], None),
         # from rest without smoothing the start of motion asks more than
-        # 30 m/s² (with it the start is eased in and the limits are met)
-        ({"start": "rest", "max_smoothing": 0.0}, ["--start", "rest", "--max-smoothing", 0.0], "limits"),
+        # 30 m/s² (with it the start is eased in and the limits are met):
+        # the correction is held back there, compensated elsewhere
+        ({"start": "rest", "max_smoothing": 0.0}, ["--start", "rest", "--max-smoothing", 0.0], "held"),
         ({"start": "rest"}, ["--start", "rest"], None),
         (
             {"start": "rest", "fallback": False, "max_acceleration": float("inf")},
@@ -151,8 +152,11 @@ def test_compensate_equals_the_cli_with_its_options(cli, tmp_path, py_options, c
     for key in keys:
         assert json.dumps(out[key], sort_keys=True) == json.dumps(summary[key], sort_keys=True), key
     # the option did what it says: the plain command is sent on a fall-back only
+    held = fallback == "held"
+    fallback = None if held else fallback
     assert (out["fallback"] or {}).get("reason") == fallback, out["fallback"]
     assert np.array_equal(out["command"], desired) == (fallback is not None)
+    assert (out["held_back_share"] > 0) == held, out["held_back_share"]
 
 
 def test_learning_from_runs_equals_the_cli_step_by_step(cli, tmp_path):
@@ -237,7 +241,20 @@ def test_online_compensation_equals_the_cli_stream_line_by_line(cli, tmp_path):
     # many lines at once: the same commands
     many = feedid.OnlineCompensator(5000.0, 4, replay=True).push_many(t, u, y)
     assert np.array_equal(np.array(many), py_rows)
-    with pytest.raises(feedid.InputError, match="at least 3 samples ahead"):
+    with pytest.raises(feedid.InputError, match="3 to 33 samples ahead"):
         feedid.OnlineCompensator(5000.0, 2)
+    # starting from an identified model: compensated from the first commands
+    model_path = tmp_path / "m.json"
+    cli("identify", rec_path, "-o", tmp_path / "p.csv", "--model-out", model_path)
+    warm = feedid.OnlineCompensator(5000.0, 4, replay=True, model=model_path)
+    warm_rows = np.array(warm.push_many(t, u, y))
+    assert warm.stats["compensated"] > stats["compensated"]
+    r = subprocess.run([cli.exe, "stream", "--compensate", "--replay", "--command-lead", "4",
+                        "--model", str(model_path)],
+                       input=rec_path.read_text(), capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    cli_warm = np.array([[float(v) for v in line.split(",")]
+                         for line in r.stdout.strip().splitlines()[1:]])
+    assert np.max(np.abs(warm_rows[:, 1:] - cli_warm[:, 1:])) <= 1e-12 * scale
     with pytest.raises(feedid.InputError, match="different lengths"):
         comp.push_many(t, u[:-1], y)

@@ -383,6 +383,11 @@ pub struct StreamArgs {
     /// column (a recorded run replayed), not the commands written.
     #[arg(long, requires = "compensate")]
     pub replay: bool,
+    /// With --compensate: start from an identified model (model.json of
+    /// `identify --model-out`, at the stream's sample interval) instead of
+    /// from nothing: compensated from the first sample, refined as it runs.
+    #[arg(long, value_name = "model.json", requires = "compensate")]
+    pub model: Option<std::path::PathBuf>,
     /// With --compensate: command velocity limit [m/s] (inf: none).
     #[arg(long, value_name = "V", default_value_t = 1.0, requires = "compensate")]
     pub max_velocity: f64,

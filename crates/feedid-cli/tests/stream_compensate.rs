@@ -23,7 +23,7 @@ fn in_a_closed_loop_each_command_comes_before_its_sample_and_equals_the_co_simul
         preview: lead - 1,
         ..OnlineConfig::default()
     };
-    let sim = co_simulate(|f| rig.stepper(rate, f), &desired, dt, &cfg, 1).unwrap();
+    let sim = co_simulate(|f| rig.stepper(rate, f), &desired, dt, &cfg, 1, None).unwrap();
     let mut child = Command::new(BIN)
         .args(["stream", "--compensate", "--command-lead", "4"])
         .stdin(Stdio::piped())

@@ -12,9 +12,10 @@
 //!
 //! Per member:
 //!
-//! * the identification run: a logarithmic sine sweep from `f_max/100` to
+//! * the identification run: [`feedid::zoo::MemberSpec::identification_chirp`]
+//!   (a logarithmic sine sweep from `f_max/100` to
 //!   `f_max = min(rate/8, max(6·Kv/2π, 5 Hz))`, amplitude
-//!   `0.8·min(A, 10 mm, v/(2π·f_max), a/(2π·f_max)²)` (`A`, `v`, `a`: the
+//!   `0.8·min(A, 10 mm, v/(2π·f_max), a/(2π·f_max)²)`; `A`, `v`, `a`: the
 //!   member's amplitude, command speed and acceleration — for a ramp
 //!   `a = v·Kv`), as long as the member's recording, noise seed + 1;
 //! * the model: `fit_global_model(.., Auto)` (the best of arx 8,8,1, oe 7,2
@@ -61,8 +62,7 @@ use std::path::PathBuf;
 use feedid::compensate::{compensate_model, learn, CompensateConfig, LearnConfig, ModelQuality};
 use feedid::ident::{fit_global_model, GlobalModelKind, LinearModel};
 use feedid::lti::{poly_from_roots, poly_roots, Complex, StateSpace};
-use feedid::signal::{Chirp, Sweep};
-use feedid::zoo::{CommandSpec, MemberSpec, Zoo};
+use feedid::zoo::{CommandSpec, Zoo};
 use feedid::Recording;
 use rayon::prelude::*;
 
@@ -150,21 +150,6 @@ fn rms_against(truth: &[f64], desired: &[f64]) -> f64 {
     (s / desired.len() as f64).sqrt()
 }
 
-/// Speed and acceleration the member's command asks of the axis.
-fn references(spec: &MemberSpec, desired: &[f64], dt: f64) -> (f64, f64) {
-    let v = desired
-        .windows(2)
-        .map(|w| ((w[1] - w[0]) / dt).abs())
-        .fold(0.0, f64::max);
-    let a = match &spec.command {
-        CommandSpec::Scurve(s) => s.max_acceleration,
-        CommandSpec::PointToPoint { program, .. } => program.max_acceleration,
-        CommandSpec::Contour(c) => c.max_acceleration.min(c.feed * c.feed / c.radius.abs()),
-        _ => v * spec.kv,
-    };
-    (v, a)
-}
-
 /// Peak finite-difference velocity and acceleration of a command.
 fn command_peaks(u: &[f64], dt: f64) -> (f64, f64) {
     let v = u
@@ -188,32 +173,11 @@ fn run(
     let member = zoo.member(index).map_err(|e| e.to_string())?;
     let spec = &member.spec;
     let desired = &member.command;
-    let n = desired.len();
     let rate = spec.rate_hz;
     let dt = 1.0 / rate;
-    let (v, a) = references(spec, desired, dt);
-    let two_pi = 2.0 * std::f64::consts::PI;
-    let mut f_max = (rate / 8.0).min((6.0 * spec.kv / two_pi).max(5.0));
-    let amp = |f: f64| {
-        0.8 * spec
-            .amplitude_m
-            .min(1e-2)
-            .min(v / (two_pi * f))
-            .min(a / (two_pi * f).powi(2))
-    };
-    while amp(f_max) < 50.0 * spec.resolution_m && f_max > 2.0 {
-        f_max /= 1.5;
-    }
-    let chirp = Chirp {
-        amplitude: amp(f_max),
-        f_start: f_max / 100.0,
-        f_end: f_max,
-        sweep: Sweep::Logarithmic,
-        taper: 0.05_f64.min(0.1 * n as f64 * dt),
-        rest: 10.0 * dt,
-    };
-    let excitation = chirp
-        .generate(rate, n as f64 * dt)
+    let (v, a) = spec.program_references(desired);
+    let excitation = spec
+        .identification_chirp(desired)
         .map_err(|e| e.to_string())?;
     let ident = spec
         .run_plant(&excitation, spec.noise_seed.wrapping_add(1))

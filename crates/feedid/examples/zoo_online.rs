@@ -14,13 +14,21 @@
 //! (the plain command's own finite-difference peaks), as `zoo_compensate`
 //! sets them. The program runs `--passes K` times back to back (default 2;
 //! the compensator starts from nothing and keeps its model from pass to
-//! pass). Tracking error: rms of the **true** position minus the desired
+//! pass; with `--prior` it starts from the following-error model of a model
+//! identified on a chirp run of the same axis,
+//! [`feedid::zoo::MemberSpec::identification_chirp`] and
+//! `fit_global_model(auto)`, as `zoo_compensate` identifies it). Tracking error: rms of the **true** position minus the desired
 //! over the last pass (the first pass's reduction beside it). A run is **unstable** when its
 //! compensated error exceeds 10× the plain one or the axis diverges.
 
-use feedid::compensate::{co_simulate, OnlineConfig};
+use feedid::compensate::{co_simulate, following_error_of, OnlineConfig};
+use feedid::ident::{fit_global_model, GlobalModelKind};
 use feedid::zoo::{CommandSpec, Zoo};
+use feedid::Recording;
 use rayon::prelude::*;
+
+/// Smallest following-error fit on the chirp [%] for its model to be the prior.
+const PRIOR_MIN_ERROR_FIT: f64 = 90.0;
 
 struct Row {
     index: usize,
@@ -44,7 +52,13 @@ fn kind(c: &CommandSpec) -> &'static str {
     }
 }
 
-fn run(zoo: &Zoo, index: usize, base: &OnlineConfig, passes: usize) -> Result<Row, String> {
+fn run(
+    zoo: &Zoo,
+    index: usize,
+    base: &OnlineConfig,
+    passes: usize,
+    with_prior: bool,
+) -> Result<Row, String> {
     let member = zoo.member(index).map_err(|e| e.to_string())?;
     let spec = &member.spec;
     let desired = &member.command;
@@ -63,8 +77,38 @@ fn run(zoo: &Zoo, index: usize, base: &OnlineConfig, passes: usize) -> Result<Ro
         ..*base
     };
     let seed = spec.noise_seed;
-    let sim = co_simulate(|first| spec.stepper(first, seed), desired, dt, &cfg, passes)
-        .map_err(|e| e.to_string())?;
+    let prior = if with_prior {
+        // a model identified on a chirp run of the same axis (another noise seed)
+        let chirp = spec
+            .identification_chirp(desired)
+            .map_err(|e| e.to_string())?;
+        let run = spec
+            .run_plant(&chirp, seed.wrapping_add(1))
+            .map_err(|e| e.to_string())?;
+        let rec = Recording::from_rate(spec.rate_hz, run.command, run.position)
+            .map_err(|e| e.to_string())?;
+        let file = fit_global_model(&rec, &GlobalModelKind::Auto).map_err(|e| e.to_string())?;
+        // only a model that explains the chirp's following error well
+        let explains = file
+            .identified_by
+            .as_ref()
+            .and_then(|p| p.error_fit_percent)
+            .is_some_and(|f| f >= PRIOR_MIN_ERROR_FIT);
+        explains
+            .then(|| following_error_of(&file.model, dt).ok())
+            .flatten()
+    } else {
+        None
+    };
+    let sim = co_simulate(
+        |first| spec.stepper(first, seed),
+        desired,
+        dt,
+        &cfg,
+        passes,
+        prior,
+    )
+    .map_err(|e| e.to_string())?;
     let n = sim.desired.len() as f64;
     let first = sim.passes[0];
     Ok(Row {
@@ -98,6 +142,7 @@ fn main() {
     let mut limit = usize::MAX;
     let mut base = OnlineConfig::default();
     let mut passes = 2;
+    let mut with_prior = false;
     let mut csv: Option<String> = None;
     let mut i = 0;
     while i < args.len() {
@@ -113,10 +158,15 @@ fn main() {
             "--min-updates" => base.min_updates = value.parse().unwrap_or(base.min_updates),
             "--blend" => base.blend_samples = value.parse().unwrap_or(base.blend_samples),
             "--passes" => passes = value.parse().unwrap_or(passes).max(1),
+            "--prior" => {
+                with_prior = true;
+                i += 1;
+                continue;
+            }
             "--csv" => csv = Some(value),
             other => {
                 eprintln!(
-                    "unknown argument {other}; use --limit N, --preview P, --terms T, --lambda L, --share S, --min-updates N, --blend N, --passes K, --csv FILE"
+                    "unknown argument {other}; use --limit N, --preview P, --terms T, --lambda L, --share S, --min-updates N, --blend N, --prior, --passes K, --csv FILE"
                 );
                 std::process::exit(2);
             }
@@ -132,7 +182,7 @@ fn main() {
     let start = std::time::Instant::now();
     let results: Vec<(usize, Result<Row, String>)> = indices
         .par_iter()
-        .map(|&i| (i, run(&zoo, i, &base, passes)))
+        .map(|&i| (i, run(&zoo, i, &base, passes, with_prior)))
         .collect();
     let mut rows = Vec::new();
     let mut failed = 0;
@@ -146,12 +196,17 @@ fn main() {
         }
     }
     println!(
-        "{} members co-simulated ({} failed) in {:.0} s, preview {} samples, {} pass(es); figures of the last pass\n",
+        "{} members co-simulated ({} failed) in {:.0} s, preview {} samples, {} pass(es){}; figures of the last pass\n",
         rows.len(),
         failed,
         start.elapsed().as_secs_f64(),
         base.preview,
-        passes
+        passes,
+        if with_prior {
+            ", starting from a model identified on a chirp run"
+        } else {
+            ""
+        }
     );
     println!("| axes | n | median rms plain | median rms online | median reduction | first pass | smallest | worse than plain | unstable (> 10× plain) |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");

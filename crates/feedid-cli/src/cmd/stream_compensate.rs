@@ -11,8 +11,8 @@
 use std::io::{BufRead, Write};
 use std::path::Path;
 
-use anyhow::{bail, Result};
-use feedid::compensate::{CommandStream, OnlineConfig, OnlineState};
+use anyhow::{bail, Context, Result};
+use feedid::compensate::{following_error_of, CommandStream, OnlineConfig, OnlineState};
 use feedid::io::{CommandRows, StreamLine, StreamReader};
 
 use super::stream::{check_writing, Output, MAX_MESSAGES};
@@ -37,6 +37,25 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         ..OnlineConfig::default()
     };
     cfg.validate()?;
+    let model = match &a.model {
+        Some(p) => {
+            let file = super::load_model_file(p)?;
+            let explains = file
+                .identified_by
+                .as_ref()
+                .and_then(|q| q.error_fit_percent);
+            if !explains.is_some_and(|f| f >= 90.0) {
+                let _ = writeln!(
+                    err,
+                    "warning: {} explains {} of its recording's following error: a poor start (on the drive zoo such models made the compensation worse than starting from nothing)",
+                    p.display(),
+                    explains.map_or("an unknown share".to_string(), |f| format!("{f:.1} %"))
+                );
+            }
+            Some((p, file.model))
+        }
+        None => None,
+    };
     let opts = read_options(&a.recording)?;
     let mut reader = StreamReader::new(input, Path::new("stdin"), &opts)?;
     let mut rows = CommandRows::new(out);
@@ -66,19 +85,11 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
                 position,
             } => (line, time, command, position),
         };
-        // a line the compensation refuses (not finite, time not after the
-        // last) is reported with its number and skipped
-        let mut refuse = |e: &dyn std::fmt::Display| {
-            skipped += 1;
-            if skipped <= MAX_MESSAGES {
-                let _ = writeln!(err, "stdin: line {no}: {e}; skipped");
-            }
-        };
         let s = match &mut stream {
             Some(s) => s,
             None => {
                 if let Some(bad) = [t, u, y].iter().find(|v| !v.is_finite()) {
-                    refuse(&format!("not finite: {bad}"));
+                    refuse(&mut err, &mut skipped, no, &format!("not finite: {bad}"));
                     continue;
                 }
                 let dt = match (opts.rate_hz, first) {
@@ -89,12 +100,29 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
                         continue;
                     }
                     (None, Some((t0, ..))) if t <= t0 => {
-                        refuse(&format!("time {t} s is not after {t0} s"));
+                        refuse(
+                            &mut err,
+                            &mut skipped,
+                            no,
+                            &format!("time {t} s is not after {t0} s"),
+                        );
                         continue;
                     }
                     (None, Some((t0, ..))) => t - t0,
                 };
                 let mut s = CommandStream::new(cfg, a.command_lead, dt, a.replay)?;
+                if let Some((path, m)) = &model {
+                    let alpha = following_error_of(m, dt).with_context(|| {
+                        format!("{}: at the stream's interval {dt} s", path.display())
+                    })?;
+                    s.set_prior(alpha)?;
+                    let _ = writeln!(
+                        err,
+                        "starting from {}: lag {:.4} ms",
+                        path.display(),
+                        1e3 * alpha[0]
+                    );
+                }
                 output = check_writing(rows.header(), "commands")?;
                 if let Some((t0, u0, y0)) = first.take() {
                     if let Some(r) = s.push(t0, u0, y0)? {
@@ -115,7 +143,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
                     output = check_writing(rows.write(r.time, r.desired, r.command), "commands")?;
                 }
             }
-            Err(e) => refuse(&e),
+            Err(e) => refuse(&mut err, &mut skipped, no, &e),
         }
     }
     let _ = write!(
@@ -127,6 +155,15 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         bail!("no usable line in the input ({read} read, {skipped} skipped)");
     }
     Ok(())
+}
+
+/// A line the compensation refuses (not finite, time not after the last)
+/// is reported with its number (the first hundred) and skipped.
+fn refuse<E: Write>(err: &mut E, skipped: &mut usize, no: usize, e: &dyn std::fmt::Display) {
+    *skipped += 1;
+    if *skipped <= MAX_MESSAGES {
+        let _ = writeln!(err, "stdin: line {no}: {e}; skipped");
+    }
 }
 
 /// The summary on standard error.

@@ -96,13 +96,15 @@ pub struct CoSimulation {
 /// Run the program `desired` (samples `dt` \[s\] apart) `passes` times
 /// back to back on two fresh axes from `axis` (called with the first
 /// command): once plain, once with an [`OnlineCompensator`] of `cfg` in the
-/// loop.
+/// loop, starting from the following-error model `prior` if given
+/// ([`OnlineCompensator::set_prior`]).
 pub fn co_simulate<A, F>(
     axis: F,
     desired: &[f64],
     dt: f64,
     cfg: &OnlineConfig,
     passes: usize,
+    prior: Option<[f64; 3]>,
 ) -> Result<CoSimulation>
 where
     A: SteppedAxis,
@@ -146,6 +148,9 @@ where
     }
     // compensated
     let mut comp = OnlineCompensator::new(*cfg, dt)?;
+    if let Some(alpha) = prior {
+        comp.set_prior(alpha)?;
+    }
     let preview = cfg.preview;
     let mut fed = 0;
     while fed < n && fed <= preview {
@@ -245,7 +250,7 @@ mod tests {
             max_acceleration: f64::INFINITY,
             ..OnlineConfig::default()
         };
-        let sim = co_simulate(|f| spec.stepper(f, 3), &member.command, dt, &cfg, 2).unwrap();
+        let sim = co_simulate(|f| spec.stepper(f, 3), &member.command, dt, &cfg, 2, None).unwrap();
         assert_eq!(sim.passes.len(), 2);
         assert_eq!(sim.desired.len(), 2 * member.command.len());
         // the plain runs of both passes are the same program
@@ -272,6 +277,7 @@ mod tests {
                 1.0 / rate,
                 &OnlineConfig::default(),
                 2,
+                None,
             )
             .unwrap();
             for p in &sim.passes {
@@ -302,12 +308,49 @@ mod tests {
     }
 
     #[test]
+    fn a_prior_from_the_rigs_model_compensates_from_the_first_pass() {
+        use crate::compensate::following_error_of;
+        use crate::drive::{closed_loop_coefficients, D1Variant};
+        use crate::ident::LinearModel;
+        let rate = 5000.0;
+        let dt = 1.0 / rate;
+        let p = RigParams::default();
+        let tf = closed_loop_coefficients(&p, D1Variant::Corrected)
+            .transfer_function()
+            .unwrap();
+        let alpha = following_error_of(&LinearModel::continuous(&tf), dt).unwrap();
+        // the P position loop's lag 1/Kv (the sampled loop adds half a sample)
+        assert!((alpha[0] * p.control.kv - 1.0).abs() < 0.1, "{alpha:?}");
+        let rig = VirtualRig::new(p).with_seed(2);
+        let desired = Scenario::Scurve.command(rate, 0.8, 0).unwrap();
+        let cfg = OnlineConfig::default();
+        let cold = co_simulate(|f| rig.stepper(rate, f), &desired, dt, &cfg, 1, None).unwrap();
+        let warm =
+            co_simulate(|f| rig.stepper(rate, f), &desired, dt, &cfg, 1, Some(alpha)).unwrap();
+        assert!(
+            warm.last.reduction > 1.3 * cold.last.reduction,
+            "with the prior {}×, without {}×",
+            warm.last.reduction,
+            cold.last.reduction
+        );
+        assert!(co_simulate(
+            |f| rig.stepper(rate, f),
+            &desired,
+            dt,
+            &cfg,
+            1,
+            Some([f64::NAN; 3])
+        )
+        .is_err());
+    }
+
+    #[test]
     fn bad_programs_are_refused() {
         let rig = VirtualRig::new(RigParams::default());
         let axis = |f| rig.stepper(5000.0, f);
         let cfg = OnlineConfig::default();
-        assert!(co_simulate(axis, &[0.0], 2e-4, &cfg, 1).is_err());
-        assert!(co_simulate(axis, &[0.0, f64::NAN], 2e-4, &cfg, 1).is_err());
-        assert!(co_simulate(axis, &[0.0, 1e-6], 2e-4, &cfg, 0).is_err());
+        assert!(co_simulate(axis, &[0.0], 2e-4, &cfg, 1, None).is_err());
+        assert!(co_simulate(axis, &[0.0, f64::NAN], 2e-4, &cfg, 1, None).is_err());
+        assert!(co_simulate(axis, &[0.0, 1e-6], 2e-4, &cfg, 0, None).is_err());
     }
 }

@@ -45,7 +45,9 @@ pub use history::{
 };
 pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
 pub use learn::{learn, LearnConfig, Learning, NoiseFilter};
-pub use online::{OnlineCompensator, OnlineConfig, OnlineState, OnlineStats, MAX_PREVIEW};
+pub use online::{
+    following_error_of, OnlineCompensator, OnlineConfig, OnlineState, OnlineStats, MAX_PREVIEW,
+};
 pub use online_stream::{CommandRow, CommandStream};
 pub use smoothing::{gaussian_smooth, gaussian_smooth_profile, smooth_step, taper_profile};
 pub use step::CommandPeaks;

@@ -102,7 +102,7 @@
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::ident::{fold_scale, has_avx2, rls_update};
+use crate::ident::{fold_scale, has_avx2, rls_update, LinearModel};
 
 /// Largest preview \[samples\].
 pub const MAX_PREVIEW: usize = 32;
@@ -122,6 +122,9 @@ const SCALE_SAMPLES: usize = 8;
 
 /// Initial covariance of the scaled parameters.
 const P0: f64 = 1e4;
+
+/// Covariance of the scaled parameters of a prior model.
+const P_PRIOR: f64 = 1.0;
 
 /// Settings of the online compensation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -302,6 +305,8 @@ pub struct OnlineCompensator {
     still: usize,
     /// Time constants of the correction `T₁, T₂, T₃` \[s, s², s³\].
     tau: [f64; TERMS],
+    /// The following-error model to start from (`[α₁, α₂, α₃]`), if any.
+    prior: Option<[f64; TERMS]>,
     /// The correction wanted for the last command \[m\].
     last_target: f64,
     state: OnlineState,
@@ -352,6 +357,7 @@ impl OnlineCompensator {
             worse_until: 0,
             still: usize::MAX,
             tau: [0.0; TERMS],
+            prior: None,
             last_target: 0.0,
             state: OnlineState::Learning,
             weight: 0.0,
@@ -371,8 +377,8 @@ impl OnlineCompensator {
         self.u.fill(0.0);
         self.s.fill(0.0);
         self.y.fill(0.0);
-        self.reset_model();
         self.scale = 0.0;
+        self.reset_model();
         self.sum_eu = 0.0;
         self.sum_uu = 0.0;
         self.scale_samples = 0;
@@ -394,6 +400,19 @@ impl OnlineCompensator {
         }
         self.kappa = 1.0;
         self.updates = 0;
+        if let Some(alpha) = self.prior {
+            // the prior's lag sets the time scale; its coefficients start the
+            // estimate with a unit covariance (scaled): a few hundred samples
+            // of data outweigh it
+            self.scale = alpha[0].abs().clamp(self.dt, 1e5 * self.dt);
+            let mut f = 1.0;
+            for (i, (t, a)) in self.theta.iter_mut().zip(alpha).take(n).enumerate() {
+                f *= self.scale;
+                *t = a / f;
+                self.p[i * n + i] = P_PRIOR;
+            }
+            self.updates = self.cfg.min_updates;
+        }
         self.typical = 0.0;
         self.typical_regressor = 0.0;
         self.ms_error = 0.0;
@@ -410,6 +429,23 @@ impl OnlineCompensator {
     /// The settings.
     pub fn config(&self) -> &OnlineConfig {
         &self.cfg
+    }
+
+    /// Start from a following-error model `[α₁, α₂, α₃]` \[s, s², s³\]
+    /// (e.g. [`following_error_of`] an identified model) instead of from
+    /// nothing: the compensation is used from the first sample and the
+    /// estimate goes on from there (kept across [`OnlineCompensator::reset`]).
+    pub fn set_prior(&mut self, alpha: [f64; TERMS]) -> Result<()> {
+        if let Some(v) = alpha.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                channel: "prior following-error model".to_string(),
+                index: 0,
+                value: *v,
+            });
+        }
+        self.prior = Some(alpha);
+        self.reset();
+        Ok(())
     }
 
     /// Counters so far.
@@ -812,6 +848,60 @@ impl OnlineCompensator {
         }
         u
     }
+}
+
+/// The following-error model `[α₁, α₂, α₃]` \[s, s², s³\] of an identified
+/// model sampled every `dt` \[s\], unit DC gain: the moments of its pulse
+/// response `h` (`p = h/Σh`), `α₁ = dt·Σk·p_k`, `α₂ = −dt²/2·Σk²·p_k`,
+/// `α₃ = dt³/6·Σk³·p_k` — the expansion of `1 − G(e^{s·dt})` the
+/// [`OnlineCompensator`] identifies. A model that does not settle (an
+/// integrator, an unstable pole, over two million samples) is refused.
+///
+/// ```
+/// use feedid::compensate::following_error_of;
+/// use feedid::ident::LinearModel;
+/// // y[k] = 0.8·y[k−1] + 0.2·u[k−1]: mean delay 1/(1 − 0.8) = 5 samples
+/// let m = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+/// let a = following_error_of(&m, 1e-3).unwrap();
+/// assert!((a[0] - 5e-3).abs() < 1e-12);
+/// ```
+pub fn following_error_of(model: &LinearModel, dt: f64) -> Result<[f64; TERMS]> {
+    const MAX_SAMPLES: usize = 2_000_000;
+    let sys = model.discrete_state_space(Some(dt))?;
+    let n = sys.order();
+    let (mut x, mut scratch) = (vec![0.0; n], vec![0.0; n]);
+    let mut m = [0.0_f64; 4];
+    let (mut peak, mut quiet) = (0.0_f64, 0usize);
+    for k in 0..MAX_SAMPLES {
+        let u = if k == 0 { 1.0 } else { 0.0 };
+        let h = sys.output(&x, u);
+        sys.advance(&mut x, u, &mut scratch)?;
+        let kf = k as f64;
+        m[0] += h;
+        m[1] += kf * h;
+        m[2] += kf * kf * h;
+        m[3] += kf * kf * kf * h;
+        peak = peak.max(h.abs());
+        let state = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        quiet = if h.abs() <= 1e-15 * peak && state <= 1e-15 * peak.max(f64::MIN_POSITIVE) {
+            quiet + 1
+        } else {
+            0
+        };
+        if !(h.is_finite() && state.is_finite()) {
+            break;
+        }
+        if quiet >= 16 {
+            if m[0].abs() <= 1e-12 || m[0].is_nan() {
+                break;
+            }
+            let p = |i: usize| m[i] / m[0];
+            return Ok([dt * p(1), -0.5 * dt * dt * p(2), dt * dt * dt / 6.0 * p(3)]);
+        }
+    }
+    Err(Error::InvalidModel {
+        reason: "the model's pulse response does not settle (an integrator, an unstable pole or a zero DC gain): it has no following-error time constants",
+    })
 }
 
 #[cfg(test)]

@@ -93,6 +93,12 @@ impl CommandStream {
         })
     }
 
+    /// Start every segment from a following-error model `[α₁, α₂, α₃]`
+    /// ([`OnlineCompensator::set_prior`]).
+    pub fn set_prior(&mut self, alpha: [f64; 3]) -> Result<()> {
+        self.comp.set_prior(alpha)
+    }
+
     /// The compensator (its model, state and counters in this segment).
     pub fn compensator(&self) -> &OnlineCompensator {
         &self.comp
@@ -238,7 +244,7 @@ mod tests {
             preview: lead - 1,
             ..OnlineConfig::default()
         };
-        let sim = co_simulate(|f| rig.stepper(rate, f), &desired, dt, &cfg, 1).unwrap();
+        let sim = co_simulate(|f| rig.stepper(rate, f), &desired, dt, &cfg, 1, None).unwrap();
         let mut stream = CommandStream::new(OnlineConfig::default(), lead, dt, false).unwrap();
         // the stream's sample `lead + j` is the co-simulation's sample j; the
         // lines before carry positions of commands sent before (at rest)

@@ -51,6 +51,7 @@ mod axis;
 mod command;
 mod defects;
 mod design;
+mod excitation;
 mod family;
 mod member;
 mod plant;

@@ -4,13 +4,26 @@
 //! library's command stream, and loud failures.
 
 use std::io::{BufRead, BufReader, Write};
-use std::process::{Command, Stdio};
+use std::process::{Command, Output, Stdio};
 
 use feedid::compensate::{co_simulate, CommandStream, OnlineConfig};
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::signal::Scenario;
 
 const BIN: &str = env!("CARGO_BIN_EXE_feedid");
+
+/// `feedid` with `args`, `input` on its standard input, run to the end.
+fn run(args: &[&str], input: &[u8]) -> Output {
+    let mut child = Command::new(BIN)
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    child.wait_with_output().unwrap()
+}
 
 #[test]
 fn in_a_closed_loop_each_command_comes_before_its_sample_and_equals_the_co_simulation() {
@@ -94,20 +107,10 @@ fn a_replayed_recording_gives_the_librarys_command_stream() {
             expected += &format!("{},{},{}\n", r.time, r.desired, r.command);
         }
     }
-    let mut child = Command::new(BIN)
-        .args(["stream", "--compensate", "--replay", "--command-lead", "5"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(input.as_bytes())
-        .unwrap();
-    let o = child.wait_with_output().unwrap();
+    let o = run(
+        &["stream", "--compensate", "--replay", "--command-lead", "5"],
+        input.as_bytes(),
+    );
     let err = String::from_utf8(o.stderr).unwrap();
     assert!(o.status.success(), "{err}");
     let got = String::from_utf8(o.stdout).unwrap();
@@ -131,22 +134,7 @@ fn a_replayed_recording_gives_the_librarys_command_stream() {
 
 #[test]
 fn a_short_lead_or_replay_without_compensate_exits_2() {
-    let run = |args: &[&str]| {
-        let mut child = Command::new(BIN)
-            .args(args)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(b"0,0,0\n0.001,0,0\n")
-            .unwrap();
-        child.wait_with_output().unwrap()
-    };
+    let run = |args: &[&str]| run(args, b"0,0,0\n0.001,0,0\n");
     let o = run(&["stream", "--compensate", "--command-lead", "2"]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8(o.stderr).unwrap();
@@ -185,20 +173,10 @@ fn refused_lines_are_reported_with_their_number_and_skipped() {
             input += &format!("{t},{},0\n", 1e-4 * k as f64);
         }
     }
-    let mut child = Command::new(BIN)
-        .args(["stream", "--compensate", "--command-lead", "3"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(input.as_bytes())
-        .unwrap();
-    let o = child.wait_with_output().unwrap();
+    let o = run(
+        &["stream", "--compensate", "--command-lead", "3"],
+        input.as_bytes(),
+    );
     let err = String::from_utf8(o.stderr).unwrap();
     assert!(o.status.success(), "{err}");
     assert!(

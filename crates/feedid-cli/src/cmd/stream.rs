@@ -31,7 +31,7 @@ use crate::cmd::method::OrderOption;
 use crate::cmd::recording::read_options;
 
 /// Messages of one kind printed at most (the summary counts them all).
-pub(super) const MAX_MESSAGES: usize = 100;
+const MAX_MESSAGES: usize = 100;
 
 /// Run on the process's standard streams.
 pub fn run(a: &StreamArgs) -> Result<()> {
@@ -158,24 +158,9 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
             break;
         };
         lines.read += 1;
-        let (no, t, u, y) = match line {
-            StreamLine::Header { .. } => {
-                lines.headers += 1;
-                continue;
-            }
-            StreamLine::Skipped { error, .. } => {
-                lines.skipped += 1;
-                if lines.skipped <= MAX_MESSAGES {
-                    let _ = writeln!(err, "{error}; skipped");
-                }
-                continue;
-            }
-            StreamLine::Sample {
-                line,
-                time,
-                command,
-                position,
-            } => (line, time, command, position),
+        let Some((no, t, u, y)) = sample(line, &mut lines.headers, &mut lines.skipped, &mut err)
+        else {
+            continue;
         };
         match s.push(t, u, y) {
             Ok(arrival) => {
@@ -189,10 +174,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
                 }
             }
             Err(e) => {
-                lines.skipped += 1;
-                if lines.skipped <= MAX_MESSAGES {
-                    let _ = writeln!(err, "stdin: line {no}: {e}; skipped");
-                }
+                refuse(&mut err, &mut lines.skipped, no, &e);
                 continue;
             }
         }
@@ -233,6 +215,50 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         );
     }
     Ok(())
+}
+
+/// The sample a line carries: `(line number, time, command, position)`;
+/// `None` for a header (counted) or a line the reader skipped (counted and
+/// reported, the first hundred).
+pub(super) fn sample<E: Write>(
+    line: StreamLine,
+    headers: &mut usize,
+    skipped: &mut usize,
+    err: &mut E,
+) -> Option<(usize, f64, f64, f64)> {
+    match line {
+        StreamLine::Header { .. } => {
+            *headers += 1;
+            None
+        }
+        StreamLine::Skipped { error, .. } => {
+            *skipped += 1;
+            if *skipped <= MAX_MESSAGES {
+                let _ = writeln!(err, "{error}; skipped");
+            }
+            None
+        }
+        StreamLine::Sample {
+            line,
+            time,
+            command,
+            position,
+        } => Some((line, time, command, position)),
+    }
+}
+
+/// A line the streamer refuses (its time, a value) is reported with its
+/// number (the first hundred) and skipped.
+pub(super) fn refuse<E: Write>(
+    err: &mut E,
+    skipped: &mut usize,
+    no: usize,
+    e: &dyn std::fmt::Display,
+) {
+    *skipped += 1;
+    if *skipped <= MAX_MESSAGES {
+        let _ = writeln!(err, "stdin: line {no}: {e}; skipped");
+    }
 }
 
 /// Report a gap or an irregular interval (the first hundred of each).

@@ -13,9 +13,9 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use feedid::compensate::{following_error_of, CommandStream, OnlineConfig, OnlineState};
-use feedid::io::{CommandRows, StreamLine, StreamReader};
+use feedid::io::{CommandRows, StreamReader};
 
-use super::stream::{check_writing, Output, MAX_MESSAGES};
+use super::stream::{check_writing, refuse, sample, Output};
 use crate::args::StreamArgs;
 use crate::cmd::recording::read_options;
 
@@ -62,28 +62,15 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
     let mut stream: Option<CommandStream> = None;
     // without --rate the interval comes from the first two lines
     let mut first: Option<(f64, f64, f64)> = None;
-    let (mut read, mut skipped, mut used) = (0usize, 0usize, 0usize);
+    let (mut read, mut headers, mut skipped, mut used) = (0usize, 0usize, 0usize, 0usize);
     let mut output = Output::Open;
     while let Output::Open = output {
         let Some(line) = reader.next_line()? else {
             break;
         };
         read += 1;
-        let (no, t, u, y) = match line {
-            StreamLine::Header { .. } => continue,
-            StreamLine::Skipped { error, .. } => {
-                skipped += 1;
-                if skipped <= MAX_MESSAGES {
-                    let _ = writeln!(err, "{error}; skipped");
-                }
-                continue;
-            }
-            StreamLine::Sample {
-                line,
-                time,
-                command,
-                position,
-            } => (line, time, command, position),
+        let Some((no, t, u, y)) = sample(line, &mut headers, &mut skipped, &mut err) else {
+            continue;
         };
         let s = match &mut stream {
             Some(s) => s,
@@ -155,15 +142,6 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         bail!("no usable line in the input ({read} read, {skipped} skipped)");
     }
     Ok(())
-}
-
-/// A line the compensation refuses (not finite, time not after the last)
-/// is reported with its number (the first hundred) and skipped.
-fn refuse<E: Write>(err: &mut E, skipped: &mut usize, no: usize, e: &dyn std::fmt::Display) {
-    *skipped += 1;
-    if *skipped <= MAX_MESSAGES {
-        let _ = writeln!(err, "stdin: line {no}: {e}; skipped");
-    }
 }
 
 /// The summary on standard error.

@@ -326,6 +326,7 @@ def identify(
     global_model: bool = True,
     residuals: bool = True,
     interval: float = 95.0,
+    runaway: Optional[float] = 1.5,
     **options: Any,
 ) -> Identification:
     """Identify a recording in short sliding windows and predict the next
@@ -376,7 +377,15 @@ def identify(
         and their keys out of the summary.
     interval : float
         Probability of the prediction intervals ``lower``/``upper`` [%],
-        in (0, 100); default 95 (``--interval``).
+        in (0, 100); default 95 (``--interval``). The summary has their
+        median width (``interval_median_width_m``) and their coverage per
+        command regime (``interval_by_regime``).
+    runaway : float or None
+        A predicted sample farther from the last measured position than
+        this many times the motion the axis has shown in as many samples is
+        cut back, its interval widened (``--runaway``; default 1.5; the
+        summary counts ``runaway_windows``, ``runaway_samples``); None keeps
+        every prediction as the method made it.
     **options
         Method options: ``solver``, ``time_origin``, ``prediction``,
         ``simplex_start`` (paper), ``lambda`` (rls forgetting factor),
@@ -418,6 +427,7 @@ def identify(
         global_model=global_model,
         residuals=residuals,
         interval=interval,
+        runaway=runaway,
         **_params(params),
         **_method_options(order, options),
     )
@@ -455,6 +465,8 @@ class Streamer:
         ARX orders (``"auto"`` is refused: a stream needs them given).
     interval : float
         Probability of the prediction intervals [%]; default 95.
+    runaway : float or None
+        The runaway cut as for :func:`identify` (default 1.5; None: off).
     **options
         Method options as for :func:`identify`.
 
@@ -475,10 +487,12 @@ class Streamer:
         jitter_tol: float = 0.01,
         order: Optional[Union[str, Sequence[int]]] = None,
         interval: float = 95.0,
+        runaway: Optional[float] = 1.5,
         **options: Any,
     ):
         self._s = _feedid.Streamer(
             interval=interval,
+            runaway=runaway,
             rate=rate,
             method=method,
             window=window,
@@ -513,7 +527,9 @@ class Streamer:
         """Counters and scores so far: lines, samples, windows,
         predicted_ahead, predicted_late, gaps, rms_error_m (None before any
         sample was scored), hold_rms_error_m (the hold baseline on the same
-        samples), interval_coverage_percent, outliers, ..."""
+        samples), interval_coverage_percent, interval_by_regime (per command
+        regime: samples, coverage_percent), runaway_windows,
+        runaway_samples, outliers, ..."""
         return self._s.stats
 
     @property

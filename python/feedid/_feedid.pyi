@@ -92,6 +92,7 @@ class Streamer:
         lambda_: Optional[float] = None,
         ridge: Optional[float] = None,
         interval: float = 95.0,
+        runaway: Optional[float] = 1.5,
     ) -> None: ...
     def push(self, t: float, u: float, y: float) -> List[_Row]: ...
     def push_many(
@@ -140,6 +141,7 @@ def identify(
     lambda_: Optional[float] = None,
     ridge: Optional[float] = None,
     interval: float = 95.0,
+    runaway: Optional[float] = 1.5,
     params_path: Optional[str] = None,
     params_json: Optional[str] = None,
     allow_unstable: bool = False,

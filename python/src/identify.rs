@@ -5,7 +5,7 @@
 //! place (a borrowed, checked [`feedid::RecordingRef`]) and handing its
 //! arrays to NumPy without copies.
 
-use feedid::ident::{OrderSearch, RESIDUAL_LAGS};
+use feedid::ident::{GuardConfig, OrderSearch, RESIDUAL_LAGS};
 use feedid::pipeline::Pipeline;
 use feedid::RecordingRef;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
@@ -28,7 +28,7 @@ use crate::recording::{slice, PyRecording};
 #[pyo3(signature = (recording = None, *, time = None, command = None, position = None,
     jitter_tol = 0.01, method = "auto", window = None, horizon = 10, hop = None,
     order = None, solver = None, time_origin = None, prediction = None, simplex_start = None, lambda_ = None,
-    ridge = None, interval = 95.0, params_path = None, params_json = None, allow_unstable = false,
+    ridge = None, interval = 95.0, runaway = Some(1.5), params_path = None, params_json = None, allow_unstable = false,
     nominal = true, global_model = true, residuals = true))]
 #[allow(clippy::too_many_arguments)]
 pub fn identify<'py>(
@@ -50,6 +50,7 @@ pub fn identify<'py>(
     lambda_: Option<f64>,
     ridge: Option<f64>,
     interval: f64,
+    runaway: Option<f64>,
     params_path: Option<String>,
     params_json: Option<String>,
     allow_unstable: bool,
@@ -68,6 +69,7 @@ pub fn identify<'py>(
     };
     let method = options.method(method)?;
     let interval = crate::method::interval(interval)?;
+    let runaway = crate::method::runaway(runaway)?;
     let select = matches!(options.order_option()?, Some(OrderOption::Select));
     let params = crate::params::load(
         params_path.as_deref(),
@@ -78,7 +80,11 @@ pub fn identify<'py>(
         .window_or_default(window)
         .horizon(horizon)
         .hop(hop)
-        .interval(interval)
+        .guard(GuardConfig {
+            interval,
+            runaway,
+            ..GuardConfig::default()
+        })
         .method_global_model(global_model)
         .residuals(if residuals { Some(RESIDUAL_LAGS) } else { None });
     if nominal {

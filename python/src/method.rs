@@ -132,6 +132,17 @@ impl MethodOptions {
     }
 }
 
+/// The runaway factor (`--runaway`): ≥ 1, or `None` (off).
+pub fn runaway(factor: Option<f64>) -> PyResult<Option<f64>> {
+    match factor {
+        #[allow(clippy::neg_cmp_op_on_partial_ord)] // rejects NaN
+        Some(k) if !(k.is_finite() && k >= 1.0) => Err(input(format!(
+            "invalid runaway {k}: a factor ≥ 1 (default 1.5), or None to keep every prediction as the method made it"
+        ))),
+        k => Ok(k),
+    }
+}
+
 /// The probability of the prediction intervals \[%\] → a fraction, checked
 /// as `--interval` is.
 pub fn interval(percent: f64) -> PyResult<f64> {

@@ -3,7 +3,7 @@
 //! the predictions that became due.
 
 use feedid::ident::stream::{CommandExtrapolation, StreamOptions, StreamStats};
-use feedid::ident::{EngineConfig, Estimator, GuardConfig, Streamer};
+use feedid::ident::{EngineConfig, Estimator, GuardConfig, Regime, Streamer};
 use std::sync::{Mutex, MutexGuard};
 
 use numpy::PyReadonlyArray1;
@@ -73,6 +73,22 @@ fn stats_dict<'py>(py: Python<'py>, s: &StreamStats) -> PyResult<Bound<'py, PyDi
     d.set_item("hold_rms_error_m", some(s.hold.rms))?;
     d.set_item("interval_coverage_percent", s.interval_coverage_percent())?;
     d.set_item("outliers", s.outliers)?;
+    d.set_item("runaway_windows", s.runaway_windows)?;
+    d.set_item("runaway_samples", s.runaway_samples)?;
+    let regimes = PyDict::new(py);
+    for r in Regime::ALL {
+        let n = s.regime_samples[r.index()];
+        if n > 0 {
+            let c = PyDict::new(py);
+            c.set_item("samples", n)?;
+            c.set_item(
+                "coverage_percent",
+                100.0 * s.regime_inside[r.index()] as f64 / n as f64,
+            )?;
+            regimes.set_item(r.name(), c)?;
+        }
+    }
+    d.set_item("interval_by_regime", regimes)?;
     Ok(d)
 }
 
@@ -82,7 +98,7 @@ impl PyStreamer {
     #[pyo3(signature = (*, rate = None, method = "auto", window = None, horizon = 10, hop = None,
         command_lead = 0, extrapolate = None, jitter_tol = 0.01, order = None, solver = None,
         time_origin = None, prediction = None, simplex_start = None, lambda_ = None, ridge = None,
-        interval = 95.0))]
+        interval = 95.0, runaway = Some(1.5)))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         rate: Option<f64>,
@@ -101,6 +117,7 @@ impl PyStreamer {
         lambda_: Option<f64>,
         ridge: Option<f64>,
         interval: f64,
+        runaway: Option<f64>,
     ) -> PyResult<Self> {
         let options = MethodOptions {
             order,
@@ -118,6 +135,7 @@ impl PyStreamer {
         }
         let method = options.method(method)?;
         let interval = crate::method::interval(interval)?;
+        let runaway = crate::method::runaway(runaway)?;
         if let Some(r) = rate {
             if !(r.is_finite() && r > 0.0) {
                 return Err(input(format!(
@@ -142,6 +160,7 @@ impl PyStreamer {
             jitter_tolerance: jitter_tol,
             guard: GuardConfig {
                 interval,
+                runaway,
                 ..GuardConfig::default()
             },
             ..StreamOptions::default()

@@ -79,6 +79,8 @@ def test_options_reach_the_method_as_on_the_command_line(cli, tmp_path):
         (["--method", "paper", "--solver", "simplex"], dict(method="paper", solver="simplex")),
         (["--method", "arx", "--ridge", "1e-6", "--interval", "80"],
          dict(method="arx", ridge=1e-6, interval=80)),
+        (["--method", "paper", "--runaway", "off"], dict(method="paper", runaway=None)),
+        (["--method", "oe", "--runaway", "3"], dict(method="oe", runaway=3.0)),
     ]
     for args, kw in cases:
         pred, coef, summ = cli_identify(cli, tmp_path, rec_path, *args)
@@ -258,3 +260,25 @@ def test_online_compensation_equals_the_cli_stream_line_by_line(cli, tmp_path):
     assert np.max(np.abs(warm_rows[:, 1:] - cli_warm[:, 1:])) <= 1e-12 * scale
     with pytest.raises(feedid.InputError, match="different lengths"):
         comp.push_many(t, u[:-1], y)
+
+
+def test_runaway_cuts_and_regime_intervals_are_in_the_summary_as_on_the_command_line(cli, tmp_path):
+    rec_path = tmp_path / "ramp.csv"
+    cli("simulate", "--scenario", "ramp", "--seed", 1, "-o", rec_path)
+    on = feedid.identify(feedid.read(rec_path), method="paper")
+    off = feedid.identify(feedid.read(rec_path), method="paper", runaway=None)
+    assert on.summary["runaway_windows"] > 0
+    assert off.summary["runaway_windows"] == 0
+    assert on.summary["max_abs_error_m"] < off.summary["max_abs_error_m"]
+    regimes = on.summary["interval_by_regime"]
+    assert sum(r["samples"] for r in regimes) == on.summary["samples_predicted"]
+    assert on.summary["interval_median_width_m"] > 0
+    with pytest.raises(feedid.InputError, match="factor"):
+        feedid.identify(feedid.read(rec_path), runaway=0.5)
+    s = feedid.Streamer(rate=5000.0, extrapolate="wait", runaway=None)
+    s.push_many(np.array(feedid.read(rec_path).time), np.array(feedid.read(rec_path).command),
+                np.array(feedid.read(rec_path).position))
+    s.finish()
+    st = s.stats
+    assert st["runaway_windows"] == 0
+    assert sum(v["samples"] for v in st["interval_by_regime"].values()) == st["samples_scored"]

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use feedid::ident::Span;
 
 /// Identify feed-drive dynamics in short sliding windows and predict the next milliseconds.
 #[derive(Debug, Parser)]
@@ -199,15 +200,15 @@ pub struct MethodOptions {
 /// Sliding-window options.
 #[derive(Debug, Clone, Args)]
 pub struct WindowArgs {
-    /// Window length W [samples] [default: the method's, see below].
-    #[arg(long, long_help = window_help())]
-    pub window: Option<usize>,
-    /// Prediction horizon H [samples].
-    #[arg(long, default_value_t = 10)]
-    pub horizon: usize,
-    /// Shift between windows [samples]; default: the horizon.
-    #[arg(long)]
-    pub hop: Option<usize>,
+    /// Window length W [samples, or a time: 10ms] [default: the method's, see below].
+    #[arg(long, value_name = "N|TIME", long_help = window_help())]
+    pub window: Option<Span>,
+    /// Prediction horizon H: samples (10) or a time (2ms, at the recording's rate).
+    #[arg(long, value_name = "N|TIME", default_value = "10")]
+    pub horizon: Span,
+    /// Shift between windows: samples or a time; default: the horizon.
+    #[arg(long, value_name = "N|TIME")]
+    pub hop: Option<Span>,
 }
 
 /// `--window`'s help, with every method's default window.
@@ -217,7 +218,7 @@ fn window_help() -> String {
         .map(|m| format!("{} {}", m.name(), m.default_window()))
         .collect();
     format!(
-        "Window length W [samples]; default: the method's ({})",
+        "Window length W: samples, or a time with its unit (20ms, at the recording's rate); default: the method's, in samples ({})",
         defaults.join(", ")
     )
 }
@@ -251,6 +252,11 @@ pub struct IdentifyArgs {
     /// Probability of the prediction intervals (lower_m, upper_m) [%], in (0, 100).
     #[arg(long, value_name = "P", default_value_t = 95.0)]
     pub interval: f64,
+    /// Cut back a predicted sample that leaves FACTOR times the motion the
+    /// axis has shown in as many samples (its interval widened to the hold);
+    /// `off` keeps every prediction as the method made it.
+    #[arg(long, value_name = "FACTOR|off", default_value = "1.5")]
+    pub runaway: Runaway,
     /// Rig parameters of the nominal simulation model (TOML); default: the built-in rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
@@ -356,6 +362,11 @@ pub struct StreamArgs {
     /// Probability of the prediction intervals (lower_m, upper_m) [%], in (0, 100).
     #[arg(long, value_name = "P", default_value_t = 95.0)]
     pub interval: f64,
+    /// Cut back a predicted sample that leaves FACTOR times the motion the
+    /// axis has shown in as many samples (its interval widened to the hold);
+    /// `off` keeps every prediction as the method made it.
+    #[arg(long, value_name = "FACTOR|off", default_value = "1.5")]
+    pub runaway: Runaway,
     /// How to read the lines (as a recording file; without a header and
     /// without column options: time, command, position are columns 1, 2, 3).
     #[command(flatten)]
@@ -631,4 +642,24 @@ pub struct CompensateArgs {
         requires = "measured"
     )]
     pub noise_filter: String,
+}
+
+/// `--runaway`: a factor ≥ 1, or `off`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Runaway(pub Option<f64>);
+
+impl std::str::FromStr for Runaway {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.eq_ignore_ascii_case("off") {
+            return Ok(Runaway(None));
+        }
+        match s.parse::<f64>() {
+            Ok(k) if k.is_finite() && k >= 1.0 => Ok(Runaway(Some(k))),
+            _ => Err(format!(
+                "{s:?}: expected a factor ≥ 1 (the default is 1.5) or `off`"
+            )),
+        }
+    }
 }

@@ -362,6 +362,87 @@ fn identify_simplex_agrees_with_qr_on_the_ramp() {
     assert_fails(&o, "--simplex-start");
 }
 
+/// `feedid identify INPUT ARGS -o DIR/NAME.csv --summary DIR/NAME.json`,
+/// which must succeed: (standard output, predictions file, summary).
+fn identify_with_summary(
+    dir: &Path,
+    input: &Path,
+    args: &[&str],
+    name: &str,
+) -> (String, String, serde_json::Value) {
+    let out = dir.join(format!("{name}.csv"));
+    let summ = dir.join(format!("{name}.json"));
+    let mut all = vec!["identify", input.to_str().unwrap()];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&[
+        "-o",
+        out.to_str().unwrap(),
+        "--summary",
+        summ.to_str().unwrap(),
+    ]);
+    let o = feedid(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    (
+        stdout(&o),
+        std::fs::read_to_string(&out).unwrap(),
+        serde_json::from_str(&std::fs::read_to_string(&summ).unwrap()).unwrap(),
+    )
+}
+
+#[test]
+fn window_horizon_and_hop_in_time_are_the_samples_at_the_recordings_rate() {
+    // the rig's ramp at 5 kHz: 10ms = 50 samples, 2ms = 10, 0.6ms = 3
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let time = ["--window", "10ms", "--horizon", "2ms", "--hop", "0.6ms"];
+    let (_, a, va) = identify_with_summary(dir.path(), &input, &time, "time");
+    let samples = ["--window", "50", "--horizon", "10", "--hop", "3"];
+    let (_, b, vb) = identify_with_summary(dir.path(), &input, &samples, "samples");
+    for key in ["window", "horizon", "hop"] {
+        assert_eq!(va[key], vb[key], "{key}");
+    }
+    assert_eq!(vb["horizon"], 10);
+    assert_eq!(a, b);
+    // a time shorter than a sample, or not a length: exit 2, named
+    let out = dir.path().join("x.csv");
+    let (i, o) = (input.to_str().unwrap(), out.to_str().unwrap());
+    let r = feedid(&["identify", i, "--horizon", "50us", "-o", o]);
+    assert_fails(&r, "shorter than one sample");
+    assert!(!out.exists());
+    let r = feedid(&["identify", i, "--horizon", "2 meters", "-o", o]);
+    assert_fails(&r, "2ms");
+}
+
+#[test]
+fn runaways_are_cut_back_by_default_counted_and_can_be_turned_off() {
+    // paper on the rig's ramp: its polynomials run away at the start of
+    // the motion; the summary counts the windows cut back, its intervals
+    // per command regime and their median width
+    let dir = tempfile::tempdir().unwrap();
+    let input = simulated(dir.path(), "ramp");
+    let paper = |extra: &[&str], name: &str| {
+        let mut args = vec!["--method", "paper"];
+        args.extend_from_slice(extra);
+        let (text, _, v) = identify_with_summary(dir.path(), &input, &args, name);
+        (text, v)
+    };
+    let (text, on) = paper(&[], "on");
+    let (_, off) = paper(&["--runaway", "off"], "off");
+    let cut = on["runaway_windows"].as_u64().unwrap();
+    assert!(cut > 0, "{on}");
+    assert!(text.contains("cut back as runaways"), "{text}");
+    assert_eq!(off["runaway_windows"], 0);
+    let max = |v: &serde_json::Value| v["max_abs_error_m"].as_f64().unwrap();
+    assert!(max(&on) < max(&off), "{} vs {}", max(&on), max(&off));
+    let regimes = on["interval_by_regime"].as_array().unwrap();
+    let n: u64 = regimes.iter().map(|r| r["samples"].as_u64().unwrap()).sum();
+    assert_eq!(n, on["samples_predicted"].as_u64().unwrap());
+    assert!(on["interval_median_width_m"].as_f64().unwrap() > 0.0);
+    let i = input.to_str().unwrap();
+    let r = feedid(&["identify", i, "--runaway", "0.5", "-o", "x.csv"]);
+    assert_fails(&r, "expected a factor ≥ 1");
+}
+
 #[test]
 fn identify_options_window_horizon_hop_time_origin_and_tf_prediction() {
     let dir = tempfile::tempdir().unwrap();

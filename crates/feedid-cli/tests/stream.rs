@@ -686,3 +686,48 @@ fn no_usable_line_and_an_unwritable_output_exit_2_and_a_closed_reader_exits_0() 
     w.join().unwrap();
     assert_eq!(child.wait().unwrap().code(), Some(0));
 }
+
+#[test]
+fn a_stream_that_loses_to_holding_says_so_with_figures_cause_and_options() {
+    // a heavy 100 Hz axis of the drive zoo (member 112: a ramp program,
+    // Kv 10.8) with the held command over a 20-sample (200 ms) horizon:
+    // the predictions lose to holding the last position
+    let rec = feedid::zoo::Zoo::standard()
+        .member(112)
+        .unwrap()
+        .recording()
+        .unwrap();
+    assert!((rec.rate_hz() - 100.0).abs() < 1e-6);
+    let (_, err) = stream(
+        &["--extrapolate", "hold", "--horizon", "20"],
+        &csv(&rec, true),
+    );
+    assert!(err.contains("lost to holding the last position"), "{err}");
+    for needle in [
+        "200.000 ms",
+        "--command-lead",
+        "--extrapolate wait",
+        "µm against",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    // a time needs the rate in a stream
+    let o = stream_output(&["--horizon", "2ms"], &csv(&rec, true));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--rate"));
+    // with it, 20ms is 2 samples at 100 Hz
+    let (out, err) = stream(&["--horizon", "20ms", "--rate", "100"], &csv(&rec, true));
+    assert!(err.contains("scored"), "{err}");
+    // each window predicts 2 samples: "windows N: P predicted, …; R rows written"
+    let line = err.lines().find(|l| l.starts_with("windows ")).unwrap();
+    let predicted: usize = line
+        .split(": ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(rows(&out).len(), 2 * predicted, "{line}");
+}

@@ -1,7 +1,9 @@
 //! Benchmark: batch throughput of the default method `auto` (W = 50, H =
 //! hop = 10) and of the paper method (QR, W = 20) with the single-threaded
 //! engine over one hour of 5 kHz data (18 million samples, 1.8 million
-//! windows). Target for the default method: ≤ 10 s.
+//! windows). Target for the default method: ≤ 10 s. `auto` runs twice: with
+//! the engine's default guard and with its runaway cut off
+//! ([`GuardConfig::runaway`] `None`): the difference is the runaway cut's cost.
 //!
 //! The hour is generated cheaply: one 1.4 s period of a back-and-forth move
 //! (50 ms rest, 30 mm forward at 50 mm/s, 100 ms hold, back, 50 ms rest) is
@@ -14,8 +16,8 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use feedid::drive::{RigParams, VirtualRig};
-use feedid::ident::engine::run;
-use feedid::ident::{EngineConfig, Estimator, Method, Signals};
+use feedid::ident::engine::run_with;
+use feedid::ident::{EngineConfig, Estimator, GuardConfig, Method, Signals};
 use std::time::{Duration, Instant};
 
 const RATE: f64 = 5000.0;
@@ -72,9 +74,18 @@ fn hour(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(1))
         .measurement_time(Duration::from_secs(1))
         .throughput(Throughput::Elements(n as u64));
-    for (name, label) in [
-        ("auto", "auto_engine_one_hour_5khz"),
-        ("paper", "paper_qr_engine_one_hour_5khz"),
+    let uncut = GuardConfig {
+        runaway: None,
+        ..GuardConfig::default()
+    };
+    for (name, label, guard) in [
+        ("auto", "auto_engine_one_hour_5khz", GuardConfig::default()),
+        ("auto", "auto_engine_one_hour_5khz_no_runaway_cut", uncut),
+        (
+            "paper",
+            "paper_qr_engine_one_hour_5khz",
+            GuardConfig::default(),
+        ),
     ] {
         let spec: Method = name.parse().unwrap_or_else(|e| panic!("{e}"));
         let cfg = EngineConfig {
@@ -83,7 +94,7 @@ fn hour(c: &mut Criterion) {
         };
         let mut est = spec.build().unwrap_or_else(|e| panic!("{e}"));
         // one reported run first: failures and the engine's own timing
-        let r = run(&mut est, &signals, &cfg).unwrap_or_else(|e| panic!("{e}"));
+        let r = run_with(&mut est, &signals, &cfg, &guard, None).unwrap_or_else(|e| panic!("{e}"));
         eprintln!(
             "{}: {} windows, {} failed, {} withheld, {} predicted samples, rms {:.3e} m; engine time {:.2} s ({:.3} µs/window)",
             est.name(),
@@ -98,7 +109,8 @@ fn hour(c: &mut Criterion) {
         drop(r);
         g.bench_function(label, |b| {
             b.iter(|| {
-                let r = run(&mut est, &signals, &cfg).unwrap_or_else(|e| panic!("{e}"));
+                let r = run_with(&mut est, &signals, &cfg, &guard, None)
+                    .unwrap_or_else(|e| panic!("{e}"));
                 black_box(r.stats.rms)
             })
         });

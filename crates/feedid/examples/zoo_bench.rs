@@ -78,7 +78,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use feedid::ident::{engine, EngineConfig, Method};
+use feedid::ident::{engine, EngineConfig, Method, Regime};
 use feedid::zoo::{Zoo, ZooMember};
 use feedid::Recording;
 use nalgebra::{DMatrix, DVector};
@@ -110,8 +110,9 @@ struct Predictions {
     value: Vec<f64>,
     /// Whether the sample is predicted.
     has: Vec<bool>,
-    /// Lower and upper 95 % interval bounds, when the method gives them.
-    interval: Option<(Vec<f64>, Vec<f64>)>,
+    /// Lower and upper 95 % interval bounds and each sample's command
+    /// regime, when the method gives them.
+    interval: Option<(Vec<f64>, Vec<f64>, Vec<Regime>)>,
     /// First sample the method can predict (the end of its first window).
     first: usize,
     /// Wall time \[s\].
@@ -121,7 +122,12 @@ struct Predictions {
 }
 
 /// Predictions, their flags, the interval bounds and the first predicted sample.
-type RunOutput = (Vec<f64>, Vec<bool>, (Vec<f64>, Vec<f64>), usize);
+type RunOutput = (
+    Vec<f64>,
+    Vec<bool>,
+    (Vec<f64>, Vec<f64>, Vec<Regime>),
+    usize,
+);
 
 /// Every use of the identification API: the five library methods with their
 /// defaults (window per method, H = 10, hop = H), as `feedid identify` runs
@@ -144,7 +150,12 @@ fn run_library_methods(rec: &Recording) -> Vec<Predictions> {
                 };
                 let r = engine::run(&mut est, &signals, &cfg)?;
                 let first = r.windows.first().map_or(n, |w| w.horizon.start);
-                Ok((r.predicted, r.has_prediction, (r.lower, r.upper), first))
+                Ok((
+                    r.predicted,
+                    r.has_prediction,
+                    (r.lower, r.upper, r.regimes),
+                    first,
+                ))
             };
             match run() {
                 Ok((value, has, interval, first)) => Predictions {
@@ -384,6 +395,9 @@ fn loses_significantly(y: &[f64], a: &Predictions, b: &Predictions, scored: &[bo
 }
 
 /// One method on one member.
+/// Fewest scored samples of a command regime for its coverage to count.
+const MIN_REGIME: usize = 200;
+
 #[derive(Clone)]
 struct Row {
     member: usize,
@@ -402,6 +416,8 @@ struct Row {
     beaten_by: Option<&'static str>,
     baseline_ratio: Option<f64>,
     interval_coverage: Option<f64>,
+    /// Scored samples and of them inside their interval, per command regime.
+    by_regime: [(usize, usize); 5],
     seconds: f64,
     note: String,
     /// Gaps of dropped samples in the member (0 for a regular one).
@@ -438,6 +454,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
         beaten_by: None,
         baseline_ratio: None,
         interval_coverage: None,
+        by_regime: [(0, 0); 5],
         seconds: 0.0,
         note: String::new(),
         gaps: 0,
@@ -541,12 +558,17 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                     }
                 }
             }
-            let interval_coverage = p.interval.as_ref().map(|(lo, hi)| {
+            let mut by_regime = [(0usize, 0usize); 5];
+            let interval_coverage = p.interval.as_ref().map(|(lo, hi, regime)| {
                 let (mut inside, mut total) = (0usize, 0usize);
                 for k in 0..n {
                     if p.has[k] && scored[k] {
                         total += 1;
-                        inside += usize::from(lo[k] <= y[k] && y[k] <= hi[k]);
+                        let i = usize::from(lo[k] <= y[k] && y[k] <= hi[k]);
+                        inside += i;
+                        let r = &mut by_regime[regime[k].index()];
+                        r.0 += 1;
+                        r.1 += i;
                     }
                 }
                 100.0 * inside as f64 / total.max(1) as f64
@@ -562,6 +584,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                 beaten_by: worst.filter(|w| w.1 > 1.0).map(|w| w.0),
                 baseline_ratio: worst.map(|w| w.1),
                 interval_coverage,
+                by_regime,
                 gap_cost: without_gaps.as_ref().and_then(|(full, kept)| {
                     let q = full.iter().find(|q| q.name == p.name)?;
                     let (mut a, mut b, mut n_shared) = (0.0, 0.0, 0usize);
@@ -789,6 +812,62 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             fmt(quantile(&cov, 0.5), 1),
             fmt(quantile(&rms, 0.5), 3),
             fmt(quantile(&intervals, 0.5), 1),
+        );
+    }
+    // intervals and largest errors: per member, per regime, against the hold
+    println!(
+        "\nPrediction intervals and largest errors: members whose 95 % interval coverage is \
+         within [90, 98] %; (member, command regime) pairs with ≥ {MIN_REGIME} scored samples \
+         and of them those below 80 %; members whose largest error is at most 1.5× the \
+         hold's on the same member:\n"
+    );
+    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's |");
+    println!("|---|---:|---:|---:|---:|---:|---:|");
+    for method in LIBRARY {
+        let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == method).collect();
+        let within = mine
+            .iter()
+            .filter(|r| {
+                r.interval_coverage
+                    .is_some_and(|c| (90.0..=98.0).contains(&c))
+            })
+            .count();
+        let pairs: Vec<f64> = mine
+            .iter()
+            .flat_map(|r| r.by_regime.iter())
+            .filter(|(n, _)| *n >= MIN_REGIME)
+            .map(|(n, i)| 100.0 * *i as f64 / *n as f64)
+            .collect();
+        let below = pairs.iter().filter(|&&c| c < 80.0).count();
+        let worst_regime = pairs.iter().copied().fold(f64::INFINITY, f64::min);
+        let ratios: Vec<f64> = mine
+            .iter()
+            .filter_map(|r| {
+                let hold = scored
+                    .iter()
+                    .find(|h| h.method == "hold" && h.member == r.member)?;
+                Some(r.max? / hold.max?)
+            })
+            .filter(|q| q.is_finite())
+            .collect();
+        let bounded = ratios.iter().filter(|&&q| q <= 1.5).count();
+        println!(
+            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} |",
+            mine.len(),
+            pairs.len(),
+            if worst_regime.is_finite() {
+                format!("{worst_regime:.1}")
+            } else {
+                "–".into()
+            },
+            ratios.len(),
+            fmt(
+                ratios
+                    .iter()
+                    .copied()
+                    .fold(None, |a: Option<f64>, q| Some(a.map_or(q, |a| a.max(q)))),
+                2
+            ),
         );
     }
     // the same count for every phase of the baselines' blocks

@@ -25,7 +25,7 @@ use std::fmt::Write as _;
 
 use crate::drive::{RigEffects, RigParams, VirtualRig};
 use crate::error::Result;
-use crate::ident::{EngineConfig, Method, PaperConfig, Solver};
+use crate::ident::{EngineConfig, GuardConfig, Method, PaperConfig, Solver};
 use crate::pipeline::{Identification, Pipeline};
 use crate::recording::Recording;
 use crate::signal::Scenario;
@@ -232,6 +232,11 @@ pub fn run_experiment(scenario: Scenario, cfg: &PaperExperimentConfig) -> Result
         runs.push(
             Pipeline::new(method)
                 .engine(cfg.engine)
+                // the paper's method as published: no runaway cut
+                .guard(GuardConfig {
+                    runaway: None,
+                    ..GuardConfig::default()
+                })
                 .method_global_model(false)
                 .nominal(cfg.params)
                 .run(&recording)?,

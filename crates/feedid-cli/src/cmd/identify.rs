@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use feedid::ident::{GlobalModelKind, OrderSearch, SlidingResult};
+use feedid::ident::{GlobalModelKind, GuardConfig, OrderSearch, SlidingResult};
 use feedid::io::{
     write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
 };
@@ -94,10 +94,12 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
         .as_deref()
         .map_or_else(|| "built-in".to_string(), |p| p.display().to_string());
     let mut pipeline = Pipeline::new(method)
-        .window_or_default(a.windows.window)
-        .horizon(a.windows.horizon)
-        .hop(a.windows.hop)
-        .interval(a.interval / 100.0)
+        .spans(a.windows.window, a.windows.horizon, a.windows.hop)
+        .guard(GuardConfig {
+            interval: a.interval / 100.0,
+            runaway: a.runaway.0,
+            ..GuardConfig::default()
+        })
         .nominal(params);
     if a.options.order_option()? == Some(OrderOption::Select) {
         pipeline = pipeline.select_orders(OrderSearch::default());

@@ -29,18 +29,22 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     // dropped samples: the methods restart after each gap (as `identify`)
     let (rec, warnings) = recording::load_checked(&a.input, &a.recording)?;
+    let rate = rec.rate_hz();
     let methods = methods
         .into_iter()
         .map(|m| {
             let cfg = EngineConfig {
-                window: a.windows.window.unwrap_or_else(|| m.default_window()),
-                horizon: a.windows.horizon,
-                hop: a.windows.hop,
+                window: match a.windows.window {
+                    Some(w) => w.samples(rate, "window")?,
+                    None => m.default_window(),
+                },
+                horizon: a.windows.horizon.samples(rate, "horizon")?,
+                hop: a.windows.hop.map(|h| h.samples(rate, "hop")).transpose()?,
                 warm_up: 0,
             };
-            (m, cfg)
+            Ok((m, cfg))
         })
-        .collect();
+        .collect::<Result<Vec<_>>>()?;
     let mut opts = ReportOptions::new(methods);
     opts.params = params;
     opts.params_source = match &a.params {

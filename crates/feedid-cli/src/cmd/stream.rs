@@ -21,9 +21,10 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use feedid::ident::stream::{
-    CommandExtrapolation, HorizonCommand, Interval, Prediction, StreamOptions, StreamStats,
+    CommandExtrapolation, HoldLoss, HoldWatch, HorizonCommand, Interval, Prediction, StreamOptions,
+    StreamStats,
 };
-use feedid::ident::{EngineConfig, Estimator, GuardConfig, Streamer};
+use feedid::ident::{EngineConfig, Estimator, GuardConfig, Regime, Span, Streamer};
 use feedid::io::{PredictionRows, StreamLine, StreamReader};
 
 use crate::args::StreamArgs;
@@ -32,6 +33,9 @@ use crate::cmd::recording::read_options;
 
 /// Messages of one kind printed at most (the summary counts them all).
 const MAX_MESSAGES: usize = 100;
+
+/// Blocks over which the predictions are compared with holding \[s\].
+const WATCH_SECONDS: f64 = 2.0;
 
 /// Run on the process's standard streams.
 pub fn run(a: &StreamArgs) -> Result<()> {
@@ -59,10 +63,32 @@ fn streamer(a: &StreamArgs, rate: Option<f64>) -> Result<Streamer<Box<dyn Estima
             a.interval
         );
     }
+    let spans = [a.windows.window, Some(a.windows.horizon), a.windows.hop];
+    let rate_hz = match rate {
+        Some(r) => r,
+        None if spans
+            .iter()
+            .flatten()
+            .any(|s| matches!(s, Span::Seconds(_))) =>
+        {
+            bail!(
+                "a window, horizon or hop given as a time needs --rate in a stream (the rate is \
+             not known before the samples arrive); or give it in samples"
+            )
+        }
+        None => f64::NAN,
+    };
     let config = EngineConfig {
-        window: a.windows.window.unwrap_or_else(|| method.default_window()),
-        horizon: a.windows.horizon,
-        hop: a.windows.hop,
+        window: match a.windows.window {
+            Some(w) => w.samples(rate_hz, "window")?,
+            None => method.default_window(),
+        },
+        horizon: a.windows.horizon.samples(rate_hz, "horizon")?,
+        hop: a
+            .windows
+            .hop
+            .map(|h| h.samples(rate_hz, "hop"))
+            .transpose()?,
         warm_up: 0,
     };
     let extrapolation: CommandExtrapolation = match &a.extrapolate {
@@ -77,6 +103,7 @@ fn streamer(a: &StreamArgs, rate: Option<f64>) -> Result<Streamer<Box<dyn Estima
         jitter_tolerance: a.recording.jitter_tol,
         guard: GuardConfig {
             interval: a.interval / 100.0,
+            runaway: a.runaway.0,
             ..GuardConfig::default()
         },
         ..StreamOptions::default()
@@ -153,6 +180,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
     let mut output = Output::Open;
     let mut header = false;
     let mut lines = Lines::default();
+    let mut watch = HoldWatch::new(WATCH_SECONDS);
     while let Output::Open = output {
         let Some(line) = reader.next_line()? else {
             break;
@@ -186,6 +214,22 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
                 }
             }
         }
+        if let Some(loss) = watch.check(&s.stats(), s.dt()) {
+            if watch.blocks().1 == 1 {
+                let dt = s.dt().unwrap_or(f64::NAN);
+                let _ = writeln!(
+                    err,
+                    "warning: up to line {no}, over the last {:.1} s ({} scored samples), the \
+                     predictions lost to holding the last position: rms {:.3} µm against {:.3} µm; \
+                     {} (further blocks lost are counted in the summary)",
+                    loss.seconds,
+                    loss.samples,
+                    1e6 * loss.rms,
+                    1e6 * loss.hold_rms,
+                    loss.advice(s.horizon_command(), s.config().horizon, dt)
+                );
+            }
+        }
     }
     if let Output::Open = output {
         s.finish();
@@ -203,6 +247,27 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         "{}",
         summary(&lines, &st, s.horizon_command(), rows.rows(), a.interval)
     );
+    let (blocks, lost) = watch.blocks();
+    if lost > 0 {
+        let _ = writeln!(
+            err,
+            "lost to holding the last position in {lost} of {blocks} blocks of {WATCH_SECONDS} s \
+             (see the warning above)"
+        );
+    } else if st.scored.samples > 0 && st.scored.rms > st.hold.rms {
+        let dt = s.dt().unwrap_or(f64::NAN);
+        let loss = HoldLoss {
+            seconds: st.scored.samples as f64 * dt,
+            samples: st.scored.samples,
+            rms: st.scored.rms,
+            hold_rms: st.hold.rms,
+        };
+        let _ = writeln!(
+            err,
+            "warning: the predictions lost to holding the last position: {}",
+            loss.advice(s.horizon_command(), s.config().horizon, dt)
+        );
+    }
     if st.lines == 0 {
         if lines.read == 0 {
             bail!("no data line in the input (it is empty or has only blank and comment lines)");
@@ -372,8 +437,23 @@ fn summary(
             percent(st.inside_interval, st.scored.samples),
             st.outliers
         );
+        let by: Vec<String> = Regime::ALL
+            .iter()
+            .filter(|r| st.regime_samples[r.index()] > 0)
+            .map(|r| {
+                let (n, inside) = (st.regime_samples[r.index()], st.regime_inside[r.index()]);
+                format!("{} {} of {n}", r.label(), percent(inside, n))
+            })
+            .collect();
+        o += &format!("inside the interval by command regime: {}\n", by.join(", "));
     } else {
         o += "scored: no sample (no prediction was compared with a measurement)\n";
+    }
+    if st.runaway_windows > 0 {
+        o += &format!(
+            "cut back as runaways: {} windows ({} samples): they left the motion the axis has shown\n",
+            st.runaway_windows, st.runaway_samples
+        );
     }
     o
 }

@@ -5,7 +5,7 @@ use super::analysis::RecordingAnalysis;
 use crate::error::Result;
 use crate::html::{Block, Section, Table};
 use crate::plot::{Band, LegendPosition, LineChart, Series};
-use feedid::ident::LinearModel;
+use feedid::ident::{LinearModel, Regime};
 use feedid::lti::{Complex, TransferFunction};
 
 impl RecordingAnalysis {
@@ -251,6 +251,60 @@ impl RecordingAnalysis {
         }
     }
 
+    /// Per method: interval coverage and median width, in all and per
+    /// command regime, and the windows cut back as runaways.
+    fn interval_table(&self, p: &str) -> Table {
+        let mut rows = Vec::new();
+        let mut interval = 95.0;
+        for m in &self.runs {
+            let s = m.identification.summary();
+            interval = s.interval_percent;
+            let mut row = vec![
+                m.label.clone(),
+                s.interval_coverage_percent
+                    .map_or("–".into(), |c| format!("{c:.1}")),
+                s.interval_median_width_m
+                    .map_or("–".into(), |w| format!("{:.3}", 1e6 * w)),
+            ];
+            for r in Regime::ALL {
+                row.push(
+                    match s.interval_by_regime.iter().find(|x| x.regime == r.name()) {
+                        Some(x) => format!("{:.1} ({})", x.coverage_percent, x.samples),
+                        None => "–".into(),
+                    },
+                );
+            }
+            row.push(format!(
+                "{} ({} samples)",
+                s.runaway_windows, s.runaway_samples
+            ));
+            rows.push(row);
+        }
+        let mut header = vec![
+            "method".into(),
+            "inside [%]".into(),
+            "median width [µm]".into(),
+        ];
+        header.extend(
+            Regime::ALL
+                .iter()
+                .map(|r| format!("{} [%] (samples)", r.label())),
+        );
+        header.push("cut back as runaways".into());
+        Table {
+            id: format!("{p}-intervals"),
+            caption: format!(
+                "The {interval} % prediction intervals: the share of the predicted samples inside \
+                 their interval, in all and by the command's regime at the sample (calibrated per \
+                 step ahead and per regime from the method's own recent errors), their median \
+                 width, and the windows whose prediction left the motion the axis has shown and \
+                 was cut back (their interval spans the hold)."
+            ),
+            header,
+            rows,
+        }
+    }
+
     pub(super) fn summary_section(&self, p: &str) -> Section {
         let um = |v: f64| {
             if v.is_finite() {
@@ -325,7 +379,8 @@ impl RecordingAnalysis {
         };
         let mut sec = Section::new(&format!("{p}-summary-sec"), "Summary")
             .with(Block::Paragraph(self.verdict()))
-            .with(Block::Table(table));
+            .with(Block::Table(table))
+            .with(Block::Table(self.interval_table(p)));
         if !self.global.is_empty() {
             sec.blocks.push(Block::Table(Table {
                 id: format!("{p}-global"),

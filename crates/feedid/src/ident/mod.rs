@@ -22,8 +22,8 @@ pub use analysis::{
 };
 pub use engine::{
     batch, stream, EngineConfig, Estimator, FitStatus, GuardConfig, PredictStatus, Prediction,
-    Samples, Signals, SlidingResult, StreamOptions, StreamStats, Streamer, WindowFit,
-    WindowOutcome, WindowRecord,
+    Regime, RegimeCoverage, Samples, Signals, SlidingResult, Span, SpanParseError, StreamOptions,
+    StreamStats, Streamer, WindowFit, WindowOutcome, WindowRecord,
 };
 pub use method::{Method, METHOD_NAMES};
 pub use methods::{

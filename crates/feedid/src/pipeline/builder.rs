@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::ident::engine::{run_with, Progress};
 use crate::ident::{
     fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind,
-    GuardConfig, Method, OrderSearch, PredictionMode, TimeOrigin, RESIDUAL_LAGS,
+    GuardConfig, Method, OrderSearch, PredictionMode, Span, TimeOrigin, RESIDUAL_LAGS,
     SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
@@ -26,9 +26,9 @@ use crate::stats::ErrorStats;
 #[derive(Clone)]
 pub struct Pipeline<'a> {
     method: Method,
-    window: Option<usize>,
-    horizon: usize,
-    hop: Option<usize>,
+    window: Option<Span>,
+    horizon: Span,
+    hop: Option<Span>,
     warm_up: usize,
     order_search: Option<OrderSearch>,
     method_global_model: bool,
@@ -64,7 +64,7 @@ impl<'a> Pipeline<'a> {
         Self {
             method,
             window: None,
-            horizon: 10,
+            horizon: Span::Samples(10),
             hop: None,
             warm_up: 0,
             order_search: None,
@@ -84,24 +84,34 @@ impl<'a> Pipeline<'a> {
 
     /// Window length W \[samples\]; default: the method's ([`Method::default_window`]).
     pub fn window(mut self, window: usize) -> Self {
-        self.window = Some(window);
+        self.window = Some(Span::Samples(window));
         self
     }
 
     /// Window length, or `None` for the method's default.
     pub fn window_or_default(mut self, window: Option<usize>) -> Self {
-        self.window = window;
+        self.window = window.map(Span::Samples);
         self
     }
 
     /// Prediction horizon H \[samples\]; default 10.
     pub fn horizon(mut self, horizon: usize) -> Self {
-        self.horizon = horizon;
+        self.horizon = Span::Samples(horizon);
         self
     }
 
     /// Shift between windows \[samples\]; `None` (default) = the horizon.
     pub fn hop(mut self, hop: Option<usize>) -> Self {
+        self.hop = hop.map(Span::Samples);
+        self
+    }
+
+    /// Window (`None`: the method's), horizon and hop (`None`: the horizon)
+    /// in samples or in time ([`Span`]: `"2ms"`), converted at the rate of
+    /// each recording run.
+    pub fn spans(mut self, window: Option<Span>, horizon: Span, hop: Option<Span>) -> Self {
+        self.window = window;
+        self.horizon = horizon;
         self.hop = hop;
         self
     }
@@ -177,14 +187,18 @@ impl<'a> Pipeline<'a> {
         self
     }
 
-    /// The engine settings this pipeline uses with `method`.
-    fn engine_config(&self, method: &Method) -> EngineConfig {
-        EngineConfig {
-            window: self.window.unwrap_or_else(|| method.default_window()),
-            horizon: self.horizon,
-            hop: self.hop,
+    /// The engine settings this pipeline uses with `method` on a recording
+    /// sampled at `rate_hz` (times converted to samples).
+    pub fn engine_config(&self, method: &Method, rate_hz: f64) -> Result<EngineConfig> {
+        Ok(EngineConfig {
+            window: match self.window {
+                Some(w) => w.samples(rate_hz, "window")?,
+                None => method.default_window(),
+            },
+            horizon: self.horizon.samples(rate_hz, "horizon")?,
+            hop: self.hop.map(|h| h.samples(rate_hz, "hop")).transpose()?,
             warm_up: self.warm_up,
-        }
+        })
     }
 
     /// Identify time \[s\], command \[m\] and measured position \[m\],
@@ -238,7 +252,7 @@ impl<'a> Pipeline<'a> {
                 })
             }
         };
-        let config = self.engine_config(&method);
+        let config = self.engine_config(&method, recording.rate_hz())?;
         let signals = recording.signals();
         let mut warnings: Vec<Warning> = check_recording(recording)
             .into_iter()

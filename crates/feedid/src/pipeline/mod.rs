@@ -38,5 +38,5 @@ mod warning;
 
 pub use builder::Pipeline;
 pub use run::{Identification, OrderChoice};
-pub use summary::IdentifySummary;
+pub use summary::{IdentifySummary, RegimeInterval};
 pub use warning::Warning;

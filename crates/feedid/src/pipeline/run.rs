@@ -4,7 +4,7 @@ use crate::ident::{
     ArxOrders, Criterion, EngineConfig, Method, ModelFile, ResidualAnalysis, SlidingResult,
     WindowOutcome,
 };
-use crate::pipeline::{IdentifySummary, Warning};
+use crate::pipeline::{IdentifySummary, RegimeInterval, Warning};
 use crate::stats::ErrorStats;
 
 /// Orders chosen from the recording ([`crate::pipeline::Pipeline::select_orders`]).
@@ -90,6 +90,21 @@ impl Identification {
                 .filter(|v| v.is_finite()),
             interval_percent: 100.0 * s.interval,
             interval_coverage_percent: s.interval_coverage_percent(),
+            interval_median_width_m: s.interval_median_width(),
+            interval_by_regime: s
+                .by_regime
+                .iter()
+                .filter_map(|r| {
+                    Some(RegimeInterval {
+                        regime: r.regime.name(),
+                        samples: r.samples,
+                        coverage_percent: r.coverage_percent()?,
+                        median_width_m: r.median_width?,
+                    })
+                })
+                .collect(),
+            runaway_windows: s.runaway_windows,
+            runaway_samples: s.runaway_samples,
             outliers: s.outliers.len(),
             sim_fit_percent: self
                 .global

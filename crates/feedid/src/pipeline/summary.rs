@@ -64,6 +64,19 @@ pub struct IdentifySummary {
     /// its prediction interval \[%\] (`None` when nothing was predicted).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub interval_coverage_percent: Option<f64>,
+    /// Median width of the prediction intervals over the predicted samples
+    /// \[m\] (`None` when nothing was predicted).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interval_median_width_m: Option<f64>,
+    /// Coverage and median width of the intervals per command regime
+    /// ([`crate::ident::Regime`]), for the regimes with predicted samples.
+    pub interval_by_regime: Vec<RegimeInterval>,
+    /// Windows whose prediction was cut back as a runaway: it left the
+    /// envelope of the motion the axis has shown (see
+    /// [`GuardConfig::runaway`](crate::ident::GuardConfig::runaway)).
+    pub runaway_windows: usize,
+    /// Predicted samples cut back as runaways.
+    pub runaway_samples: usize,
     /// Measured samples rejected as isolated outliers (not fitted; still scored).
     pub outliers: usize,
     /// NRMSE fit of the free-run simulation of the method's global model
@@ -124,6 +137,19 @@ pub struct IdentifySummary {
     pub global_note: Option<String>,
 }
 
+/// The prediction intervals of one command regime in a summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RegimeInterval {
+    /// The regime's name ([`crate::ident::Regime::name`]).
+    pub regime: &'static str,
+    /// Predicted samples in it.
+    pub samples: usize,
+    /// Share of them inside their interval \[%\].
+    pub coverage_percent: f64,
+    /// Median interval width there \[m\].
+    pub median_width_m: f64,
+}
+
 impl fmt::Display for IdentifySummary {
     /// The lines `feedid identify` prints after `"{file}: "`, each ending
     /// with a newline.
@@ -180,6 +206,38 @@ impl fmt::Display for IdentifySummary {
                 f,
                 "  prediction error: none (no sample was predicted, coverage 0 %; see the warnings)"
             )?,
+        }
+        if let Some(w) = self.interval_median_width_m {
+            let parts: Vec<String> = self
+                .interval_by_regime
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{} {:.1} % ({} samples, width {:.3} µm)",
+                        r.regime.replace('_', " "),
+                        r.coverage_percent,
+                        r.samples,
+                        1e6 * r.median_width_m
+                    )
+                })
+                .collect();
+            writeln!(
+                f,
+                "  {} % intervals: median width {:.3} µm; inside by command regime: {}",
+                self.interval_percent,
+                1e6 * w,
+                parts.join(", ")
+            )?;
+        }
+        if self.runaway_windows > 0 {
+            writeln!(
+                f,
+                "  {} window(s) cut back as runaways ({} samples, {:.2} % of the predicted): \
+                 they left the motion the axis has shown",
+                self.runaway_windows,
+                self.runaway_samples,
+                100.0 * self.runaway_samples as f64 / self.samples_predicted.max(1) as f64
+            )?;
         }
         if self.gaps > 0 {
             writeln!(

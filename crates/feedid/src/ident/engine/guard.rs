@@ -18,14 +18,40 @@
 //! (the first error sets `q_j`). In the long run a share `1 − P` of the
 //! errors lies beyond `q_j`, whatever their scale (the updates are
 //! multiplicative: a recording in other units gives proportional widths),
-//! and a jump of the errors is followed within tens of horizons. A new
-//! prediction `ŷ` at `j` samples ahead gets the interval `ŷ ± q_j`. Until
-//! [`MIN_HISTORY`] errors are known at `j`, the half-width is the distance
-//! from the last measured position to the prediction plus the range of the
-//! measured position over the window (wide, not calibrated). The share of
-//! measured samples inside their interval is reported as the interval
-//! coverage; it is close to `P` when the recent errors are representative
-//! of the next ones, lower after a sudden change of the motion.
+//! and a jump of the errors is followed within tens of horizons. This is
+//! the quantile tracking of conformal prediction for time series (Gibbs &
+//! Candès, *Adaptive conformal inference under distribution shift*,
+//! NeurIPS 2021; in the multiplicative form of Angelopoulos, Candès &
+//! Tibshirani, *Conformal PID control for time series prediction*, 2023):
+//! it needs no model of the errors, only their order, and its long-run
+//! coverage holds whatever the errors do.
+//!
+//! Errors differ most between the situations of the command — at rest, at
+//! a start of motion, at constant velocity, accelerating, at a reversal
+//! ([`Regime`], classified from the command over the horizon). A per-step
+//! width pooled over all of them is too wide at rest and too narrow at
+//! starts and reversals, where few samples are. Each regime `r` therefore
+//! tracks a factor `s_r` by the same rule on the ratios `e / q_j` of its own
+//! errors (pooled over the steps ahead, so that a rare regime calibrates
+//! ten times sooner than per step): a new prediction `ŷ` at `j` samples
+//! ahead in regime `r` gets the interval `ŷ ± s_r·q_j` (`s_r` starts at 1).
+//! Until [`MIN_HISTORY`] errors are known at `j`, the half-width is the
+//! distance from the last measured position to the prediction plus the
+//! range of the measured position over the window (wide, not calibrated).
+//! The share of measured samples inside their interval is reported as the
+//! interval coverage, in all and per regime; it is close to `P` when the
+//! recent errors are representative of the next ones, lower after a sudden
+//! change of the motion.
+//!
+//! # Runaway predictions
+//!
+//! A prediction whose samples leave the envelope of the motion the axis has
+//! shown ([`Envelope`]: `κ` times the largest distance travelled and the
+//! largest departure from the last velocity in `j` samples, `κ` =
+//! [`GuardConfig::runaway`]) is cut back to the envelope's edge, and the
+//! interval of a cut sample spans the hold and the cut value. It applies to
+//! every method (the paper's reproduction turns it off to stay as
+//! published); the windows and samples cut are counted.
 //!
 //! # Outliers
 //!
@@ -85,6 +111,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::error::{Error, Result};
+use crate::ident::engine::envelope::Envelope;
+use crate::ident::engine::regime::{Regime, RegimeClassifier};
 
 /// Errors needed at a step ahead before its interval is calibrated and
 /// outliers are detected there.
@@ -110,6 +138,11 @@ pub struct GuardConfig {
     /// doc, *Implausible predictions*) is withheld and the estimator
     /// restarts; `None` keeps every prediction; default `Some(4.0)`.
     pub plausibility: Option<f64>,
+    /// A predicted sample farther from the last measured position than this
+    /// many times the motion the axis has shown in as many samples (see the
+    /// module doc, *Runaway predictions*) is cut back; `None` keeps every
+    /// prediction as the method made it; default `Some(1.5)`.
+    pub runaway: Option<f64>,
 }
 
 impl Default for GuardConfig {
@@ -119,6 +152,7 @@ impl Default for GuardConfig {
             outlier: Some(8.0),
             adaptation: 0.1,
             plausibility: Some(4.0),
+            runaway: Some(1.5),
         }
     }
 }
@@ -158,6 +192,15 @@ impl GuardConfig {
                 });
             }
         }
+        if let Some(k) = self.runaway {
+            if !(k.is_finite() && k >= 1.0) {
+                return Err(Error::InvalidParameter {
+                    name: "runaway",
+                    value: k,
+                    reason: "must be finite and ≥ 1",
+                });
+            }
+        }
         Ok(())
     }
 }
@@ -174,6 +217,8 @@ struct Tracker {
 
 impl Tracker {
     const NEW: Self = Self { q: 0.0, n: 0 };
+    /// A factor tracker: starts at 1.
+    const UNIT: Self = Self { q: 1.0, n: 0 };
 
     fn push(&mut self, e: f64, up: f64, down: f64) {
         if self.q == 0.0 {
@@ -204,6 +249,11 @@ struct Pending {
     start: usize,
     len: usize,
     values: Vec<f64>,
+    /// The per-step half-width `q_j` each value's interval was scaled from
+    /// (0: not calibrated).
+    base: Vec<f64>,
+    /// Each value's regime.
+    regime: Vec<Regime>,
 }
 
 /// The engine's interval and outlier state for one run (see the module doc).
@@ -241,6 +291,20 @@ pub struct Guard {
     motion: f64,
     /// Predictions withheld as implausible since the reset.
     implausible: usize,
+    /// Per-regime factors on the per-step half-widths.
+    factors: [Tracker; 5],
+    classifier: RegimeClassifier,
+    envelope: Envelope,
+    /// The command's reach and swerve over the windows so far, the command
+    /// tracked up to this absolute index, and the figures around the
+    /// current horizon (scratch).
+    command_seen: Envelope,
+    command_tracked: Option<usize>,
+    /// The command with its horizon extrapolated (scratch).
+    command: Vec<f64>,
+    /// Windows and samples cut back as runaways since the reset.
+    runaway_windows: usize,
+    runaway_samples: usize,
 }
 
 impl Guard {
@@ -260,6 +324,8 @@ impl Guard {
                     start: 0,
                     len: 0,
                     values: vec![0.0; horizon],
+                    base: vec![0.0; horizon],
+                    regime: vec![Regime::Rest; horizon],
                 })
                 .collect(),
             first: 0,
@@ -275,6 +341,14 @@ impl Guard {
             outliers: 0,
             motion: 0.0,
             implausible: 0,
+            factors: [Tracker::UNIT; 5],
+            classifier: RegimeClassifier::default(),
+            envelope: Envelope::new(horizon),
+            command_seen: Envelope::horizon_only(horizon),
+            command_tracked: None,
+            command: Vec::new(),
+            runaway_windows: 0,
+            runaway_samples: 0,
         })
     }
 
@@ -289,6 +363,8 @@ impl Guard {
         self.outliers = 0;
         self.motion = 0.0;
         self.implausible = 0;
+        self.runaway_windows = 0;
+        self.runaway_samples = 0;
     }
 
     /// Forget the errors and pending predictions but keep the outlier count
@@ -304,6 +380,11 @@ impl Guard {
         self.mean_square.fill(0.0);
         self.resolution = f64::INFINITY;
         self.last = None;
+        self.factors = [Tracker::UNIT; 5];
+        self.classifier.reset();
+        self.envelope.reset();
+        self.command_seen.reset();
+        self.command_tracked = None;
     }
 
     /// Set the outlier count to 0.
@@ -319,6 +400,21 @@ impl Guard {
     /// Predictions found implausible since the reset ([`Guard::plausible`]).
     pub fn implausible(&self) -> usize {
         self.implausible
+    }
+
+    /// Windows whose prediction was cut back as a runaway since the reset.
+    pub fn runaway_windows(&self) -> usize {
+        self.runaway_windows
+    }
+
+    /// Predicted samples cut back as runaways since the reset.
+    pub fn runaway_samples(&self) -> usize {
+        self.runaway_samples
+    }
+
+    /// The interval factor of each regime now ([`Regime::ALL`] order).
+    pub fn regime_factors(&self) -> [f64; 5] {
+        self.factors.map(|t| t.q)
     }
 
     /// Whether the prediction `values` of a window is plausible: it leaves
@@ -350,8 +446,11 @@ impl Guard {
     /// Check the samples measured since the last call, up to `end`
     /// (exclusive): score the pending predictions on `position(k)` (the
     /// measured value) and call `replace(k, prediction)` for each outlier.
+    /// `start` is the first sample of the window that ends at `end` (the
+    /// first call of a segment takes the motion of its window from there).
     pub fn observe(
         &mut self,
+        start: usize,
         end: usize,
         position: impl Fn(usize) -> f64,
         mut replace: impl FnMut(usize, f64),
@@ -359,7 +458,11 @@ impl Guard {
         let from = match self.checked {
             Some(c) => c,
             None => {
-                // nothing was predicted before the first window ends
+                // nothing was predicted before the first window ends; its
+                // samples show the motion so far
+                for k in start..end {
+                    self.envelope.track(position(k));
+                }
                 self.checked = Some(end);
                 return;
             }
@@ -450,6 +553,7 @@ impl Guard {
                 self.step = self.step.max((y_clean - p).abs());
             }
             self.last_clean = Some(y_clean);
+            self.envelope.track(y_clean);
             if !outlier {
                 let w = self.config.adaptation;
                 for s in 0..self.count {
@@ -458,6 +562,14 @@ impl Guard {
                         let j = k - p.start;
                         let e = (c.y - p.values[j]).abs();
                         if e.is_finite() {
+                            let base = p.base[j];
+                            if base > 0.0 {
+                                self.factors[p.regime[j].index()].push(
+                                    e / base,
+                                    self.up,
+                                    self.down,
+                                );
+                            }
                             self.trackers[j].push(e, self.up, self.down);
                             let ms = &mut self.mean_square[j];
                             *ms = if self.trackers[j].n == 1 {
@@ -486,49 +598,124 @@ impl Guard {
         self.checked = Some(end.max(from));
     }
 
-    /// Record a window's prediction `values` of the samples from `start`
-    /// and write its interval bounds; `last` is the last measured position
-    /// and `spread` the range of the measured position over the window
-    /// (the interval's half-width before the errors are known).
+    /// Record a window's prediction `values` of the samples from `start`:
+    /// classify their regimes into `regimes` from `command` (the command
+    /// over the window and the horizon: its last `values.len()` samples are
+    /// the horizon's; with `horizon_known` false those are not read — the
+    /// method predicts without them — and the command goes on at its last
+    /// velocity instead), write their interval bounds, and cut back a
+    /// runaway (`values` and the bounds changed in place; see the module doc).
+    /// `last` is the last measured position and `spread` the range of the
+    /// measured position over the window (the interval's half-width before
+    /// the errors are known). Returns the number of samples cut back.
+    #[allow(clippy::too_many_arguments)]
     pub fn predicted(
         &mut self,
         start: usize,
-        values: &[f64],
+        values: &mut [f64],
         last: f64,
         spread: f64,
+        command: &[f64],
+        horizon_known: bool,
         lower: &mut [f64],
         upper: &mut [f64],
-    ) {
+        regimes: &mut [Regime],
+    ) -> usize {
+        let len = values
+            .len()
+            .min(self.horizon)
+            .min(lower.len())
+            .min(upper.len())
+            .min(regimes.len());
+        let (values, lower, upper, regimes) = (
+            &mut values[..len],
+            &mut lower[..len],
+            &mut upper[..len],
+            &mut regimes[..len],
+        );
+        let command = if horizon_known || command.len() < len + 2 {
+            command
+        } else {
+            // the command over the horizon as the method knows it: going on
+            // at the velocity of the window's last two samples
+            let n = command.len();
+            self.command.clear();
+            self.command.extend_from_slice(&command[..n - len]);
+            let (a, b) = (command[n - len - 2], command[n - len - 1]);
+            self.command
+                .extend((1..=len).map(|j| b + j as f64 * (b - a)));
+            &self.command[..]
+        };
+        if command.len() >= len {
+            self.classifier.classify(command, self.horizon, regimes);
+        } else {
+            regimes.fill(Regime::Rest);
+        }
         let n_slots = self.slots.len();
         if self.count == n_slots {
             self.first = (self.first + 1) % n_slots;
             self.count -= 1;
         }
-        let len = values.len().min(self.horizon);
-        let slot = &mut self.slots[(self.first + self.count) % n_slots];
-        slot.start = start;
-        slot.len = len;
-        slot.values[..len].copy_from_slice(&values[..len]);
-        self.count += 1;
-        if self.checked.is_none() {
-            self.checked = Some(start);
-        }
+        let slot_index = (self.first + self.count) % n_slots;
         for (j, ((v, lo), hi)) in values
             .iter()
             .zip(lower.iter_mut())
             .zip(upper.iter_mut())
             .enumerate()
-            .take(len)
         {
             let t = &self.trackers[j];
-            let q = if t.n >= MIN_HISTORY {
-                t.q
+            let (base, q) = if t.n >= MIN_HISTORY {
+                (t.q, t.q * self.factors[regimes[j].index()].q)
             } else {
-                (v - last).abs() + spread
+                (0.0, (v - last).abs() + spread)
             };
+            self.slots[slot_index].base[j] = base;
             *lo = v - q;
             *hi = v + q;
         }
+        // the commands up to H samples before the window's end (those the
+        // axis has had a horizon to answer) join the command's envelope
+        let first = start.saturating_sub(command.len().saturating_sub(len));
+        let answered = start.saturating_sub(self.horizon);
+        let from = self.command_tracked.unwrap_or(first).max(first);
+        for k in from..answered {
+            self.command_seen.track(command[k - first]);
+        }
+        self.command_tracked = Some(answered.max(from));
+        let cut = match self.config.runaway {
+            Some(k) => {
+                // the command's whole-horizon figures now and as answered
+                let (reach, swerve) = self.command_seen.whole_horizon_of(command, len);
+                let (r, s) = self.command_seen.seen(self.horizon);
+                // figures below a millionth of the command's travel over a
+                // horizon are its rounding (a ramp's swerve), not a motion
+                let floor = 1e-6 * r.max(reach);
+                let grow = |now: f64, before: f64| {
+                    if before > floor && now > before {
+                        now / before
+                    } else {
+                        1.0
+                    }
+                };
+                let kappa = (k * grow(reach, r), k * grow(swerve, s));
+                self.envelope.cut(values, last, |_| kappa, lower, upper)
+            }
+            None => 0,
+        };
+        if cut > 0 {
+            self.runaway_windows += 1;
+            self.runaway_samples += cut;
+        }
+        let slot = &mut self.slots[slot_index];
+        slot.start = start;
+        slot.len = len;
+        slot.values[..len].copy_from_slice(values);
+        slot.regime[..len].copy_from_slice(regimes);
+        self.count += 1;
+        if self.checked.is_none() {
+            self.checked = Some(start);
+        }
+        cut
     }
 }
 
@@ -594,10 +781,12 @@ mod tests {
         let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
         let mut clean = y.to_vec();
         let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
+        let mut regimes = vec![Regime::Rest; h];
         let mut replaced = Vec::new();
         let mut start = 10;
         while start + h <= y.len() {
             g.observe(
+                start - 10,
                 start,
                 |k| y[k],
                 |k, v| {
@@ -605,8 +794,19 @@ mod tests {
                     clean[k] = v;
                 },
             );
-            let pred: Vec<f64> = (start..start + h).map(|k| k as f64 + 0.02).collect();
-            g.predicted(start, &pred, clean[start - 1], 1.0, &mut lo, &mut hi);
+            let mut pred: Vec<f64> = (start..start + h).map(|k| k as f64 + 0.02).collect();
+            let command: Vec<f64> = (start - 10..start + h).map(|k| k as f64).collect();
+            g.predicted(
+                start,
+                &mut pred,
+                clean[start - 1],
+                1.0,
+                &command,
+                true,
+                &mut lo,
+                &mut hi,
+                &mut regimes,
+            );
             start += h;
         }
         (clean, replaced)
@@ -659,20 +859,36 @@ mod tests {
         // sample to sample (every other step ahead far off): the
         // measurement is kept, so the estimators never see the wild values
         let h = 10;
-        let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
+        // (the runaway guard off: it would cut the wild steps back)
+        let config = GuardConfig {
+            runaway: None,
+            ..GuardConfig::default()
+        };
+        let mut g = Guard::new(config, h, h).unwrap();
         let y: Vec<f64> = (0..600).map(|k| 1e-3 * k as f64).collect();
         let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
+        let mut regimes = vec![Regime::Rest; h];
         let mut replaced = Vec::new();
         let mut start = 10;
         while start + h <= y.len() {
-            g.observe(start, |k| y[k], |k, _| replaced.push(k));
-            let pred: Vec<f64> = (start..start + h)
+            g.observe(start - 10, start, |k| y[k], |k, _| replaced.push(k));
+            let mut pred: Vec<f64> = (start..start + h)
                 .map(|k| {
                     let wild = start >= 300 && (k - start) % 2 == 1;
                     y[k] + if wild { 1.0 } else { 1e-6 * ((k % 3) as f64) }
                 })
                 .collect();
-            g.predicted(start, &pred, y[start - 1], 1e-2, &mut lo, &mut hi);
+            g.predicted(
+                start,
+                &mut pred,
+                y[start - 1],
+                1e-2,
+                &y[start - 10..start + h],
+                true,
+                &mut lo,
+                &mut hi,
+                &mut regimes,
+            );
             start += h;
         }
         assert!(replaced.is_empty(), "{replaced:?}");
@@ -691,6 +907,10 @@ mod tests {
             },
             GuardConfig {
                 adaptation: 0.0,
+                ..GuardConfig::default()
+            },
+            GuardConfig {
+                runaway: Some(0.5),
                 ..GuardConfig::default()
             },
         ] {

@@ -3,21 +3,29 @@
 //! batches of recordings on all cores.
 
 pub mod batch;
+mod envelope;
 mod estimator;
 mod guard;
+mod regime;
 mod signals;
 mod sliding;
+mod span;
 pub mod stream;
 #[cfg(test)]
 mod test_estimators;
 
+pub use envelope::Envelope;
 pub(crate) use estimator::rate_changed;
 pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
 pub use guard::{Guard, GuardConfig, MIN_HISTORY};
+pub use regime::{Regime, RegimeClassifier, MOVING_SHARE};
 pub use signals::{Samples, Signals};
 pub(crate) use sliding::fit_and_predict;
+#[cfg(test)]
+pub(crate) use sliding::run_as_made;
 pub use sliding::{
-    run, run_with, run_with_progress, EngineConfig, Progress, SlidingResult, WindowIter,
-    WindowRecord,
+    run, run_with, run_with_progress, EngineConfig, Progress, RegimeCoverage, SlidingResult,
+    WindowIter, WindowRecord,
 };
+pub use span::{Span, SpanParseError};
 pub use stream::{Prediction, StreamOptions, StreamStats, Streamer};

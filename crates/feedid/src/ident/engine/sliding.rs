@@ -51,6 +51,7 @@ use std::time::{Duration, Instant};
 
 use crate::error::{Error, Result};
 use crate::ident::engine::guard::{Guard, GuardConfig};
+use crate::ident::engine::regime::Regime;
 use crate::ident::{Estimator, PredictStatus, Signals, WindowOutcome};
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
@@ -196,6 +197,18 @@ pub struct SlidingResult {
     /// Samples rejected as outliers (absolute indices, ascending): replaced
     /// by their prediction in what the estimator saw; scored as measured.
     pub outliers: Vec<usize>,
+    /// The command regime of each sample's prediction ([`Regime`]);
+    /// meaningful only where `has_prediction`.
+    pub regimes: Vec<Regime>,
+    /// Windows whose prediction was cut back as a runaway
+    /// ([`GuardConfig::runaway`]).
+    pub runaway_windows: usize,
+    /// Predicted samples cut back as runaways.
+    pub runaway_samples: usize,
+    /// Interval coverage and median width per command regime over the
+    /// predicted samples ([`Regime::ALL`] order; a regime without samples
+    /// has `samples == 0`).
+    pub by_regime: [RegimeCoverage; 5],
     /// Error statistics over all predicted samples (against the measured position).
     pub stats: ErrorStats,
     /// Wall time of identification and prediction only (no I/O).
@@ -224,6 +237,16 @@ impl SlidingResult {
     pub fn interval_coverage_percent(&self) -> Option<f64> {
         (self.stats.samples > 0)
             .then(|| 100.0 * self.inside_interval as f64 / self.stats.samples as f64)
+    }
+
+    /// Median width of the prediction intervals over the predicted samples
+    /// \[m\]; `None` if nothing was predicted.
+    pub fn interval_median_width(&self) -> Option<f64> {
+        let mut w: Vec<f64> = (0..self.predicted.len())
+            .filter(|&k| self.has_prediction[k])
+            .map(|k| self.upper[k] - self.lower[k])
+            .collect();
+        (!w.is_empty()).then(|| crate::stats::median(&mut w))
     }
 
     /// Coefficients of window `w`.
@@ -259,6 +282,26 @@ impl SlidingResult {
     }
 }
 
+/// The prediction intervals of one command regime over a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RegimeCoverage {
+    /// The regime.
+    pub regime: Regime,
+    /// Predicted samples in it.
+    pub samples: usize,
+    /// Of which inside their interval.
+    pub inside: usize,
+    /// Median interval width there \[m\]; `None` without samples.
+    pub median_width: Option<f64>,
+}
+
+impl RegimeCoverage {
+    /// Share of its samples inside their interval \[%\]; `None` without samples.
+    pub fn coverage_percent(&self) -> Option<f64> {
+        (self.samples > 0).then(|| 100.0 * self.inside as f64 / self.samples as f64)
+    }
+}
+
 /// Slide `estimator` over `signals` (offset 0) and collect predictions,
 /// intervals and statistics (default [`GuardConfig`]).
 pub fn run<E: Estimator + ?Sized>(
@@ -267,6 +310,21 @@ pub fn run<E: Estimator + ?Sized>(
     config: &EngineConfig,
 ) -> Result<SlidingResult> {
     run_with(estimator, signals, config, &GuardConfig::default(), None)
+}
+
+/// [`run`] without the runaway cut ([`GuardConfig::runaway`] `None`): the
+/// predictions as the estimator made them, for tests of its arithmetic.
+#[cfg(test)]
+pub(crate) fn run_as_made<E: Estimator + ?Sized>(
+    estimator: &mut E,
+    signals: &Signals<'_>,
+    config: &EngineConfig,
+) -> Result<SlidingResult> {
+    let guard = GuardConfig {
+        runaway: None,
+        ..GuardConfig::default()
+    };
+    run_with(estimator, signals, config, &guard, None)
 }
 
 /// A progress hook: `progress(done, total)` in samples (called from the
@@ -332,9 +390,11 @@ pub fn run_with<E: Estimator + ?Sized>(
     let mut has_prediction = vec![false; n];
     let mut lower = vec![0.0; n];
     let mut upper = vec![0.0; n];
+    let mut regimes = vec![Regime::Rest; n];
     let mut buf = vec![0.0; config.horizon];
     let mut lo = vec![0.0; config.horizon];
     let mut hi = vec![0.0; config.horizon];
+    let mut reg = vec![Regime::Rest; config.horizon];
     let mut guard = Guard::new(*guard, config.horizon, config.hop())?;
     let raw = signals.all();
     // what the estimator sees: the measured position with outliers replaced
@@ -372,6 +432,7 @@ pub fn run_with<E: Estimator + ?Sized>(
                 }
             }
             guard.observe(
+                segment.start,
                 window.end,
                 |k| raw.position[k],
                 |k, v| {
@@ -411,12 +472,24 @@ pub fn run_with<E: Estimator + ?Sized>(
                 estimator.restart();
             }
             if record.outcome.predicted() {
-                let (lo, hi) = (&mut lo[..h], &mut hi[..h]);
-                guard.predicted(record.horizon.start, out, last, spread, lo, hi);
+                let (lo, hi, reg) = (&mut lo[..h], &mut hi[..h], &mut reg[..h]);
+                let command = &all.command[window.start..record.horizon.end];
+                guard.predicted(
+                    record.horizon.start,
+                    out,
+                    last,
+                    spread,
+                    command,
+                    estimator.uses_future_command(),
+                    lo,
+                    hi,
+                    reg,
+                );
                 predicted[record.horizon.clone()].copy_from_slice(out);
                 has_prediction[record.horizon.clone()].fill(true);
                 lower[record.horizon.clone()].copy_from_slice(lo);
                 upper[record.horizon.clone()].copy_from_slice(hi);
+                regimes[record.horizon.clone()].copy_from_slice(reg);
             }
             windows.push(record);
         }
@@ -429,11 +502,26 @@ pub fn run_with<E: Estimator + ?Sized>(
     let mut acc = ErrorAccumulator::default();
     let mut inside_interval = 0;
     let y = raw.position;
+    let mut by_regime = Regime::ALL.map(|regime| RegimeCoverage {
+        regime,
+        samples: 0,
+        inside: 0,
+        median_width: None,
+    });
+    let mut widths: [Vec<f64>; 5] = Default::default();
     for k in 0..n {
         if has_prediction[k] {
             acc.push(y[k], predicted[k]);
-            inside_interval += usize::from(lower[k] <= y[k] && y[k] <= upper[k]);
+            let inside = usize::from(lower[k] <= y[k] && y[k] <= upper[k]);
+            inside_interval += inside;
+            let r = &mut by_regime[regimes[k].index()];
+            r.samples += 1;
+            r.inside += inside;
+            widths[regimes[k].index()].push(upper[k] - lower[k]);
         }
+    }
+    for (r, w) in by_regime.iter_mut().zip(widths.iter_mut()) {
+        r.median_width = (!w.is_empty()).then(|| crate::stats::median(w));
     }
     Ok(SlidingResult {
         method: estimator.name(),
@@ -447,6 +535,10 @@ pub fn run_with<E: Estimator + ?Sized>(
         interval: guard.config().interval,
         inside_interval,
         outliers,
+        regimes,
+        runaway_windows: guard.runaway_windows(),
+        runaway_samples: guard.runaway_samples(),
+        by_regime,
         stats: acc.finish(),
         elapsed,
     })
@@ -621,6 +713,126 @@ mod tests {
         };
         let r = run_with(&mut est, &s, &cfg, &guard, None).unwrap();
         assert_eq!((r.withheld_windows(), est.restarts), (0, 0));
+    }
+
+    #[test]
+    fn a_prediction_beyond_the_motion_shown_is_cut_back_counted_and_its_interval_spans_the_hold() {
+        // a sine of amplitude 1 (0.05 rad per sample): a hold that jumps by
+        // 2 on its 30th window is plausible (below 4× the motion) but far
+        // beyond what the axis has travelled in as many samples (the plain
+        // holds are cut too, towards going on: the axis cannot stop within
+        // a horizon as fast as a hold says)
+        let n = 800;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let y: Vec<f64> = (0..n).map(|k| (0.05 * k as f64).sin()).collect();
+        let s = Signals::new(&t, &y, &y, 1e-3, 0.0);
+        let cfg = EngineConfig {
+            window: 20,
+            horizon: 10,
+            hop: None,
+            warm_up: 0,
+        };
+        let mut est = Wild::new(30, 2.0);
+        let r = run(&mut est, &s, &cfg).unwrap();
+        let w = &r.windows[29];
+        let we = w.horizon.start;
+        assert_eq!(r.withheld_windows(), 0);
+        assert!(r.runaway_windows >= 1 && r.runaway_samples >= 10);
+        // the independent reference: the largest distance travelled in j
+        // samples before the window end, brute force
+        let last = y[we - 1];
+        for (j, k) in w.horizon.clone().enumerate() {
+            let j = j + 1;
+            let reach = (j..we).map(|i| (y[i] - y[i - j]).abs()).fold(0.0, f64::max);
+            let p = r.prediction(k).unwrap();
+            assert!(
+                p - last <= 1.5 * reach + 1e-12,
+                "{j}: {p} vs {last} + 1.5·{reach}"
+            );
+            let (lo, hi) = r.interval_at(k).unwrap();
+            assert!(lo <= last && hi >= p, "{j}: [{lo}, {hi}]");
+        }
+        // turned off: the prediction as made
+        let guard = GuardConfig {
+            runaway: None,
+            ..GuardConfig::default()
+        };
+        let r = run_with(&mut Wild::new(30, 2.0), &s, &cfg, &guard, None).unwrap();
+        assert_eq!(r.runaway_windows, 0);
+        assert_eq!(r.prediction(we), Some(last + 2.0));
+        // the stream cuts the same window back, by the same amount
+        // (each window waiting for its command, as the batch engine has it)
+        let options = crate::ident::StreamOptions {
+            extrapolation: crate::ident::stream::CommandExtrapolation::Wait,
+            ..crate::ident::StreamOptions::default()
+        };
+        let mut st =
+            crate::ident::Streamer::with_options(Wild::new(30, 2.0), cfg, options).unwrap();
+        let mut cut = Vec::new();
+        for k in 0..n {
+            st.push(t[k], y[k], y[k]).unwrap();
+            while let Some(p) = st.poll().unwrap() {
+                if p.horizon.start == we {
+                    cut = p.position.to_vec();
+                }
+            }
+        }
+        st.finish();
+        while st.poll().unwrap().is_some() {}
+        let b = run(&mut Wild::new(30, 2.0), &s, &cfg).unwrap();
+        assert_eq!(cut, b.predicted[we..we + 10].to_vec());
+        assert_eq!(
+            (st.stats().runaway_windows, st.stats().runaway_samples),
+            (b.runaway_windows, b.runaway_samples)
+        );
+    }
+
+    #[test]
+    fn intervals_are_counted_per_regime_and_sum_to_the_whole() {
+        // moves and rests of a first-order follower: every regime but the
+        // reversal occurs; the counts add up to the predicted samples
+        let n = 3000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let u: Vec<f64> = (0..n)
+            .map(|k| {
+                let phase = (k / 250) % 4;
+                let x = (k % 250) as f64 / 250.0;
+                match phase {
+                    0 => 0.0,
+                    1 => x,
+                    2 => 1.0,
+                    _ => 1.0 - x,
+                }
+            })
+            .collect();
+        let mut y = vec![0.0; n];
+        for k in 1..n {
+            y[k] = y[k - 1] + 0.2 * (u[k - 1] - y[k - 1]);
+        }
+        let s = Signals::new(&t, &u, &y, 1e-3, 0.0);
+        let r = run(&mut Linear { calls: 0 }, &s, &EngineConfig::default()).unwrap();
+        let total: usize = r.by_regime.iter().map(|c| c.samples).sum();
+        let inside: usize = r.by_regime.iter().map(|c| c.inside).sum();
+        assert_eq!((total, inside), (r.stats.samples, r.inside_interval));
+        for regime in [
+            Regime::Rest,
+            Regime::Start,
+            Regime::ConstantVelocity,
+            Regime::Accelerating,
+        ] {
+            let c = &r.by_regime[regime.index()];
+            assert!(c.samples > 0, "{regime:?}");
+            assert!(c.median_width.is_some_and(|w| w > 0.0), "{regime:?}");
+        }
+        // a linear extrapolation misses most at a start and least at rest:
+        // its intervals are wider at starts than at rest
+        let w = |g: Regime| r.by_regime[g.index()].median_width.unwrap();
+        assert!(
+            w(Regime::Start) > w(Regime::Rest),
+            "{} vs {}",
+            w(Regime::Start),
+            w(Regime::Rest)
+        );
     }
 
     #[test]

@@ -61,7 +61,7 @@
 //! *Adaptive Filter Theory*, ch. 10; design notes §3.
 //!
 //! ```
-//! use feedid::ident::{engine, ArxOrders, EngineConfig, RlsConfig, Signals};
+//! use feedid::ident::{engine, ArxOrders, EngineConfig, GuardConfig, RlsConfig, Signals};
 //! let n = 600;
 //! let dt = 1e-3;
 //! let u: Vec<f64> = (0..n).map(|k| 1e-3 * (0.05 * k as f64).sin()).collect();
@@ -73,7 +73,11 @@
 //! let mut rls = RlsConfig { orders: ArxOrders::new(1, 1, 1), p0: 1e10, ..RlsConfig::default() }
 //!     .build()
 //!     .unwrap();
-//! let res = engine::run(&mut rls, &Signals::new(&t, &u, &y, dt, 0.0), &EngineConfig::default()).unwrap();
+//! // the predictions as the method made them: the runaway guard off (early in
+//! // a recording the motion seen so far may be less than the next horizon's)
+//! let guard = GuardConfig { runaway: None, ..GuardConfig::default() };
+//! let s = Signals::new(&t, &u, &y, dt, 0.0);
+//! let res = engine::run_with(&mut rls, &s, &EngineConfig::default(), &guard, None).unwrap();
 //! assert!(res.stats.rms < 1e-8, "{}", res.stats.rms); // amplitude 1e-3
 //! ```
 

@@ -167,8 +167,10 @@ mod options;
 mod streamer;
 #[cfg(test)]
 mod tests;
+mod watch;
 
 pub use options::{
     Arrival, CommandExtrapolation, HorizonCommand, Interval, Jump, StreamOptions, GAP_DEVIATION,
 };
 pub use streamer::{Prediction, StreamStats, Streamer};
+pub use watch::{HoldLoss, HoldWatch, MIN_BLOCK};

@@ -8,7 +8,7 @@ use crate::ident::engine::sliding::range;
 use crate::ident::engine::stream::options::{
     Arrival, CommandExtrapolation, HorizonCommand, Interval, Jump, StreamOptions,
 };
-use crate::ident::engine::{fit_and_predict, EngineConfig, Guard};
+use crate::ident::engine::{fit_and_predict, EngineConfig, Guard, Regime};
 use crate::ident::{Estimator, Signals, WindowOutcome};
 use crate::recording::MOTION_THRESHOLD;
 use crate::stats::{ErrorAccumulator, ErrorStats};
@@ -93,6 +93,43 @@ pub struct StreamStats {
     pub inside_interval: usize,
     /// Samples rejected as isolated outliers (not fitted; scored as measured).
     pub outliers: usize,
+    /// Windows whose prediction was cut back as a runaway
+    /// ([`GuardConfig::runaway`](crate::ident::GuardConfig::runaway)).
+    pub runaway_windows: usize,
+    /// Predicted samples cut back as runaways.
+    pub runaway_samples: usize,
+    /// Scored samples per command regime ([`Regime::ALL`] order).
+    pub regime_samples: [usize; 5],
+    /// Of which inside their prediction interval.
+    pub regime_inside: [usize; 5],
+}
+
+impl Default for StreamStats {
+    /// A stream before its first line: every count 0, nothing scored.
+    fn default() -> Self {
+        let none = ErrorStats::from_pairs([]);
+        Self {
+            lines: 0,
+            samples: 0,
+            commands: 0,
+            unused_positions: 0,
+            windows: 0,
+            failed_windows: 0,
+            withheld_windows: 0,
+            predicted_ahead: 0,
+            predicted_late: 0,
+            gaps: 0,
+            irregular_intervals: 0,
+            scored: none,
+            hold: none,
+            inside_interval: 0,
+            outliers: 0,
+            runaway_windows: 0,
+            runaway_samples: 0,
+            regime_samples: [0; 5],
+            regime_inside: [0; 5],
+        }
+    }
 }
 
 impl StreamStats {
@@ -141,6 +178,8 @@ pub struct Streamer<E: Estimator = Box<dyn Estimator>> {
     lo: Vec<f64>,
     hi: Vec<f64>,
     base: Vec<f64>,
+    /// The regime of each latest prediction.
+    rg: Vec<Regime>,
     has: Vec<bool>,
     /// Prediction intervals and outlier rejection, as in the batch engine.
     guard: Guard,
@@ -178,7 +217,12 @@ pub struct Streamer<E: Estimator = Box<dyn Estimator>> {
     pred: Vec<f64>,
     pred_lo: Vec<f64>,
     pred_hi: Vec<f64>,
+    pred_rg: Vec<Regime>,
     inside: usize,
+    runaway_windows: usize,
+    runaway_samples: usize,
+    regime_samples: [usize; 5],
+    regime_inside: [usize; 5],
     lines: usize,
     unused: usize,
     windows: usize,
@@ -263,6 +307,7 @@ impl<E: Estimator> Streamer<E> {
             lo: vec![0.0; cap],
             hi: vec![0.0; cap],
             base: vec![0.0; cap],
+            rg: vec![Regime::Rest; cap],
             has: vec![false; cap],
             guard,
             nc: 0,
@@ -288,7 +333,12 @@ impl<E: Estimator> Streamer<E> {
             pred: vec![0.0; config.horizon],
             pred_lo: vec![0.0; config.horizon],
             pred_hi: vec![0.0; config.horizon],
+            pred_rg: vec![Regime::Rest; config.horizon],
             inside: 0,
+            runaway_windows: 0,
+            runaway_samples: 0,
+            regime_samples: [0; 5],
+            regime_inside: [0; 5],
             lines: 0,
             unused: 0,
             windows: 0,
@@ -326,9 +376,13 @@ impl<E: Estimator> Streamer<E> {
         self.acc = ErrorAccumulator::default();
         self.acc_hold = ErrorAccumulator::default();
         self.inside = 0;
+        self.runaway_windows = 0;
+        self.runaway_samples = 0;
+        self.regime_samples = [0; 5];
+        self.regime_inside = [0; 5];
         self.est.reset();
         self.begin_segment();
-        self.guard.reset_outliers();
+        self.guard.reset();
     }
 
     /// Start a segment at sample `np` (commands already stored from there on
@@ -427,6 +481,10 @@ impl<E: Estimator> Streamer<E> {
             hold: self.acc_hold.finish(),
             inside_interval: self.inside,
             outliers: self.guard.outliers(),
+            runaway_windows: self.runaway_windows,
+            runaway_samples: self.runaway_samples,
+            regime_samples: self.regime_samples,
+            regime_inside: self.regime_inside,
         }
     }
 
@@ -615,9 +673,9 @@ impl<E: Estimator> Streamer<E> {
         // isolated wild samples measured since the last window: replaced by
         // their prediction in what the estimator sees (as the batch engine)
         {
-            let (raw, y) = (&self.raw, &mut self.y);
+            let (raw, y, seg) = (&self.raw, &mut self.y, self.seg);
             self.guard
-                .observe(we, |k| raw[k - off], |k, v| y[k - off] = v);
+                .observe(seg.max(off), we, |k| raw[k - off], |k, v| y[k - off] = v);
         }
         let motion_start = match self.motion_idx {
             Some(i) if i < np => self.motion_time,
@@ -650,11 +708,20 @@ impl<E: Estimator> Streamer<E> {
         let ok = record.outcome.predicted();
         let already = np.clamp(we, he) - we;
         let (lo, hi) = (&mut self.pred_lo[..he - we], &mut self.pred_hi[..he - we]);
+        let rg = &mut self.pred_rg[..he - we];
         if ok {
-            self.guard.predicted(we, out, last, spread, lo, hi);
+            let command = &self.u[s - off..he - off];
+            let cut = self
+                .guard
+                .predicted(we, out, last, spread, command, self.future, lo, hi, rg);
+            if cut > 0 {
+                self.runaway_windows += 1;
+                self.runaway_samples += cut;
+            }
             self.p[we - off..he - off].copy_from_slice(out);
             self.lo[we - off..he - off].copy_from_slice(lo);
             self.hi[we - off..he - off].copy_from_slice(hi);
+            self.rg[we - off..he - off].copy_from_slice(rg);
             self.has[we - off..he - off].fill(true);
             let hold = self.y[we - 1 - off];
             self.base[we - off..he - off].fill(hold);
@@ -850,7 +917,11 @@ impl<E: Estimator> Streamer<E> {
                 let y = self.raw[i];
                 self.acc.push(y, self.p[i]);
                 self.acc_hold.push(y, self.base[i]);
-                self.inside += usize::from(self.lo[i] <= y && y <= self.hi[i]);
+                let inside = usize::from(self.lo[i] <= y && y <= self.hi[i]);
+                self.inside += inside;
+                let r = self.rg[i].index();
+                self.regime_samples[r] += 1;
+                self.regime_inside[r] += inside;
             }
             self.scored += 1;
         }
@@ -881,6 +952,7 @@ impl<E: Estimator> Streamer<E> {
         ] {
             v.copy_within(a..b, 0);
         }
+        self.rg.copy_within(a..b, 0);
         self.has.copy_within(a..b, 0);
         self.has[b - a..].fill(false);
         self.off = keep;

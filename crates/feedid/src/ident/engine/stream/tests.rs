@@ -9,7 +9,7 @@ use super::*;
 use crate::drive::{RigParams, VirtualRig};
 use crate::error::{Error, Result};
 use crate::ident::engine::test_estimators::{follow, follow7, Linear, Wild};
-use crate::ident::engine::{run, EngineConfig, SlidingResult};
+use crate::ident::engine::{run, EngineConfig, GuardConfig, SlidingResult};
 use crate::ident::{Estimator, PaperConfig, PaperMethod, Solver, WindowOutcome};
 use crate::recording::MOTION_THRESHOLD;
 use crate::signal::Scenario;
@@ -72,24 +72,7 @@ fn collect_from(out: &mut Collected, p: Prediction<'_>, measured: usize) {
 }
 
 fn empty_stats() -> StreamStats {
-    let z = ErrorStats::from_pairs([]);
-    StreamStats {
-        lines: 0,
-        samples: 0,
-        commands: 0,
-        unused_positions: 0,
-        windows: 0,
-        failed_windows: 0,
-        withheld_windows: 0,
-        predicted_ahead: 0,
-        predicted_late: 0,
-        gaps: 0,
-        irregular_intervals: 0,
-        scored: z,
-        hold: z,
-        inside_interval: 0,
-        outliers: 0,
-    }
+    StreamStats::default()
 }
 
 /// Stream `rec` (`Lines(l)`: its samples `l..` are the stream's, the lines
@@ -101,6 +84,18 @@ fn stream<E: Estimator>(
     feed: Feed,
     extrapolation: CommandExtrapolation,
 ) -> Collected {
+    stream_guarded(est, cfg, rec, feed, extrapolation, GuardConfig::default())
+}
+
+/// [`stream`] with the guard settings `guard`.
+fn stream_guarded<E: Estimator>(
+    est: E,
+    cfg: EngineConfig,
+    rec: &Recording,
+    feed: Feed,
+    extrapolation: CommandExtrapolation,
+    guard: GuardConfig,
+) -> Collected {
     let (t, u, y) = (rec.time(), rec.command(), rec.position());
     let n = t.len();
     let (opts, shift) = match feed {
@@ -108,6 +103,7 @@ fn stream<E: Estimator>(
             StreamOptions {
                 command_lead: l,
                 extrapolation,
+                guard,
                 ..StreamOptions::default()
             },
             l,
@@ -116,6 +112,7 @@ fn stream<E: Estimator>(
             StreamOptions {
                 lookahead: Some(l),
                 extrapolation,
+                guard,
                 ..StreamOptions::default()
             },
             0,
@@ -484,10 +481,16 @@ fn extrapolated_predictions_come_at_the_window_end_with_the_extrapolated_command
     let y: Vec<f64> = (0..n).map(|k| 0.5e-6 * (k as f64).powi(2)).collect();
     let rec = Recording::new(t, u.clone(), y.clone()).unwrap();
     let cfg = EngineConfig::default();
-    let batch = run(&mut follow(), &rec.signals(), &cfg).unwrap();
+    // the extrapolation's arithmetic: the predictions as made (a held or
+    // linear command on this accelerating axis is cut back by the guard)
+    let batch = crate::ident::engine::run_as_made(&mut follow(), &rec.signals(), &cfg).unwrap();
     let scale = 0.16;
+    let as_made = GuardConfig {
+        runaway: None,
+        ..GuardConfig::default()
+    };
     for x in [Hold, Velocity, Acceleration] {
-        let c = stream(follow(), cfg, &rec, Feed::Lines(0), x);
+        let c = stream_guarded(follow(), cfg, &rec, Feed::Lines(0), x, as_made);
         assert_eq!(c.stats.predicted_late, 0, "{x:?}");
         assert!(c.stats.predicted_ahead > n / 2, "{x:?}");
         for &(at, h, already) in &c.arrivals {

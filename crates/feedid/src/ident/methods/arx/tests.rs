@@ -8,7 +8,7 @@ use std::ops::Range;
 use super::config::*;
 use super::factor::SlidingFactor;
 use super::fit::*;
-use crate::ident::engine::{run, EngineConfig};
+use crate::ident::engine::EngineConfig;
 use crate::ident::methods::regressor::*;
 use crate::ident::{Estimator, FitStatus, Signals};
 use crate::lti::poly_roots;
@@ -304,7 +304,7 @@ fn k_step_prediction_is_exact_for_noise_free_data_far_from_zero() {
     }
     .build()
     .unwrap();
-    let r = run(
+    let r = crate::ident::engine::run_as_made(
         &mut est,
         &s,
         &EngineConfig {

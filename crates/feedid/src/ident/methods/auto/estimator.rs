@@ -754,7 +754,7 @@ impl Estimator for AutoEstimator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ident::engine::{run, EngineConfig};
+    use crate::ident::engine::EngineConfig;
 
     /// 1 kHz, a slow 1 µm sine of the position; the command `offset` away.
     fn signals_data(offset: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -776,7 +776,7 @@ mod tests {
             hop: None,
             warm_up: 0,
         };
-        run(&mut est, &s, &cfg).unwrap()
+        crate::ident::engine::run_as_made(&mut est, &s, &cfg).unwrap()
     }
 
     /// `auto` with these candidates over [`signals_data`].

@@ -704,7 +704,7 @@ fn signals_with_offset_are_indexed_absolutely() {
 
 #[test]
 fn sliding_engine_runs_the_paper_method_on_a_lagged_ramp_without_nan() {
-    use crate::ident::engine::{run, EngineConfig};
+    use crate::ident::engine::EngineConfig;
     // 50 mm/s ramp through a first-order lag 1/Kv (Kv = 700 1/s): the
     // following error settles at v/Kv = 71.4 µm
     let (v, tl) = (0.05, 1.0 / 700.0);
@@ -717,7 +717,7 @@ fn sliding_engine_runs_the_paper_method_on_a_lagged_ramp_without_nan() {
         .collect();
     let s = Signals::new(&t, &u, &y, DT, 0.0);
     let mut qr = method(Solver::Qr, TimeOrigin::Motion);
-    let rq = run(&mut qr, &s, &EngineConfig::default()).unwrap();
+    let rq = crate::ident::engine::run_as_made(&mut qr, &s, &EngineConfig::default()).unwrap();
     assert!(rq
         .windows
         .iter()
@@ -749,7 +749,7 @@ fn sliding_engine_runs_the_paper_method_on_a_lagged_ramp_without_nan() {
         .fold(0.0, f64::max);
     assert!(el < 5e-6, "{el}");
     let mut nm = method(Solver::Simplex, TimeOrigin::Motion);
-    let rs = run(&mut nm, &s, &EngineConfig::default()).unwrap();
+    let rs = crate::ident::engine::run_as_made(&mut nm, &s, &EngineConfig::default()).unwrap();
     assert!(rs
         .windows
         .iter()

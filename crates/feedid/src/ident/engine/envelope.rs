@@ -1,0 +1,362 @@
+//! The runaway guard's envelope: how far the axis can be from its last
+//! measured position `j` samples later, judged by the motion the recording
+//! has shown.
+//!
+//! From the measured (outlier-cleaned) position the engine keeps, for every
+//! step ahead `j = 1 … H`,
+//!
+//! ```text
+//! D_j = max_k |y[k] − y[k−j]|                              (reach: speed)
+//! S_j = max_k |y[k] − y[k−j] − j·v[k−j]|                   (swerve: acceleration)
+//! v[i] = (y[i] − y[i−H]) / H
+//! ```
+//!
+//! over the samples seen so far: the largest distance the axis has travelled
+//! in `j` samples, and the largest departure in `j` samples from going on at
+//! its recent velocity (the mean over the last `H` samples, so that the
+//! noise of one sample is not multiplied by `j`). A prediction `ŷ_j` made
+//! from the last position `y₀` (recent velocity `v = (y₀ − y₋H)/H`) is
+//! expected within
+//!
+//! ```text
+//! |ŷ_j − y₀| ≤ κ·D_j    and    |ŷ_j − y₀ − j·v| ≤ κ·S_j
+//! ```
+//!
+//! (`κ` = [`GuardConfig::runaway`](crate::ident::GuardConfig::runaway)).
+//! Where the command asks for more than it has before, the bounds grow with
+//! it: the same two figures of the command over a whole horizon (`j = H`) —
+//! over the commands the axis has had a horizon to answer (`D̂ᶜ`, `Ŝᶜ`) and
+//! over the pairs that end in the current horizon (`Dᶜ`, `Sᶜ`) — widen every
+//! `D_j` by `Dᶜ / D̂ᶜ` and every `S_j` by `Sᶜ / Ŝᶜ` where these exceed 1 (a
+//! larger or faster move of a program, a sweep rising in frequency; a
+//! command that has never moved gives no such scale: the axis has shown
+//! nothing to scale). [`Envelope::horizon_only`] keeps those figures.
+//! A model that winds up within its horizon — an error growing by a
+//! constant factor per step, as a nearly unstable window model does at a
+//! reversal — leaves this envelope within a few steps; so does a model
+//! fitted on a window at rest that predicts a jump onto a stepped command
+//! the axis has never shown it can follow. The samples of a prediction
+//! outside it are *cut back* to its edge and their interval is widened to
+//! span the hold and the cut value (see [`Envelope::cut`]).
+//!
+//! Why these bounds: a position servo's speed and acceleration are limited
+//! (by its drive, its gains and its mass), and the recording shows them.
+//! Both bounds are ratios of lengths of the recording itself, so they carry
+//! no unit; the measurement noise enters both (the one-sample velocity is
+//! as noisy as the data), so at high rates the envelope widens with the
+//! noise rather than cutting honest predictions. The price is the first
+//! motion of a recording: before the axis has moved, `D_j` and `S_j` are
+//! the noise's, and a prediction that the axis will start is cut back
+//! towards the hold (its interval widened to the prediction). Every later
+//! start is judged by the motion seen before it.
+//!
+//! All state is allocated in [`Envelope::new`]; [`Envelope::track`] costs
+//! `O(H)` per sample.
+
+/// Per step ahead, the largest reach and swerve seen, and the last samples.
+#[derive(Debug, Clone)]
+pub struct Envelope {
+    horizon: usize,
+    /// `D_j`, index `j − 1`.
+    reach: Vec<f64>,
+    /// `S_j`, index `j − 1`.
+    swerve: Vec<f64>,
+    /// Pairs seen per step ahead (reach; swerve needs one more sample).
+    pairs: Vec<usize>,
+    /// The last `m = 2H + 1` samples, a ring (`head` = next write) stored
+    /// twice (`recent[i]` = `recent[i + m]`), so that reading back needs no
+    /// modulo.
+    recent: Vec<f64>,
+    head: usize,
+    len: usize,
+    /// Track the whole horizon (`j = H`) only.
+    whole_only: bool,
+}
+
+impl Envelope {
+    /// An envelope for horizons of `horizon` samples.
+    pub fn new(horizon: usize) -> Self {
+        let horizon = horizon.max(1);
+        Self {
+            horizon,
+            reach: vec![0.0; horizon],
+            swerve: vec![0.0; horizon],
+            pairs: vec![0; horizon],
+            recent: vec![0.0; 2 * (2 * horizon + 1)],
+            head: 0,
+            len: 0,
+            whole_only: false,
+        }
+    }
+
+    /// An envelope that tracks the whole horizon (`j = H`) only: the
+    /// command's scale (see the module doc); `O(1)` per sample.
+    pub fn horizon_only(horizon: usize) -> Self {
+        Self {
+            whole_only: true,
+            ..Self::new(horizon)
+        }
+    }
+
+    /// Forget the motion seen (a new recording).
+    pub fn reset(&mut self) {
+        self.reach.fill(0.0);
+        self.swerve.fill(0.0);
+        self.pairs.fill(0);
+        self.restart();
+    }
+
+    /// Forget the last samples but keep the motion seen (a gap: nothing
+    /// pairs samples across it; the axis is the same).
+    pub fn restart(&mut self) {
+        self.head = 0;
+        self.len = 0;
+    }
+
+    /// The sample `back` (< `2H + 1`) samples before the newest one (0: the newest).
+    #[inline]
+    fn ago(&self, back: usize) -> f64 {
+        let m = self.recent.len() / 2;
+        self.recent[self.head + m - 1 - back]
+    }
+
+    /// Take the next measured (cleaned) sample into the envelope.
+    pub fn track(&mut self, y: f64) {
+        if !y.is_finite() {
+            return;
+        }
+        let m = self.recent.len() / 2;
+        self.recent[self.head] = y;
+        self.recent[self.head + m] = y;
+        self.head = if self.head + 1 == m { 0 } else { self.head + 1 };
+        self.len = (self.len + 1).min(m);
+        let h = self.horizon;
+        // the newest sample sits at `newest`; j samples before it at `newest − j`
+        let newest = self.head + m - 1;
+        let (recent, reach, swerve, pairs) = (
+            &self.recent,
+            &mut self.reach,
+            &mut self.swerve,
+            &mut self.pairs,
+        );
+        let inv_h = 1.0 / h as f64;
+        let first = if self.whole_only { h } else { 1 };
+        for j in first..=h.min(self.len.saturating_sub(1)) {
+            let base = recent[newest - j];
+            let d = (y - base).abs();
+            if d > reach[j - 1] {
+                reach[j - 1] = d;
+            }
+            pairs[j - 1] += 1;
+            if self.len > j + h {
+                let v = (base - recent[newest - j - h]) * inv_h;
+                let s = (y - base - j as f64 * v).abs();
+                if s > swerve[j - 1] {
+                    swerve[j - 1] = s;
+                }
+            }
+        }
+    }
+
+    /// The largest reach and swerve seen at `j` (1-based) steps ahead (0
+    /// before any was seen).
+    pub fn seen(&self, j: usize) -> (f64, f64) {
+        match j.checked_sub(1) {
+            Some(i) if i < self.horizon => (self.reach[i], self.swerve[i]),
+            _ => (0.0, 0.0),
+        }
+    }
+
+    /// The reach and swerve over a whole horizon (`j = H`) of the pairs of
+    /// `samples` that end in its last `last` samples (NaN pairs skipped):
+    /// the same figures as tracking, over a slice.
+    pub fn whole_horizon_of(&self, samples: &[f64], last: usize) -> (f64, f64) {
+        let h = self.horizon;
+        let inv_h = 1.0 / h as f64;
+        let (mut reach, mut swerve) = (0.0f64, 0.0f64);
+        for k in samples.len().saturating_sub(last).max(h)..samples.len() {
+            let (y, base) = (samples[k], samples[k - h]);
+            let d = (y - base).abs();
+            if d > reach {
+                reach = d;
+            }
+            if k >= 2 * h {
+                let v = (base - samples[k - 2 * h]) * inv_h;
+                let s = (y - base - h as f64 * v).abs();
+                if s > swerve {
+                    swerve = s;
+                }
+            }
+        }
+        (reach, swerve)
+    }
+
+    /// The envelope of the sample `j` (1-based) steps after the last one
+    /// tracked, started from `last` with the recent velocity (over the last
+    /// `H` tracked samples), the reach widened `kappa.0` times and the swerve
+    /// `kappa.1` times; `None` before any pair of samples `j` apart was seen.
+    pub fn bounds(&self, j: usize, last: f64, kappa: (f64, f64)) -> Option<(f64, f64)> {
+        if j == 0 || j > self.horizon || self.pairs[j - 1] == 0 || !last.is_finite() {
+            return None;
+        }
+        let d = kappa.0 * self.reach[j - 1];
+        let (mut lo, mut hi) = (last - d, last + d);
+        if self.len > self.horizon && self.swerve[j - 1] > 0.0 {
+            let v = (self.ago(0) - self.ago(self.horizon)) / self.horizon as f64;
+            let c = last + j as f64 * v;
+            let w = kappa.1 * self.swerve[j - 1];
+            let (a, b) = (lo.max(c - w), hi.min(c + w));
+            if a <= b {
+                lo = a;
+                hi = b;
+            }
+        }
+        Some((lo, hi))
+    }
+
+    /// Cut `values` (the prediction of the next samples from `last`) back
+    /// into the envelope, its reach and swerve at step `j` widened
+    /// `kappa(j)` times (see [`Envelope::bounds`]); the interval of a cut
+    /// sample becomes `[min(last, ŷ) − q, max(last, ŷ) + q]` with `ŷ` the
+    /// cut value and `q` its half-width before (from `lower`/`upper`).
+    /// Returns the number of samples cut.
+    pub fn cut(
+        &self,
+        values: &mut [f64],
+        last: f64,
+        kappa: impl Fn(usize) -> (f64, f64),
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) -> usize {
+        let mut cut = 0;
+        for (i, ((v, lo), hi)) in values
+            .iter_mut()
+            .zip(lower.iter_mut())
+            .zip(upper.iter_mut())
+            .enumerate()
+        {
+            let Some((a, b)) = self.bounds(i + 1, last, kappa(i + 1)) else {
+                continue;
+            };
+            // (bounds that are not ordered, NaN included, cut nothing)
+            let ordered = matches!(a.partial_cmp(&b), Some(o) if o.is_le());
+            if !ordered || (*v >= a && *v <= b) {
+                continue;
+            }
+            let q = 0.5 * (*hi - *lo).abs();
+            *v = v.clamp(a, b);
+            *lo = last.min(*v) - q;
+            *hi = last.max(*v) + q;
+            cut += 1;
+        }
+        cut
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reach_and_swerve_are_the_largest_displacement_and_departure_seen() {
+        // a parabola y = k²/2 (acceleration 1 per sample²): D_j over samples
+        // 0..=20 is the largest |y[k] − y[k−j]|, S_j = j²/2 exactly
+        let mut e = Envelope::new(5);
+        for k in 0..=20 {
+            e.track(0.5 * (k * k) as f64);
+        }
+        for j in 1..=5 {
+            let d = 0.5 * (400 - (20 - j) * (20 - j)) as f64;
+            assert!((e.reach[j - 1] - d).abs() < 1e-12, "{j}");
+            // the mean velocity over the 5 samples before k−j lags 2.5
+            // samples: y[k] − y[k−j] − j·v = j²/2 + 2.5·j
+            let s = 0.5 * (j * j) as f64 + 2.5 * j as f64;
+            assert!(
+                (e.swerve[j - 1] - s).abs() < 1e-12,
+                "{j}: {}",
+                e.swerve[j - 1]
+            );
+        }
+    }
+
+    #[test]
+    fn the_whole_horizon_figures_of_a_slice_are_those_of_tracking_it() {
+        let y: Vec<f64> = (0..60)
+            .map(|k| ((k as f64) * 0.15).sin() * (k as f64))
+            .collect();
+        let mut e = Envelope::horizon_only(7);
+        for v in &y {
+            e.track(*v);
+        }
+        assert_eq!(e.seen(7), e.whole_horizon_of(&y, y.len()));
+        assert_eq!(e.seen(3), (0.0, 0.0));
+        // the pairs ending in the last 5 samples only: brute force
+        let reach = (55..60)
+            .map(|k| (y[k] - y[k - 7]).abs())
+            .fold(0.0, f64::max);
+        assert_eq!(e.whole_horizon_of(&y, 5).0, reach);
+    }
+
+    #[test]
+    fn a_geometric_runaway_is_cut_back_and_its_interval_spans_the_hold() {
+        // a constant velocity of 1 per sample: a prediction whose error
+        // doubles every step leaves the envelope (κ = 1.5) and is cut
+        let mut e = Envelope::new(10);
+        for k in 0..100 {
+            e.track(k as f64);
+        }
+        let last = 99.0;
+        let mut pred: Vec<f64> = (1..=10)
+            .map(|j| last + j as f64 + 0.01 * 2f64.powi(j))
+            .collect();
+        let mut lo: Vec<f64> = pred.iter().map(|v| v - 0.1).collect();
+        let mut hi: Vec<f64> = pred.iter().map(|v| v + 0.1).collect();
+        let cut = e.cut(&mut pred, last, |_| (1.5, 1.5), &mut lo, &mut hi);
+        // reach 1.5·j always holds; the swerve is 0 on an exact ramp, so the
+        // acceleration bound is not used and only the reach cuts: steps
+        // whose excess 0.01·2^j exceeds 0.5·j
+        let expected = (1..=10)
+            .filter(|&j| 0.01 * 2f64.powi(j) > 0.5 * j as f64)
+            .count();
+        assert_eq!(cut, expected);
+        for (j, v) in pred.iter().enumerate() {
+            assert!(*v <= last + 1.5 * (j + 1) as f64 + 1e-12);
+        }
+        assert!(lo[9] <= last && hi[9] >= pred[9]);
+    }
+
+    #[test]
+    fn before_any_motion_a_jump_is_cut_to_the_noise() {
+        let mut e = Envelope::new(4);
+        for k in 0..50 {
+            e.track(1e-9 * ((k * 7 % 3) as f64 - 1.0));
+        }
+        let mut pred = vec![-1e-3; 4];
+        let (mut lo, mut hi) = (vec![-2e-3; 4], vec![0.0; 4]);
+        assert_eq!(e.cut(&mut pred, 0.0, |_| (1.5, 1.5), &mut lo, &mut hi), 4);
+        assert!(pred.iter().all(|v| v.abs() <= 1e-8), "{pred:?}");
+        // its interval still reaches what the model said, widened to the hold
+        assert!(lo.iter().all(|&l| l <= -1e-3 + 1e-9), "{lo:?}");
+    }
+
+    #[test]
+    fn units_do_not_change_what_is_cut() {
+        let y: Vec<f64> = (0..80).map(|k| ((k as f64) * 0.2).sin()).collect();
+        let run = |scale: f64| {
+            let mut e = Envelope::new(6);
+            for v in &y {
+                e.track(v * scale);
+            }
+            let mut p: Vec<f64> = (1..=6).map(|j| scale * 0.3 * j as f64).collect();
+            let (mut lo, mut hi) = (p.clone(), p.clone());
+            let n = e.cut(&mut p, y[79] * scale, |_| (1.5, 1.5), &mut lo, &mut hi);
+            (n, p.iter().map(|v| v / scale).collect::<Vec<_>>())
+        };
+        let (a, pa) = run(1.0);
+        let (b, pb) = run(1e-6);
+        assert_eq!(a, b);
+        for (x, z) in pa.iter().zip(&pb) {
+            assert!((x - z).abs() < 1e-9 * x.abs().max(1.0));
+        }
+    }
+}

@@ -4,7 +4,7 @@
 //! plus a 10-step prediction, the ARX fit using the exact sliding update),
 //! (`oe_projected`: `OeJacobian::Projected`), and `rls` per sample (it
 //! updates on every sample; hop 10, window 100).
-//! Target (issue 6): RLS ≤ 200 ns per sample.
+//! Target: RLS ≤ 200 ns per sample.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use feedid::drive::{RigParams, VirtualRig};

@@ -1,7 +1,7 @@
 //! Benchmark: the paper method per window (fit + prediction of H = 10
 //! samples) at W = 20, QR and simplex, on windows of the virtual rig's ramp
 //! (every effect on) in motion, consecutive windows (hop 10). Targets
-//! (issue 19): QR ≤ 1 µs, simplex ≤ 50 µs per window; the simplex from the
+//! QR ≤ 1 µs, simplex ≤ 50 µs per window; the simplex from the
 //! paper's zeros (default) and from the previous window's coefficients.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};

@@ -1,4 +1,4 @@
-//! The drive-zoo benchmark (issue 13): every identification method with its
+//! The drive-zoo benchmark: every identification method with its
 //! defaults and three simple baselines on every zoo member, 10-sample-ahead
 //! (H = 10) prediction, every comparison scored on the samples both predict.
 //!

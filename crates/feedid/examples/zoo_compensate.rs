@@ -1,4 +1,4 @@
-//! Compensation on the drive zoo (issue 18): for every regular zoo member
+//! Compensation on the drive zoo: for every regular zoo member
 //! whose command is a ramp, an S-curve, a point-to-point program or a
 //! contour axis, identify a global model from a **chirp** run on the same
 //! axis, compensate the member's command with it (library defaults: smoothing

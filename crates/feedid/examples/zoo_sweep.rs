@@ -1,5 +1,5 @@
 //! A settings sweep on the drive zoo: the tool that chose the defaults of
-//! `arx`, `rls` and `auto`'s candidates (issue 13). A development tool, not
+//! `arx`, `rls` and `auto`'s candidates. A development tool, not
 //! a benchmark: it panics on a bad configuration line.
 //!
 //! ```sh

@@ -1,10 +1,10 @@
-//! 2 ms-ahead prediction targets of the `arx` and `rls` estimators (issue 5)
+//! 2 ms-ahead prediction targets of the `arx` and `rls` estimators
 //! on the virtual rig (all effects on, 0.2 µm noise, 0.1 µm quantisation,
 //! 5 kHz, horizon H = 10 = 2 ms, hop = H) and on the EMPS benchmark (1 kHz,
 //! H = 10).
 //!
-//! Settings: the rig-tuned settings of issue 5, which were the defaults until
-//! issue 13 chose new ones on the drive zoo (see the README's zoo benchmark):
+//! Settings: the settings tuned on the rig, the defaults before the drive
+//! zoo chose the present ones (see the README's zoo benchmark):
 //! `arx` na = nb = 8, nk = 1, ridge 1e-8, DC gain in [0.5, 2], excitation
 //! gate 0.1 µm, over windows of W = 200 samples; `rls` na = nb = 8, nk = 1,
 //! λ = 0.999, p0 = 1e4, coordinates scaled by 1 mm, predictions every H
@@ -36,7 +36,7 @@ fn run(est: &mut dyn Estimator, s: &Signals<'_>, window: usize) -> ErrorStats {
     r.stats
 }
 
-/// The rig-tuned settings of issue 5.
+/// The settings tuned on the rig (the defaults before the drive zoo).
 fn both(s: &Signals<'_>) -> (ErrorStats, ErrorStats) {
     let mut arx = ArxConfig {
         orders: ArxOrders::new(8, 8, 1),

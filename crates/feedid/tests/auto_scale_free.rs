@@ -1,4 +1,4 @@
-//! Issue 13: `auto` is scale-free, always predicts, carries calibrated
+//! `auto` is scale-free, always predicts, carries calibrated
 //! prediction intervals, and an isolated glitch neither is fitted nor ends
 //! the predictions of any regressor method.
 
@@ -13,7 +13,7 @@ use feedid::zoo::Zoo;
 const H: usize = 10;
 
 /// Invariance tolerance of nearly every sample, relative to the
-/// recording's range. Issue 13 asks 1e-9; a recording converted to mm or µm
+/// recording's range. The aim is 1e-9; a recording converted to mm or µm
 /// differs in its last bits, and the recursive candidates amplify that to
 /// 1e-12 … 1e-8 of the range over thousands of samples.
 const TOL: f64 = 2e-8;

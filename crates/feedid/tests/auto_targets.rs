@@ -2,14 +2,14 @@
 //! effects on, 0.2 µm noise, 0.1 µm quantisation, 5 kHz, horizon H = 10 =
 //! 2 ms, hop = H, window 50) and on the EMPS benchmark (1 kHz, H = 10).
 //!
-//! `auto` predicts every window after its first (issue 13), so coverage
+//! `auto` predicts every window after its first, so coverage
 //! after the first window is 100 % on every scenario. Its error targets
-//! (issue 5: rms ≤ 0.5 µm, max ≤ 10 µm) hold once the motion has been seen:
+//! (rms ≤ 0.5 µm, max ≤ 10 µm) hold once the motion has been seen:
 //! over the samples from 100 ms on (the first horizons of a motion, before
 //! any model has seen it, are predicted by holding: up to ~100 µm on the
 //! ramp's start), except at the ramp's stop (see below). The paper step (50 ms, the current saturated for ~25 ms)
 //! is checked for coverage only. EMPS: ≤ 0.40 µm rms over every predicted
-//! sample at ≥ 99.5 % coverage (issue 13).
+//! sample at ≥ 99.5 % coverage.
 
 mod common;
 
@@ -72,7 +72,7 @@ fn auto_reaches_the_prediction_targets_on_every_rig_scenario() {
         );
         // the ramp's stop at 0.61 s is a change no model has seen: predicted
         // by the models of the constant speed, up to 12 µm off for a horizon
-        // (issue 5's 0.5 µm / 10 µm are missed there: 0.52 / 12.3 µm)
+        // (the 0.5 µm / 10 µm targets are missed there: 0.52 / 12.3 µm)
         let (rms, max) = if scenario == Scenario::Ramp {
             (0.55e-6, 15e-6)
         } else {

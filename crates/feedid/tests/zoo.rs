@@ -1,4 +1,4 @@
-//! The drive zoo: determinism, stability, coverage of the ranges issue 13
+//! The drive zoo: determinism, stability, coverage of the ranges the zoo
 //! asks for, defects.
 
 use std::collections::BTreeSet;
@@ -49,7 +49,7 @@ fn every_member_is_stable_finite_and_within_its_caps() {
     let zoo = Zoo::standard();
     assert!(
         zoo.regular().len() >= 200,
-        "issue 13: at least 200 recordings"
+        "the zoo: at least 200 recordings"
     );
     let idx: Vec<usize> = (0..zoo.len()).collect();
     for (i, m) in zoo.members(&idx).into_iter().enumerate() {

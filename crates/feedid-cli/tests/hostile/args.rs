@@ -1,4 +1,4 @@
-//! Negative numbers typed as option values (issue 15): every numeric option
+//! Negative numbers typed as option values: every numeric option
 //! of every command takes `-5` or `-1e-6` as its value, so the validator
 //! answers with its own message naming the option and the value — never
 //! clap's "unexpected argument".

@@ -486,7 +486,7 @@ fn catalogue() -> Vec<Case> {
             expect: Fails(&["{file}", "no variable `time`", "qg"]),
             stream: Fails(&["no usable line"]),
         },
-        // --- issue 15: hostile text and implausible recordings
+        // --- hostile text and implausible recordings
         Case {
             name: "CR-only line endings",
             file: "mac.csv",

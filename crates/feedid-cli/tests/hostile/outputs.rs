@@ -1,4 +1,4 @@
-//! Outputs that never destroy (issue 15), as tables over every command that
+//! Outputs that never destroy, as tables over every command that
 //! writes a file:
 //!
 //! - [`destinations`]: what an output path names — a character device

@@ -1,4 +1,4 @@
-//! Unstable physical models (issue 15), as a table: every family of
+//! Unstable physical models, as a table: every family of
 //! unstable parameters (high position gain, high velocity gain, high
 //! integral gains, a soft screw) × every command that uses a rig file.
 //! `model` says UNSTABLE (`"stable": false` in JSON); every command that

@@ -1,4 +1,4 @@
-//! Results that never mislead (issue 15): verdicts agree with the data.
+//! Results that never mislead: verdicts agree with the data.
 //!
 //! - grey-box: a model that leaves structure in the residuals (the linear
 //!   model of a rig with friction, position alone or with the current, any

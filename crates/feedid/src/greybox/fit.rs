@@ -1083,7 +1083,7 @@ mod tests {
 
     #[test]
     fn a_linear_model_of_data_with_friction_is_not_called_identifiable() {
-        // issue 15: the linear model started from the true values on the
+        // the linear model started from the true values on the
         // rig's data (friction, quantisation, noise) gave C2 and Ki far off
         // (here C2 ≈ 780 vs 100, Ki ≈ 340 vs 471) with standard errors of
         // about 1 %, labelled identifiable. The residuals are far from white.

@@ -383,7 +383,7 @@ mod tests {
 
     #[test]
     fn a_window_without_excitation_keeps_the_last_estimate() {
-        // issue 15: K tracked on a plain ramp ran off to 1.18e16 N/m, "converged"
+        // K tracked on a plain ramp ran off to 1.18e16 N/m, "converged"
         let rate = 5000.0;
         let u = Ramp::default().generate(rate, 0.8).unwrap();
         let out = VirtualRig::new(RigParams::default())

@@ -1,6 +1,6 @@
 //! The drive zoo: a deterministic family of generated recordings of feed
 //! drives unlike the paper's rig, to choose defaults on and to benchmark
-//! every method against (issue 13).
+//! every method against.
 //!
 //! [`Zoo::standard`] holds 220 members: 210 regular recordings (every one a
 //! file `feedid identify` reads) and 10 with dropped rows. Member `i` depends

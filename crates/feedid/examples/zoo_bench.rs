@@ -418,6 +418,9 @@ struct Row {
     interval_coverage: Option<f64>,
     /// Scored samples and of them inside their interval, per command regime.
     by_regime: [(usize, usize); 5],
+    /// At the samples of a start of motion: the squared errors of the method
+    /// and of the hold baseline, and their number.
+    starts: (f64, f64, usize),
     seconds: f64,
     note: String,
     /// Gaps of dropped samples in the member (0 for a regular one).
@@ -455,6 +458,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
         baseline_ratio: None,
         interval_coverage: None,
         by_regime: [(0, 0); 5],
+        starts: (0.0, 0.0, 0),
         seconds: 0.0,
         note: String::new(),
         gaps: 0,
@@ -559,6 +563,10 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                 }
             }
             let mut by_regime = [(0usize, 0usize); 5];
+            // at starts of motion: squared errors of the method and of holding
+            // (the hold baseline) on the same samples
+            let mut starts = (0.0, 0.0, 0usize);
+            let hold = by_name["hold"];
             let interval_coverage = p.interval.as_ref().map(|(lo, hi, regime)| {
                 let (mut inside, mut total) = (0usize, 0usize);
                 for k in 0..n {
@@ -569,6 +577,11 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                         let r = &mut by_regime[regime[k].index()];
                         r.0 += 1;
                         r.1 += i;
+                        if regime[k] == Regime::Start && hold.has[k] {
+                            starts.0 += (y[k] - p.value[k]).powi(2);
+                            starts.1 += (y[k] - hold.value[k]).powi(2);
+                            starts.2 += 1;
+                        }
                     }
                 }
                 100.0 * inside as f64 / total.max(1) as f64
@@ -585,6 +598,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                 baseline_ratio: worst.map(|w| w.1),
                 interval_coverage,
                 by_regime,
+                starts,
                 gap_cost: without_gaps.as_ref().and_then(|(full, kept)| {
                     let q = full.iter().find(|q| q.name == p.name)?;
                     let (mut a, mut b, mut n_shared) = (0.0, 0.0, 0usize);
@@ -821,8 +835,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          and of them those below 80 %; members whose largest error is at most 1.5× the \
          hold's on the same member:\n"
     );
-    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's |");
-    println!("|---|---:|---:|---:|---:|---:|---:|");
+    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for method in LIBRARY {
         let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == method).collect();
         let within = mine
@@ -851,8 +865,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .filter(|q| q.is_finite())
             .collect();
         let bounded = ratios.iter().filter(|&&q| q <= 1.5).count();
+        // members with start-of-motion samples: the method's rms there
+        // against holding's on the same samples
+        let start_ratios: Vec<f64> = mine
+            .iter()
+            .filter(|r| r.starts.2 > 0 && r.starts.1 > 0.0)
+            .map(|r| (r.starts.0 / r.starts.1).sqrt())
+            .collect();
+        let above = start_ratios.iter().filter(|&&q| q > 1.0).count();
         println!(
-            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} |",
+            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} | {} ({above}) | {} |",
             mine.len(),
             pairs.len(),
             if worst_regime.is_finite() {
@@ -868,6 +890,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .fold(None, |a: Option<f64>, q| Some(a.map_or(q, |a| a.max(q)))),
                 2
             ),
+            start_ratios.len(),
+            fmt(quantile(&start_ratios, 0.5), 3),
         );
     }
     // the same count for every phase of the baselines' blocks

@@ -412,11 +412,6 @@ impl Guard {
         self.runaway_samples
     }
 
-    /// The interval factor of each regime now ([`Regime::ALL`] order).
-    pub fn regime_factors(&self) -> [f64; 5] {
-        self.factors.map(|t| t.q)
-    }
-
     /// Whether the prediction `values` of a window is plausible: it leaves
     /// the last measured position `last` by at most
     /// [`GuardConfig::plausibility`] times the larger of the largest range

@@ -140,7 +140,12 @@ pub struct SimulateArgs {
     /// Rig parameters (TOML); default: the built-in default rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
-    /// Nonlinear effects of the virtual rig (TOML, see `feedid simulate --help`); default: all on.
+    /// Nonlinear effects of the virtual rig: a TOML file of any of the keys friction
+    /// ([motor_friction], [table_friction]), variable_stiffness, limits (current_limit,
+    /// voltage_limit), quantisation (resolution), noise (noise_std), position_loop
+    /// (sampled, continuous, interpolated), backlash (backlash_width), dead_time and
+    /// [pulses] (force, width, period, first); missing keys keep the default: all on
+    /// but backlash, dead time and pulses.
     #[arg(long, value_name = "effects.toml", conflicts_with = "linear")]
     pub effects: Option<PathBuf>,
     /// Seed of the measurement noise (and of the PRBS).

@@ -34,7 +34,19 @@ fn zoo_list_prints_one_row_per_member_and_the_ranges() {
     assert!(s.contains("rig-heavy") && s.contains("second-order"), "{s}");
     // the whole zoo
     let o = feedid(&["zoo", "--list"]);
-    assert!(stdout(&o).contains("220 members span:"));
+    assert!(stdout(&o).contains("250 members span:"));
+    // the disturbed members, one of each kind at least, with their source
+    let o = feedid(&["zoo", "--list", "--members", "disturbed"]);
+    let s = stdout(&o);
+    assert!(s.contains("30 members span:"), "{s}");
+    assert!(
+        s.contains("force pulses on 10, strong friction on 10, coarse encoder on 10"),
+        "{s}"
+    );
+    assert!(
+        s.contains("force pulses") && s.contains("encoder") && s.contains(" of #"),
+        "{s}"
+    );
 }
 
 #[test]
@@ -206,7 +218,7 @@ fn a_member_with_dropped_rows_is_identified_segment_by_segment() {
 fn bad_member_sets_are_refused_with_the_choices() {
     for (set, needle) in [
         ("5..2", "empty"),
-        ("0..999", "member 220 does not exist"),
+        ("0..999", "member 250 does not exist"),
         ("one", "expected all, regular"),
         ("1,x", "expected all, regular"),
     ] {

@@ -3,11 +3,11 @@
 //! (H = 10) prediction, every comparison scored on the samples both predict.
 //!
 //! ```sh
-//! cargo run --release -p feedid --example zoo_bench                     # all 220 members
+//! cargo run --release -p feedid --example zoo_bench                     # all 250 members
 //! cargo run --release -p feedid --example zoo_bench -- --members small --csv zoo.csv
 //! ```
 //!
-//! `--members` takes all (default), regular, even, odd, gapped, small, a range `A..B` /
+//! `--members` takes all (default), regular, even, odd, gapped, disturbed, small, a range `A..B` /
 //! `A..=B` or a list `1,5,9`; `--csv FILE` writes one row per member and
 //! method. The summary is printed as a Markdown table.
 //!
@@ -73,6 +73,11 @@
 //! baselines. They are scored apart from the regular members, in a table of
 //! their own (coverage after each segment's first window, losses, and the
 //! rms against the same method on the member they were cut from).
+//!
+//! Disturbed members (force pulses, strong friction, a coarse encoder at
+//! ≤ 1 kHz: copies of regular members, [`feedid::zoo::Disturbance`]) are
+//! scored like the regular ones but apart, in tables of their own, so the
+//! main table stays comparable from one version to the next.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -402,6 +407,8 @@ const MIN_REGIME: usize = 200;
 struct Row {
     member: usize,
     label: String,
+    /// The disturbance of a disturbed member (`pulses`, `friction`, `encoder`).
+    disturbance: Option<&'static str>,
     plant: &'static str,
     command: &'static str,
     method: &'static str,
@@ -444,6 +451,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
     let base = Row {
         member: s.index,
         label: s.label.clone(),
+        disturbance: s.disturbed.map(|d| d.disturbance.name()),
         plant: s.plant.name(),
         command: s.command.name(),
         method: "",
@@ -657,7 +665,7 @@ fn parse_members(s: &str, zoo: &Zoo) -> Result<Vec<usize>, String> {
     let n = zoo.len();
     let bad = || {
         format!(
-            "invalid --members `{s}` (all, regular, even, odd, gapped, small, A..B, A..=B, 1,5,9)"
+            "invalid --members `{s}` (all, regular, even, odd, gapped, disturbed, small, A..B, A..=B, 1,5,9)"
         )
     };
     let v: Vec<usize> = match s {
@@ -666,6 +674,7 @@ fn parse_members(s: &str, zoo: &Zoo) -> Result<Vec<usize>, String> {
         "even" => zoo.regular().filter(|i| i % 2 == 0).collect(),
         "odd" => zoo.regular().filter(|i| i % 2 == 1).collect(),
         "gapped" => zoo.gapped().collect(),
+        "disturbed" => zoo.disturbed().collect(),
         "small" => zoo.small().collect(),
         _ if s.contains("..") => {
             let (a, b) = s.split_once("..").ok_or_else(bad)?;
@@ -747,11 +756,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut text = String::from(
             "member,method,plant,command,samples,predicted,coverage_percent,\
              coverage_after_first_window_percent,rms_m,max_m,ratio_to_best_fixed,beaten_by_baseline,worst_baseline_ratio,loses_significantly,interval_coverage_percent,\
-             seconds,note,label\n",
+             seconds,note,disturbance,label\n",
         );
         for r in &rows {
             text += &format!(
-                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{:.6},\"{}\",\"{}\"\n",
+                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{:.6},\"{}\",{},\"{}\"\n",
                 r.member,
                 r.method,
                 r.plant,
@@ -769,6 +778,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 fmt(r.interval_coverage, 2),
                 r.seconds,
                 r.note.replace('"', "'"),
+                r.disturbance.unwrap_or(""),
                 r.label.replace('"', "'")
             );
         }
@@ -778,7 +788,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let scored: Vec<&Row> = rows
         .iter()
-        .filter(|r| !r.note.starts_with("refused") && r.gaps == 0)
+        .filter(|r| !r.note.starts_with("refused") && r.gaps == 0 && r.disturbance.is_none())
+        .collect();
+    let disturbed: Vec<&Row> = rows
+        .iter()
+        .filter(|r| !r.note.starts_with("refused") && r.disturbance.is_some())
         .collect();
     let gapped: Vec<&Row> = rows
         .iter()
@@ -797,103 +811,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .map(|r| r.member)
         .collect::<std::collections::BTreeSet<_>>();
+    let disturbed_members = disturbed
+        .iter()
+        .map(|r| r.member)
+        .collect::<std::collections::BTreeSet<_>>();
     println!(
-        "Drive zoo benchmark: {} recordings scored (and {} with dropped rows, apart below; {} refused by the reader), H = {H}, {:.1} s wall on {} threads\n",
+        "Drive zoo benchmark: {} recordings scored (and {} with dropped rows and {} disturbed, apart below; {} refused by the reader), H = {H}, {:.1} s wall on {} threads\n",
         recordings.len(),
         gapped_members.len(),
+        disturbed_members.len(),
         refused.len(),
         wall,
         rayon::current_num_threads()
     );
-    println!("| method | compared | median rms / best fixed | 90th pct rms / best fixed | loses to a baseline | of which beyond chance | coverage after the first window, min / median [%] | median own rms [µm] | failed | 95 % interval coverage |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for method in LIBRARY.iter().chain(&BASELINES) {
-        let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == *method).collect();
-        let ratios: Vec<f64> = mine.iter().filter_map(|r| r.ratio).collect();
-        let losses = mine.iter().filter(|r| r.beaten_by.is_some()).count();
-        let significant = mine.iter().filter(|r| r.significant).count();
-        let cov: Vec<f64> = mine.iter().map(|r| r.coverage_after).collect();
-        let rms: Vec<f64> = mine.iter().filter_map(|r| r.rms).map(|v| v * 1e6).collect();
-        let failed = mine.iter().filter(|r| !r.note.is_empty()).count();
-        let intervals: Vec<f64> = mine.iter().filter_map(|r| r.interval_coverage).collect();
-        println!(
-            "| {method} | {} | {} | {} | {losses} of {} | {significant} | {} / {} | {} | {failed} | {} |",
-            ratios.len(),
-            fmt(quantile(&ratios, 0.5), 2),
-            fmt(quantile(&ratios, 0.9), 2),
-            mine.len(),
-            fmt(quantile(&cov, 0.0), 1),
-            fmt(quantile(&cov, 0.5), 1),
-            fmt(quantile(&rms, 0.5), 3),
-            fmt(quantile(&intervals, 0.5), 1),
-        );
-    }
-    // intervals and largest errors: per member, per regime, against the hold
+    main_table(&scored);
     println!(
         "\nPrediction intervals and largest errors: members whose 95 % interval coverage is \
          within [90, 98] %; (member, command regime) pairs with ≥ {MIN_REGIME} scored samples \
          and of them those below 80 %; members whose largest error is at most 1.5× the \
          hold's on the same member:\n"
     );
-    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for method in LIBRARY {
-        let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == method).collect();
-        let within = mine
-            .iter()
-            .filter(|r| {
-                r.interval_coverage
-                    .is_some_and(|c| (90.0..=98.0).contains(&c))
-            })
-            .count();
-        let pairs: Vec<f64> = mine
-            .iter()
-            .flat_map(|r| r.by_regime.iter())
-            .filter(|(n, _)| *n >= MIN_REGIME)
-            .map(|(n, i)| 100.0 * *i as f64 / *n as f64)
-            .collect();
-        let below = pairs.iter().filter(|&&c| c < 80.0).count();
-        let worst_regime = pairs.iter().copied().fold(f64::INFINITY, f64::min);
-        let ratios: Vec<f64> = mine
-            .iter()
-            .filter_map(|r| {
-                let hold = scored
-                    .iter()
-                    .find(|h| h.method == "hold" && h.member == r.member)?;
-                Some(r.max? / hold.max?)
-            })
-            .filter(|q| q.is_finite())
-            .collect();
-        let bounded = ratios.iter().filter(|&&q| q <= 1.5).count();
-        // members with start-of-motion samples: the method's rms there
-        // against holding's on the same samples
-        let start_ratios: Vec<f64> = mine
-            .iter()
-            .filter(|r| r.starts.2 > 0 && r.starts.1 > 0.0)
-            .map(|r| (r.starts.0 / r.starts.1).sqrt())
-            .collect();
-        let above = start_ratios.iter().filter(|&&q| q > 1.0).count();
-        println!(
-            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} | {} ({above}) | {} |",
-            mine.len(),
-            pairs.len(),
-            if worst_regime.is_finite() {
-                format!("{worst_regime:.1}")
-            } else {
-                "–".into()
-            },
-            ratios.len(),
-            fmt(
-                ratios
-                    .iter()
-                    .copied()
-                    .fold(None, |a: Option<f64>, q| Some(a.map_or(q, |a| a.max(q)))),
-                2
-            ),
-            start_ratios.len(),
-            fmt(quantile(&start_ratios, 0.5), 3),
-        );
-    }
+    interval_table(&scored);
     // the same count for every phase of the baselines' blocks
     println!(
         "\nRecordings where each library method loses to a baseline when the baselines' blocks \
@@ -998,6 +936,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if !gapped.is_empty() {
         gapped_table(&gapped);
     }
+    if !disturbed.is_empty() {
+        let kinds = ["pulses", "friction", "encoder"];
+        let count = |k: &str| {
+            disturbed_members
+                .iter()
+                .filter(|&&m| {
+                    disturbed
+                        .iter()
+                        .any(|r| r.member == m && r.disturbance == Some(k))
+                })
+                .count()
+        };
+        println!(
+            "\nDisturbed members ({} force pulses, {} strong friction, {} coarse encoder at \
+             ≤ 1 kHz; each a copy of a regular member, see `feedid zoo --list --members disturbed`):\n",
+            count(kinds[0]),
+            count(kinds[1]),
+            count(kinds[2])
+        );
+        main_table(&disturbed);
+        println!();
+        interval_table(&disturbed);
+    }
     println!(
         "\ncompared: recordings where the method shares ≥ {MIN_SHARED} predicted samples with a \
          fixed method; ratio: rms of the method / rms of the best fixed method (paper, arx, rls, oe \
@@ -1014,6 +975,97 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// The members with dropped rows: what the gaps cost each method.
+/// The main table: ratios to the best fixed method, losses, coverage, intervals.
+fn main_table(scored: &[&Row]) {
+    println!("| method | compared | median rms / best fixed | 90th pct rms / best fixed | loses to a baseline | of which beyond chance | coverage after the first window, min / median [%] | median own rms [µm] | failed | 95 % interval coverage |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for method in LIBRARY.iter().chain(&BASELINES) {
+        let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == *method).collect();
+        let ratios: Vec<f64> = mine.iter().filter_map(|r| r.ratio).collect();
+        let losses = mine.iter().filter(|r| r.beaten_by.is_some()).count();
+        let significant = mine.iter().filter(|r| r.significant).count();
+        let cov: Vec<f64> = mine.iter().map(|r| r.coverage_after).collect();
+        let rms: Vec<f64> = mine.iter().filter_map(|r| r.rms).map(|v| v * 1e6).collect();
+        let failed = mine.iter().filter(|r| !r.note.is_empty()).count();
+        let intervals: Vec<f64> = mine.iter().filter_map(|r| r.interval_coverage).collect();
+        println!(
+            "| {method} | {} | {} | {} | {losses} of {} | {significant} | {} / {} | {} | {failed} | {} |",
+            ratios.len(),
+            fmt(quantile(&ratios, 0.5), 2),
+            fmt(quantile(&ratios, 0.9), 2),
+            mine.len(),
+            fmt(quantile(&cov, 0.0), 1),
+            fmt(quantile(&cov, 0.5), 1),
+            fmt(quantile(&rms, 0.5), 3),
+            fmt(quantile(&intervals, 0.5), 1),
+        );
+    }
+}
+
+/// Intervals and largest errors: coverage per member and per regime, the
+/// largest error against the hold's, the starts of motion.
+fn interval_table(scored: &[&Row]) {
+    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for method in LIBRARY {
+        let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == method).collect();
+        let within = mine
+            .iter()
+            .filter(|r| {
+                r.interval_coverage
+                    .is_some_and(|c| (90.0..=98.0).contains(&c))
+            })
+            .count();
+        let pairs: Vec<f64> = mine
+            .iter()
+            .flat_map(|r| r.by_regime.iter())
+            .filter(|(n, _)| *n >= MIN_REGIME)
+            .map(|(n, i)| 100.0 * *i as f64 / *n as f64)
+            .collect();
+        let below = pairs.iter().filter(|&&c| c < 80.0).count();
+        let worst_regime = pairs.iter().copied().fold(f64::INFINITY, f64::min);
+        let ratios: Vec<f64> = mine
+            .iter()
+            .filter_map(|r| {
+                let hold = scored
+                    .iter()
+                    .find(|h| h.method == "hold" && h.member == r.member)?;
+                Some(r.max? / hold.max?)
+            })
+            .filter(|q| q.is_finite())
+            .collect();
+        let bounded = ratios.iter().filter(|&&q| q <= 1.5).count();
+        // members with start-of-motion samples: the method's rms there
+        // against holding's on the same samples
+        let start_ratios: Vec<f64> = mine
+            .iter()
+            .filter(|r| r.starts.2 > 0 && r.starts.1 > 0.0)
+            .map(|r| (r.starts.0 / r.starts.1).sqrt())
+            .collect();
+        let above = start_ratios.iter().filter(|&&q| q > 1.0).count();
+        println!(
+            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} | {} ({above}) | {} |",
+            mine.len(),
+            pairs.len(),
+            if worst_regime.is_finite() {
+                format!("{worst_regime:.1}")
+            } else {
+                "–".into()
+            },
+            ratios.len(),
+            fmt(
+                ratios
+                    .iter()
+                    .copied()
+                    .fold(None, |a: Option<f64>, q| Some(a.map_or(q, |a| a.max(q)))),
+                2
+            ),
+            start_ratios.len(),
+            fmt(quantile(&start_ratios, 0.5), 3),
+        );
+    }
+}
+
 fn gapped_table(gapped: &[&Row]) {
     println!(
         "\nMembers with dropped rows ({}): every method and baseline restarts its windows \

@@ -32,14 +32,14 @@ fn the_same_seed_gives_the_same_bits_alone_or_in_parallel() {
         assert_eq!(zoo.spec(i).unwrap(), alone.spec);
     }
     // another seed is another zoo
-    let other = Zoo::new(14, 20, 0).unwrap();
+    let other = Zoo::new(14, 20, 0, 0).unwrap();
     assert_ne!(
         other.member(0).unwrap().position,
         parallel[0].as_ref().unwrap().position
     );
     // the standard zoo through `new` is the same zoo
     assert_eq!(
-        Zoo::new(13, 210, 10).unwrap().member(5).unwrap(),
+        Zoo::new(13, 210, 10, 30).unwrap().member(5).unwrap(),
         zoo.member(5).unwrap()
     );
 }
@@ -96,7 +96,7 @@ fn every_member_is_stable_finite_and_within_its_caps() {
 }
 
 #[test]
-fn the_family_spans_the_ranges_of_issue_13() {
+fn the_family_spans_the_ranges_its_module_doc_promises() {
     let zoo = Zoo::standard();
     let specs = all_specs(&zoo);
     let (lo, hi) = min_max(specs.iter().map(|s| s.rate_hz));
@@ -233,7 +233,7 @@ fn unknown_members_are_an_error_not_a_panic() {
     let zoo = Zoo::standard();
     assert!(zoo.member(zoo.len()).is_err());
     assert!(zoo.spec(usize::MAX).is_err());
-    assert!(Zoo::new(1, 0, 3).is_err());
+    assert!(Zoo::new(1, 0, 3, 0).is_err());
 }
 
 #[test]
@@ -272,4 +272,76 @@ fn run_plant_on_the_members_own_command_gives_its_recording() {
     assert!(exact >= 5, "{exact}");
     assert!(zoo.spec(0).unwrap().run_plant(&[0.0], 1).is_err());
     assert!(zoo.spec(0).unwrap().run_plant(&[0.0, f64::NAN], 1).is_err());
+}
+
+#[test]
+fn disturbed_members_are_their_source_with_one_disturbance() {
+    use feedid::zoo::Disturbance;
+    let zoo = Zoo::standard();
+    let idx: Vec<usize> = zoo.disturbed().collect();
+    assert_eq!(idx.len(), 30);
+    let mut kinds = [0usize; 3];
+    for m in zoo.members(&idx) {
+        let m = m.unwrap();
+        let s = &m.spec;
+        let d = s.disturbed.expect("a disturbed member says what it adds");
+        let src = zoo.member(d.source).unwrap();
+        assert!(zoo.regular().contains(&d.source));
+        // every disturbed member is a recording the reader accepts
+        assert!(m.recording().is_ok(), "member {}", s.index);
+        // the source's command (re-planned at the lower rate of a coarse encoder)
+        assert_eq!(s.command.name(), src.spec.command.name());
+        if !matches!(d.disturbance, Disturbance::Encoder { .. }) {
+            assert_eq!(s.command, src.spec.command, "member {}", s.index);
+        }
+        match d.disturbance {
+            Disturbance::Pulses { pulses, share } => {
+                kinds[0] += 1;
+                assert!(matches!(s.plant, PlantKind::Rig(_)));
+                assert!((0.1..=0.5).contains(&share));
+                assert!(pulses.width >= 1e-3 * 0.999 && pulses.width <= 0.05);
+                assert_eq!(s.rig.unwrap().effects.pulses, pulses);
+                // the same axis and noise: identical until the first pulse,
+                // pushed off the source's path after it
+                let first = (pulses.first * s.rate_hz).floor() as usize;
+                assert_eq!(m.truth[..first], src.truth[..first], "member {}", s.index);
+                let moved = m
+                    .truth
+                    .iter()
+                    .zip(&src.truth)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                assert!(moved > 0.0, "member {}", s.index);
+            }
+            Disturbance::Friction { share } => {
+                kinds[1] += 1;
+                assert!((0.1..=0.25).contains(&share));
+                assert_eq!(s.friction_share, share);
+                assert!(src.spec.friction_share <= 0.1);
+                assert!(
+                    ["sweep", "square", "p2p", "contour"].contains(&s.command.name()),
+                    "member {}: friction members reverse",
+                    s.index
+                );
+                let rig = s.rig.unwrap();
+                assert!(rig.effects.friction && rig.effects.table_friction.coulomb > 0.0);
+            }
+            Disturbance::Encoder { counts } => {
+                kinds[2] += 1;
+                assert!((30.0..=1000.0).contains(&counts));
+                assert!(s.rate_hz <= 1000.0 * (1.0 + 1e-9), "member {}", s.index);
+                let q = s.resolution_m;
+                assert!((q * counts / s.amplitude_m - 1.0).abs() < 1e-9);
+                assert_eq!(s.noise_std_m, 0.0);
+                // every measured sample (but glitches) is a whole count
+                for (k, y) in m.position.iter().enumerate() {
+                    if s.glitches.iter().all(|g| g.index != k) {
+                        let c = y / q;
+                        assert!((c - c.round()).abs() < 1e-6, "member {} row {k}", s.index);
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(kinds, [10, 10, 10]);
 }

@@ -22,8 +22,9 @@ pub struct ZooArgs {
     /// with DIR/manifest.csv and DIR/manifest.json (every parameter drawn).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Members: all, regular (readable), gapped (dropped rows), small (the
-    /// first 20), a range A..B or A..=B, or a list 1,5,9.
+    /// Members: all, regular, gapped (dropped rows), disturbed (force
+    /// pulses, strong friction, coarse encoders), small (the first 20), a
+    /// range A..B or A..=B, or a list 1,5,9.
     #[arg(long, value_name = "SET", default_value = "all")]
     pub members: String,
 }
@@ -54,7 +55,7 @@ fn parse_members(s: &str, zoo: &Zoo) -> Result<Vec<usize>> {
     let n = zoo.len();
     let bad = || {
         anyhow::anyhow!(
-            "invalid --members `{s}`: expected all, regular, gapped, small, A..B, A..=B or a list 1,5,9 (members 0 … {})",
+            "invalid --members `{s}`: expected all, regular, gapped, disturbed, small, A..B, A..=B or a list 1,5,9 (members 0 … {})",
             n - 1
         )
     };
@@ -62,6 +63,7 @@ fn parse_members(s: &str, zoo: &Zoo) -> Result<Vec<usize>> {
         "all" => (0..n).collect(),
         "regular" => zoo.regular().collect(),
         "gapped" => zoo.gapped().collect(),
+        "disturbed" => zoo.disturbed().collect(),
         "small" => zoo.small().collect(),
         _ if t.contains("..") => {
             let (lo, hi) = t.split_once("..").ok_or_else(bad)?;
@@ -195,6 +197,13 @@ fn table(specs: &[MemberSpec]) -> String {
         count(&|m| !m.glitches.is_empty()),
         count(&|m| m.has_gaps())
     );
+    let kind = |k: &'static str| count(&|m| m.disturbed.is_some_and(|d| d.disturbance.name() == k));
+    s += &format!(
+        "  disturbances           force pulses on {}, strong friction on {}, coarse encoder on {}\n",
+        kind("pulses"),
+        kind("friction"),
+        kind("encoder")
+    );
     s
 }
 
@@ -258,7 +267,8 @@ fn manifest_csv(specs: &[MemberSpec], w: &mut dyn Write) -> std::io::Result<()> 
         "index,file,readable,plant,command,rate_hz,loop_rate_hz,samples,duration_s,kv,\
          velocity_bandwidth_hz,kvff,kaff,mass_kg,axial_mode_hz,resonance_placed,friction_share,\
          backlash_m,dead_time_samples,resolution_m,noise_std_m,amplitude_m,glitch_rows,\
-         dropped_rows,gap_source,max_real_part,min_damping,spectral_radius,label"
+         dropped_rows,gap_source,disturbance,disturbed_source,max_real_part,min_damping,\
+         spectral_radius,label"
     )?;
     let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
     let rows = |v: &[usize]| {
@@ -271,7 +281,7 @@ fn manifest_csv(specs: &[MemberSpec], w: &mut dyn Write) -> std::io::Result<()> 
         let glitches: Vec<usize> = s.glitches.iter().map(|g| g.index).collect();
         writeln!(
             w,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
             s.index,
             file_name(s.index),
             !s.has_gaps(),
@@ -297,6 +307,10 @@ fn manifest_csv(specs: &[MemberSpec], w: &mut dyn Write) -> std::io::Result<()> 
             rows(&glitches),
             rows(&s.dropped_rows),
             s.gap_source.map(|g| g.to_string()).unwrap_or_default(),
+            s.disturbed.map(|d| d.disturbance.name()).unwrap_or_default(),
+            s.disturbed
+                .map(|d| d.source.to_string())
+                .unwrap_or_default(),
             s.stability.max_real_part,
             s.stability.min_damping,
             s.stability.spectral_radius,

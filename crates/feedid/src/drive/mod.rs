@@ -19,7 +19,8 @@ pub use params::{
     Geometry, Inertia, Material, Motor, RigParams, Stiffness, Table,
 };
 pub use rig::{
-    Friction, PositionLoop, RigEffects, RigOutput, RigStepper, VirtualRig, DEFAULT_MAX_STEP,
+    ForcePulses, Friction, PositionLoop, RigEffects, RigOutput, RigStepper, VirtualRig,
+    DEFAULT_MAX_STEP,
 };
 pub use stability::{check_model, require_stable, ModelCheck};
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

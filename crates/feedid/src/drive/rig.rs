@@ -84,6 +84,10 @@
 //!   while the recorded command is `x_s[k]`; the command before the first
 //!   sample is the first sample. The linear response is the delay-free one
 //!   shifted by d samples.
+//! * **Force pulses** (`pulses`, default off): a train of table forces of
+//!   alternating sign, `force` N for `width` s every `period` s from `first`
+//!   s on ([`ForcePulses`]): interrupted cutting and impacts, a disturbance
+//!   the command does not announce.
 //! * **Sampled position loop**: see below.
 //!
 //! # Sampling and integration
@@ -257,6 +261,8 @@ pub struct RigEffects {
     /// Dead time between the recorded set-point and the drive \[samples\]:
     /// the loop acts on `x_s[k − d]`; default 0 (off).
     pub dead_time: usize,
+    /// Force pulses on the table (cutting, impacts); default off (`force = 0`).
+    pub pulses: ForcePulses,
 }
 
 /// How the P position loop is closed (see the module doc, "Sampling").
@@ -292,6 +298,7 @@ impl Default for RigEffects {
             backlash: false,
             backlash_width: 5e-6,
             dead_time: 0,
+            pulses: ForcePulses::default(),
         }
     }
 }
@@ -310,6 +317,7 @@ impl RigEffects {
             position_loop: PositionLoop::Continuous,
             backlash: false,
             dead_time: 0,
+            pulses: ForcePulses::default(),
             ..Self::default()
         }
     }
@@ -340,7 +348,7 @@ impl RigEffects {
                 reason: "must be at most 1e6 samples",
             });
         }
-        Ok(())
+        self.pulses.validate()
     }
 }
 
@@ -697,7 +705,7 @@ impl Plant {
 
     /// Right-hand side `ẋ = f(x, input)`.
     #[inline]
-    fn deriv(&self, x: &[f64; 7], input: Input, tau: f64) -> [f64; 7] {
+    fn deriv(&self, x: &[f64; 7], input: Input, tau: f64, disturbance: f64) -> [f64; 7] {
         let [zv, zi, i, th, w, xa, va] = *x;
         let (vc, iff) = match input {
             Input::Held { vc, iff } => (vc, iff),
@@ -753,20 +761,22 @@ impl Plant {
             w,
             (self.kt * i - self.c1 * w - self.r * spring - tf) * self.inv_j,
             va,
-            (spring - self.c2 * va - ff) * self.inv_m,
+            (spring - self.c2 * va - ff + disturbance) * self.inv_m,
         ]
     }
 
-    /// One classical Runge–Kutta step of length `h` from time `tau` after the sample.
+    /// One classical Runge–Kutta step of length `h` from time `tau` after the
+    /// sample, under the table force `disturbance` \[N\] (held over the step).
     #[inline]
-    fn rk4(&self, x: &mut [f64; 7], input: Input, tau: f64, h: f64) {
+    fn rk4(&self, x: &mut [f64; 7], input: Input, tau: f64, h: f64, disturbance: f64) {
         let axpy = |a: &[f64; 7], s: f64, b: &[f64; 7]| -> [f64; 7] {
             std::array::from_fn(|j| a[j] + s * b[j])
         };
-        let k1 = self.deriv(x, input, tau);
-        let k2 = self.deriv(&axpy(x, 0.5 * h, &k1), input, tau + 0.5 * h);
-        let k3 = self.deriv(&axpy(x, 0.5 * h, &k2), input, tau + 0.5 * h);
-        let k4 = self.deriv(&axpy(x, h, &k3), input, tau + h);
+        let d = disturbance;
+        let k1 = self.deriv(x, input, tau, d);
+        let k2 = self.deriv(&axpy(x, 0.5 * h, &k1), input, tau + 0.5 * h, d);
+        let k3 = self.deriv(&axpy(x, 0.5 * h, &k2), input, tau + 0.5 * h, d);
+        let k4 = self.deriv(&axpy(x, h, &k3), input, tau + h, d);
         let h6 = h / 6.0;
         for j in 0..7 {
             x[j] += h6 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
@@ -796,8 +806,10 @@ fn non_negative(name: &'static str, value: f64) -> Result<()> {
     Ok(())
 }
 
+mod pulses;
 mod stepper;
 
+pub use pulses::ForcePulses;
 pub use stepper::RigStepper;
 
 #[cfg(test)]

@@ -42,8 +42,8 @@ use nalgebra::Complex;
 use super::design::{Dim, Draws};
 use super::spec::{AxisClass, RigSetup, Stability};
 use crate::drive::{
-    closed_loop_state_space, closed_loop_state_space_with_stiffness, Friction, PositionLoop,
-    RigEffects, RigParams,
+    closed_loop_state_space, closed_loop_state_space_with_stiffness, ForcePulses, Friction,
+    PositionLoop, RigEffects, RigParams,
 };
 use crate::error::{Error, Result};
 use crate::lti::{DiscreteStateSpace, StateSpace};
@@ -261,6 +261,7 @@ pub(crate) fn build(d: &mut Draws, inp: &AxisInputs) -> Result<Axis> {
                     RigEffects::default().backlash_width
                 },
                 dead_time: inp.dead_time,
+                pulses: ForcePulses::default(),
             };
             p.validate()?;
             effects.validate()?;

@@ -9,9 +9,14 @@ use super::axis::{self, class_ranges, AxisInputs};
 use super::command::{self, CommandKind, Limits};
 use super::defects;
 use super::design::{log_lerp, plant_group, Dim, Draws};
+use super::disturbance::{
+    self, Disturbance, Disturbed, ENCODER_COUNTS, ENCODER_MAX_RATE, FRICTION_SHARE, PULSE_SHARE,
+    PULSE_WIDTH,
+};
 use super::member::ZooMember;
 use super::spec::{AxisClass, MemberSpec, PlantKind, ServoSetup};
 use super::{plant, servo};
+use crate::drive::ForcePulses;
 use crate::error::{Error, Result};
 
 /// Seed of the standard zoo.
@@ -20,6 +25,8 @@ pub const ZOO_SEED: u64 = 13;
 pub const STANDARD_REGULAR: usize = 210;
 /// Members of the standard zoo with dropped rows (after the regular ones).
 pub const STANDARD_GAPPED: usize = 10;
+/// Disturbed members of the standard zoo (after those with dropped rows).
+pub const STANDARD_DISTURBED: usize = 30;
 /// Members of the small subset (the first regular members).
 pub const SMALL_MEMBERS: usize = 20;
 /// Most rows of a member's recording.
@@ -36,7 +43,7 @@ pub const MIN_ROWS: usize = 1000;
 /// ```
 /// use feedid::zoo::Zoo;
 /// let zoo = Zoo::standard();
-/// assert_eq!(zoo.len(), 220);
+/// assert_eq!(zoo.len(), 250);
 /// let m = zoo.member(3).unwrap();
 /// assert_eq!(m, zoo.member(3).unwrap()); // the same bits every time
 /// assert!(m.recording().is_ok());
@@ -46,32 +53,39 @@ pub struct Zoo {
     seed: u64,
     regular: usize,
     gapped: usize,
+    disturbed: usize,
 }
 
 impl Zoo {
-    /// The standard zoo: seed 13, 210 regular members and 10 with dropped rows.
+    /// The standard zoo: seed 13, 210 regular members, 10 with dropped rows
+    /// and 30 disturbed.
     pub fn standard() -> Self {
         Self {
             seed: ZOO_SEED,
             regular: STANDARD_REGULAR,
             gapped: STANDARD_GAPPED,
+            disturbed: STANDARD_DISTURBED,
         }
     }
 
     /// A zoo with another seed or size (member `i` depends on the seed, `i`
-    /// and the number of regular members; gapped members copy regular ones).
-    pub fn new(seed: u64, regular: usize, gapped: usize) -> Result<Self> {
-        if regular == 0 && gapped > 0 {
-            return Err(Error::InvalidParameter {
-                name: "gapped",
-                value: gapped as f64,
-                reason: "gapped members copy regular ones: needs at least one regular member",
-            });
+    /// and the number of regular members; gapped and disturbed members copy
+    /// regular ones, so they need at least one).
+    pub fn new(seed: u64, regular: usize, gapped: usize, disturbed: usize) -> Result<Self> {
+        for (name, count) in [("gapped", gapped), ("disturbed", disturbed)] {
+            if regular == 0 && count > 0 {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: count as f64,
+                    reason: "these members copy regular ones: needs at least one regular member",
+                });
+            }
         }
         Ok(Self {
             seed,
             regular,
             gapped,
+            disturbed,
         })
     }
 
@@ -82,7 +96,7 @@ impl Zoo {
 
     /// Number of members.
     pub fn len(&self) -> usize {
-        self.regular + self.gapped
+        self.regular + self.gapped + self.disturbed
     }
 
     /// True when the zoo has no member.
@@ -97,7 +111,19 @@ impl Zoo {
 
     /// Indices of the members with dropped rows.
     pub fn gapped(&self) -> Range<usize> {
-        self.regular..self.len()
+        self.regular..self.regular + self.gapped
+    }
+
+    /// Indices of the disturbed members (force pulses, strong friction, a
+    /// coarse encoder at a low rate; every one readable).
+    pub fn disturbed(&self) -> Range<usize> {
+        self.regular + self.gapped..self.len()
+    }
+
+    /// Indices of every member the reader accepts: the regular members, then
+    /// the disturbed ones.
+    pub fn readable(&self) -> Vec<usize> {
+        self.regular().chain(self.disturbed()).collect()
     }
 
     /// Indices of the small subset for fast tests: the first 20 regular
@@ -140,10 +166,13 @@ impl Zoo {
             });
         }
         if index < self.regular {
-            return plan_regular(self.seed, self.regular, index);
+            return plan_regular(self.seed, self.regular, index, &Overrides::default());
+        }
+        if index >= self.regular + self.gapped {
+            return self.plan_disturbed(index, index - self.regular - self.gapped);
         }
         let source = self.gap_source(index - self.regular);
-        let mut plan = plan_regular(self.seed, self.regular, source)?;
+        let mut plan = plan_regular(self.seed, self.regular, source, &Overrides::default())?;
         let mut d = Draws::new(self.seed, index, self.regular);
         let rows = defects::dropped_rows(&mut d, plan.rows);
         let s = &mut plan.spec;
@@ -153,6 +182,130 @@ impl Zoo {
         s.gap_source = Some(source);
         s.label = s.make_label();
         Ok(plan)
+    }
+}
+
+impl Zoo {
+    /// The regular member the `d`-th disturbed member copies: candidates of
+    /// its kind (disturbance.rs), spread evenly.
+    fn disturbed_source(&self, d: usize) -> Result<usize> {
+        let kind = disturbance::kind_of(d);
+        let is_rig = |i: usize| plant_group(i) <= 2;
+        let reverses = |i: usize| {
+            matches!(
+                CommandKind::of(i),
+                CommandKind::Sweep
+                    | CommandKind::Square
+                    | CommandKind::PointToPoint
+                    | CommandKind::Contour
+            )
+        };
+        let candidates: Vec<usize> = self
+            .regular()
+            .filter(|&i| match kind {
+                0 => is_rig(i),
+                1 => is_rig(i) && reverses(i),
+                _ => true,
+            })
+            .collect();
+        if candidates.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "disturbed",
+                value: self.disturbed as f64,
+                reason: "no regular member of the kind a disturbed member copies",
+            });
+        }
+        // the golden-ratio sequence: well spread for any count, and irregular
+        // enough not to follow the design's cycles (command, feed-forward)
+        let golden = 0.5 * (5f64.sqrt() - 1.0);
+        let u = (0.05 + 0.3 * kind as f64 + (d / 3) as f64 * golden).fract();
+        let at = ((u * candidates.len() as f64) as usize).min(candidates.len() - 1);
+        Ok(candidates[at])
+    }
+
+    fn plan_disturbed(&self, index: usize, d: usize) -> Result<Plan> {
+        let source = self.disturbed_source(d)?;
+        let mut draws = Draws::new(self.seed, index, self.regular);
+        let kind = disturbance::kind_of(d);
+        let overrides = match kind {
+            1 => Overrides {
+                friction_share: Some(draws.uniform(FRICTION_SHARE.0, FRICTION_SHARE.1)),
+                ..Overrides::default()
+            },
+            2 => Overrides {
+                max_rate: ENCODER_MAX_RATE,
+                ..Overrides::default()
+            },
+            _ => Overrides::default(),
+        };
+        let mut plan = plan_regular(self.seed, self.regular, source, &overrides)?;
+        let s = &mut plan.spec;
+        let disturbance = match kind {
+            0 => {
+                let Some(rig) = s.rig.as_mut() else {
+                    return Err(Error::InvalidModel {
+                        reason: "zoo: force pulses need a rig member",
+                    });
+                };
+                let p = &rig.params;
+                let peak_force = p.motor.kt * rig.effects.current_limit / p.r();
+                let share = draws.uniform(PULSE_SHARE.0, PULSE_SHARE.1);
+                let width = draws
+                    .log_uniform(PULSE_WIDTH.0, PULSE_WIDTH.1)
+                    .max(2.0 / s.loop_rate_hz);
+                let period = (s.duration_s / draws.uniform(3.0, 8.0)).max(2.0 * width);
+                let first = s.duration_s * draws.uniform(0.05, 0.3);
+                let pulses = ForcePulses {
+                    force: draws.sign() * share * peak_force,
+                    width,
+                    period,
+                    first,
+                };
+                rig.effects.pulses = pulses;
+                Disturbance::Pulses { pulses, share }
+            }
+            1 => Disturbance::Friction {
+                share: s.friction_share,
+            },
+            _ => {
+                let counts = draws.log_uniform(ENCODER_COUNTS.0, ENCODER_COUNTS.1);
+                let q = s.amplitude_m / counts;
+                s.resolution_m = q;
+                s.noise_std_m = 0.0;
+                if let Some(rig) = s.rig.as_mut() {
+                    rig.effects.quantisation = true;
+                    rig.effects.resolution = q;
+                    rig.effects.noise = false;
+                    rig.effects.noise_std = 0.0;
+                }
+                Disturbance::Encoder { counts }
+            }
+        };
+        s.index = index;
+        s.disturbed = Some(Disturbed {
+            source,
+            disturbance,
+        });
+        s.label = s.make_label();
+        Ok(plan)
+    }
+}
+
+/// Changes to the design of a regular member (disturbed members).
+#[derive(Debug, Clone, Copy)]
+struct Overrides {
+    /// Coulomb friction share in place of the design's (rig members).
+    friction_share: Option<f64>,
+    /// Highest recording rate \[Hz\] (the rate quantile maps onto the range up to it).
+    max_rate: f64,
+}
+
+impl Default for Overrides {
+    fn default() -> Self {
+        Self {
+            friction_share: None,
+            max_rate: MAX_LOOP_RATE,
+        }
     }
 }
 
@@ -200,7 +353,7 @@ struct Fixed {
     zeta: f64,
 }
 
-fn plan_regular(seed: u64, regular: usize, i: usize) -> Result<Plan> {
+fn plan_regular(seed: u64, regular: usize, i: usize, over: &Overrides) -> Result<Plan> {
     let d = Draws::new(seed, i, regular);
     let plant = plant_of(i);
     let (kv_range, amplitude_max) = match plant {
@@ -213,7 +366,7 @@ fn plan_regular(seed: u64, regular: usize, i: usize) -> Result<Plan> {
     let kv_asked = d.log_in(Dim::Kv, kv_range);
     // recording rate: a loop of Kv·Δt ≤ 0.15 within 20 samples per row
     let rate_lo = (kv_asked / (0.15 * 20.0)).max(100.0);
-    let mut rate = d.log_in(Dim::Rate, (rate_lo, MAX_LOOP_RATE));
+    let mut rate = d.log_in(Dim::Rate, (rate_lo, over.max_rate.max(rate_lo)));
     let resolution = d.log_in(Dim::Resolution, (1e-9, 2e-5));
     let u_noise = d.u(Dim::Noise);
     let ff_mode = (i / 7) % 3;
@@ -242,10 +395,10 @@ fn plan_regular(seed: u64, regular: usize, i: usize) -> Result<Plan> {
             0.0
         },
         wanted: d.log_in(Dim::Duration, (1.0, 5.0)),
-        friction_share: if is_rig {
-            d.lin_in(Dim::Friction, (0.0, 0.1))
-        } else {
-            0.0
+        friction_share: match (is_rig, over.friction_share) {
+            (false, _) => 0.0,
+            (true, Some(f)) => f,
+            (true, None) => d.lin_in(Dim::Friction, (0.0, 0.1)),
         },
         backlash: if is_rig && d.u(Dim::Backlash) < 0.35 {
             d.lin_in(Dim::BacklashWidth, (1e-6, 2e-5))
@@ -386,6 +539,7 @@ fn attempt(f: &Fixed, rate: f64, d: &mut Draws) -> Result<(Plan, f64, f64)> {
         glitches,
         dropped_rows: Vec::new(),
         gap_source: None,
+        disturbed: None,
         noise_seed,
         stability,
         rig,

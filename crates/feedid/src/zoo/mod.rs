@@ -2,8 +2,10 @@
 //! drives unlike the paper's rig, to choose defaults on and to benchmark
 //! every method against.
 //!
-//! [`Zoo::standard`] holds 220 members: 210 regular recordings (every one a
-//! file `feedid identify` reads) and 10 with dropped rows. Member `i` depends
+//! [`Zoo::standard`] holds 250 members: 210 regular recordings (every one a
+//! file `feedid identify` reads), 10 with dropped rows and 30 disturbed
+//! ([`Zoo::disturbed`]: force pulses, strong friction, coarse encoders at
+//! low rates; readable like the regular ones). Member `i` depends
 //! only on the zoo seed, `i` and the zoo's size, so a test or a task can make member `i`
 //! alone ([`Zoo::member`]); [`Zoo::members`] makes many in parallel.
 //! [`Zoo::small`] is the first 20 (every plant, command and feed-forward kind,
@@ -31,12 +33,14 @@
 //! | commands | ramp, step, S-curve, sine sweep, square wave, random point-to-point moves with dwells, contour axis (circle) |
 //! | defects | 1–3 glitches (wild samples, 0.1 … 1000 × the amplitude) on every 12th member; dropped rows on the 10 gapped members |
 //! | length | 1000 … 20 000 rows (1–5 s asked; ≤ 60 000 loop samples) |
+//! | disturbances (the 30 disturbed members) | force pulses and impacts on the table, 10 … 50 % of the peak force, 1 … 50 ms; Coulomb friction 10 … 25 % of the peak force on reversing commands; encoders of 30 … 1000 counts over the amplitude at 100 Hz … 1 kHz (`disturbance.rs`) |
 //!
 //! The design (which member gets what) is in `design.rs`, the rig recipe
 //! (mechanics, motor, loop tuning, stability checks) in `axis.rs`, the servo
 //! plants in `servo.rs`, the commands in `command.rs`, glitches and dropped
-//! rows in `defects.rs`. No member is chosen or tuned for any identification
-//! method: parameters come from the design and the physical recipe only.
+//! rows in `defects.rs`, the disturbed members in `disturbance.rs`. No
+//! member is chosen or tuned for any identification method: parameters come
+//! from the design and the physical recipe only.
 //!
 //! # Dropped rows
 //!
@@ -51,6 +55,7 @@ mod axis;
 mod command;
 mod defects;
 mod design;
+mod disturbance;
 mod excitation;
 mod family;
 mod member;
@@ -58,9 +63,10 @@ mod plant;
 mod servo;
 mod spec;
 
+pub use disturbance::{Disturbance, Disturbed};
 pub use family::{
-    Zoo, MAX_LOOP_RATE, MAX_LOOP_SAMPLES, MAX_ROWS, MIN_ROWS, SMALL_MEMBERS, STANDARD_GAPPED,
-    STANDARD_REGULAR, ZOO_SEED,
+    Zoo, MAX_LOOP_RATE, MAX_LOOP_SAMPLES, MAX_ROWS, MIN_ROWS, SMALL_MEMBERS, STANDARD_DISTURBED,
+    STANDARD_GAPPED, STANDARD_REGULAR, ZOO_SEED,
 };
 pub use member::ZooMember;
 pub use plant::{PlantRun, PlantStepper};

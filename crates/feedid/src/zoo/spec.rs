@@ -5,6 +5,7 @@ use std::fmt;
 
 use serde::Serialize;
 
+use super::disturbance::{Disturbance, Disturbed};
 use crate::drive::{RigEffects, RigParams};
 use crate::signal::{Chirp, Contour, PointToPoint, Ramp, Scurve, Square, Step};
 
@@ -191,6 +192,8 @@ pub struct MemberSpec {
     pub dropped_rows: Vec<usize>,
     /// For a member with dropped rows: the member it was made from.
     pub gap_source: Option<usize>,
+    /// For a disturbed member: its disturbance and the member it copies.
+    pub disturbed: Option<Disturbed>,
     /// Seed of the measurement noise.
     pub noise_seed: u64,
     /// Checks of the linear closed loop.
@@ -248,6 +251,23 @@ impl MemberSpec {
         }
         if let Some(src) = self.gap_source {
             s += &format!(", {} dropped row(s) of #{src}", self.dropped_rows.len());
+        }
+        if let Some(d) = &self.disturbed {
+            let pct = |v: f64| format!("{:.0} %", 100.0 * v);
+            s += &match d.disturbance {
+                Disturbance::Pulses { pulses, share } => format!(
+                    ", force pulses {} × {} ms of #{}",
+                    pct(share),
+                    short(1e3 * pulses.width),
+                    d.source
+                ),
+                Disturbance::Friction { share } => {
+                    format!(", friction {} of #{}", pct(share), d.source)
+                }
+                Disturbance::Encoder { counts } => {
+                    format!(", encoder {:.0} counts of #{}", counts, d.source)
+                }
+            };
         }
         s
     }

@@ -296,7 +296,7 @@ fn backlash_is_a_dead_band_of_the_screw_force() {
     let input = Input::Held { vc: 0.0, iff: 0.0 };
     let table_acceleration = |stretch: f64| {
         let x = [0.0, 0.0, 0.0, stretch / r, 0.0, 0.0, 0.0];
-        plant.deriv(&x, input, 0.0)[6]
+        plant.deriv(&x, input, 0.0, 0.0)[6]
     };
     for s in [-0.49 * width, -0.2 * width, 0.0, 0.3 * width, 0.5 * width] {
         assert_eq!(table_acceleration(s), 0.0, "stretch {s}");
@@ -409,4 +409,63 @@ fn new_effects_read_from_toml_and_bad_values_are_rejected() {
     assert!(e.to_string().contains("control.kvff"), "{e}");
     let e = RigParams::from_toml_str("[control]\nkaff = 3\n", None).unwrap_err();
     assert!(e.to_string().contains("control.kaff"), "{e}");
+}
+
+#[test]
+fn force_pulses_push_the_table_only_while_they_act_and_the_loop_recovers() {
+    let cmd = ramp_cmd();
+    let pulses = ForcePulses {
+        force: 50.0,
+        width: 0.01,
+        period: 0.2,
+        first: 0.3,
+    };
+    let fx = RigEffects {
+        noise: false,
+        quantisation: false,
+        ..RigEffects::default()
+    };
+    let plain = VirtualRig::new(RigParams::default())
+        .with_effects(fx)
+        .simulate(&cmd, RATE)
+        .unwrap();
+    let pushed = VirtualRig::new(RigParams::default())
+        .with_effects(RigEffects { pulses, ..fx })
+        .simulate(&cmd, RATE)
+        .unwrap();
+    let first = (0.3 * RATE).round() as usize;
+    // nothing changes before the first pulse, bit for bit
+    assert_eq!(
+        plain.true_position[..=first],
+        pushed.true_position[..=first]
+    );
+    let dev: Vec<f64> = plain
+        .true_position
+        .iter()
+        .zip(&pushed.true_position)
+        .map(|(a, b)| b - a)
+        .collect();
+    // the push (+50 N) moves the table forward, the pull at 0.5 s back
+    let during = |t0: f64| -> f64 {
+        let k0 = (t0 * RATE) as usize;
+        dev[k0..k0 + (0.02 * RATE) as usize]
+            .iter()
+            .copied()
+            .fold(0.0, |m: f64, v| if v.abs() > m.abs() { v } else { m })
+    };
+    let (push, pull) = (during(0.3), during(0.5));
+    assert!(push > 1e-7, "{push}");
+    assert!(pull < -1e-7, "{pull}");
+    // the velocity loop's integral rejects the force: gone before the next pulse
+    let before_next = dev[(0.49 * RATE) as usize].abs();
+    assert!(before_next < 0.1 * push.abs(), "{before_next} vs {push}");
+    // read from TOML like every effect
+    let fx: RigEffects = toml::from_str("[pulses]\nforce = 20.0\nwidth = 0.002\n").unwrap();
+    assert_eq!(fx.pulses.force, 20.0);
+    assert_eq!(fx.pulses.period, ForcePulses::default().period);
+    let e = toml::from_str::<RigEffects>("[pulses]\nforce = 1.0\nwidth = 1.0\nperiod = 0.5\n")
+        .unwrap()
+        .validate()
+        .unwrap_err();
+    assert!(e.to_string().contains("pulses.period"), "{e}");
 }

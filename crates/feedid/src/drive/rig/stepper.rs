@@ -7,7 +7,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-use super::{positive, Input, Plant, PositionLoop, VirtualRig};
+use super::{positive, ForcePulses, Input, Plant, PositionLoop, VirtualRig};
 use crate::error::{Error, Result};
 
 /// The virtual rig stepped one sample at a time ([`VirtualRig::stepper`]).
@@ -27,6 +27,8 @@ pub struct RigStepper {
     /// Commands `u[k − delay − 1] … u[k + 1 − delay]` and newer (ring, oldest first).
     history: Vec<f64>,
     delay: usize,
+    /// Force pulses on the table.
+    pulses: ForcePulses,
     k: usize,
     x: [f64; 7],
     measured: f64,
@@ -70,6 +72,7 @@ impl VirtualRig {
             rng: ChaCha8Rng::seed_from_u64(self.seed),
             history: vec![first; delay + 3],
             delay,
+            pulses: fx.pulses,
             k: 0,
             x: [0.0; 7],
             measured: 0.0,
@@ -170,8 +173,11 @@ impl RigStepper {
             }
         };
         let h = 1.0 / rate / self.substeps as f64;
+        let t0 = self.k as f64 / rate;
         for j in 0..self.substeps {
-            self.plant.rk4(&mut self.x, input, j as f64 * h, h);
+            let tau = j as f64 * h;
+            let force = self.pulses.at(t0 + tau);
+            self.plant.rk4(&mut self.x, input, tau, h, force);
         }
         self.k += 1;
         if self.x.iter().any(|v| !v.is_finite()) {

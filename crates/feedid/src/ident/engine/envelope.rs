@@ -30,7 +30,15 @@
 //! `D_j` by `Dᶜ / D̂ᶜ` and every `S_j` by `Sᶜ / Ŝᶜ` where these exceed 1 (a
 //! larger or faster move of a program, a sweep rising in frequency; a
 //! command that has never moved gives no such scale: the axis has shown
-//! nothing to scale). [`Envelope::horizon_only`] keeps those figures.
+//! nothing to scale), but never beyond the command's own figure plus the
+//! following error now, `Dᶜ + |u₀ − y₀|` and `Sᶜ + |u₀ − y₀|`: a command
+//! that has barely moved before (the first samples of a jerk-limited
+//! start) would otherwise make the ratio, and the bound, as large as it
+//! likes. Where the method predicts without the horizon's command, `Dᶜ` and
+//! `Sᶜ` are taken over the pairs that end in the window's last `H` samples
+//! (what has been asked and not yet answered): the command extrapolated
+//! over the horizon is a guess, and a step extrapolated at its own slope
+//! would ask for ten steps. [`Envelope::horizon_only`] keeps those figures.
 //! A model that winds up within its horizon — an error growing by a
 //! constant factor per step, as a nearly unstable window model does at a
 //! reversal — leaves this envelope within a few steps; so does a model
@@ -193,19 +201,25 @@ impl Envelope {
 
     /// The envelope of the sample `j` (1-based) steps after the last one
     /// tracked, started from `last` with the recent velocity (over the last
-    /// `H` tracked samples), the reach widened `kappa.0` times and the swerve
-    /// `kappa.1` times; `None` before any pair of samples `j` apart was seen.
-    pub fn bounds(&self, j: usize, last: f64, kappa: (f64, f64)) -> Option<(f64, f64)> {
+    /// `H` tracked samples): within `widths(j, D_j, S_j).0` of `last` and
+    /// `widths(j, D_j, S_j).1` of going on at that velocity (the caller
+    /// turns the figures seen into the allowed ones, `κ·D_j` and `κ·S_j` or
+    /// wider); `None` before any pair of samples `j` apart was seen.
+    pub fn bounds(
+        &self,
+        j: usize,
+        last: f64,
+        widths: impl Fn(usize, f64, f64) -> (f64, f64),
+    ) -> Option<(f64, f64)> {
         if j == 0 || j > self.horizon || self.pairs[j - 1] == 0 || !last.is_finite() {
             return None;
         }
-        let d = kappa.0 * self.reach[j - 1];
-        let (mut lo, mut hi) = (last - d, last + d);
+        let (reach, swerve) = widths(j, self.reach[j - 1], self.swerve[j - 1]);
+        let (mut lo, mut hi) = (last - reach, last + reach);
         if self.len > self.horizon && self.swerve[j - 1] > 0.0 {
             let v = (self.ago(0) - self.ago(self.horizon)) / self.horizon as f64;
             let c = last + j as f64 * v;
-            let w = kappa.1 * self.swerve[j - 1];
-            let (a, b) = (lo.max(c - w), hi.min(c + w));
+            let (a, b) = (lo.max(c - swerve), hi.min(c + swerve));
             if a <= b {
                 lo = a;
                 hi = b;
@@ -215,8 +229,8 @@ impl Envelope {
     }
 
     /// Cut `values` (the prediction of the next samples from `last`) back
-    /// into the envelope, its reach and swerve at step `j` widened
-    /// `kappa(j)` times (see [`Envelope::bounds`]); the interval of a cut
+    /// into the envelope, its reach and swerve at step `j` allowed as
+    /// `widths(j, D_j, S_j)` (see [`Envelope::bounds`]); the interval of a cut
     /// sample becomes `[min(last, ŷ) − q, max(last, ŷ) + q]` with `ŷ` the
     /// cut value and `q` its half-width before (from `lower`/`upper`).
     /// Returns the number of samples cut.
@@ -224,7 +238,7 @@ impl Envelope {
         &self,
         values: &mut [f64],
         last: f64,
-        kappa: impl Fn(usize) -> (f64, f64),
+        widths: impl Fn(usize, f64, f64) -> (f64, f64),
         lower: &mut [f64],
         upper: &mut [f64],
     ) -> usize {
@@ -235,7 +249,7 @@ impl Envelope {
             .zip(upper.iter_mut())
             .enumerate()
         {
-            let Some((a, b)) = self.bounds(i + 1, last, kappa(i + 1)) else {
+            let Some((a, b)) = self.bounds(i + 1, last, &widths) else {
                 continue;
             };
             // (bounds that are not ordered, NaN included, cut nothing)
@@ -311,7 +325,13 @@ mod tests {
             .collect();
         let mut lo: Vec<f64> = pred.iter().map(|v| v - 0.1).collect();
         let mut hi: Vec<f64> = pred.iter().map(|v| v + 0.1).collect();
-        let cut = e.cut(&mut pred, last, |_| (1.5, 1.5), &mut lo, &mut hi);
+        let cut = e.cut(
+            &mut pred,
+            last,
+            |_, d, s| (1.5 * d, 1.5 * s),
+            &mut lo,
+            &mut hi,
+        );
         // reach 1.5·j always holds; the swerve is 0 on an exact ramp, so the
         // acceleration bound is not used and only the reach cuts: steps
         // whose excess 0.01·2^j exceeds 0.5·j
@@ -333,7 +353,16 @@ mod tests {
         }
         let mut pred = vec![-1e-3; 4];
         let (mut lo, mut hi) = (vec![-2e-3; 4], vec![0.0; 4]);
-        assert_eq!(e.cut(&mut pred, 0.0, |_| (1.5, 1.5), &mut lo, &mut hi), 4);
+        assert_eq!(
+            e.cut(
+                &mut pred,
+                0.0,
+                |_, d, s| (1.5 * d, 1.5 * s),
+                &mut lo,
+                &mut hi
+            ),
+            4
+        );
         assert!(pred.iter().all(|v| v.abs() <= 1e-8), "{pred:?}");
         // its interval still reaches what the model said, widened to the hold
         assert!(lo.iter().all(|&l| l <= -1e-3 + 1e-9), "{lo:?}");
@@ -349,7 +378,13 @@ mod tests {
             }
             let mut p: Vec<f64> = (1..=6).map(|j| scale * 0.3 * j as f64).collect();
             let (mut lo, mut hi) = (p.clone(), p.clone());
-            let n = e.cut(&mut p, y[79] * scale, |_| (1.5, 1.5), &mut lo, &mut hi);
+            let n = e.cut(
+                &mut p,
+                y[79] * scale,
+                |_, d, s| (1.5 * d, 1.5 * s),
+                &mut lo,
+                &mut hi,
+            );
             (n, p.iter().map(|v| v / scale).collect::<Vec<_>>())
         };
         let (a, pa) = run(1.0);

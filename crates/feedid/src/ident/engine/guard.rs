@@ -628,6 +628,16 @@ impl Guard {
             &mut upper[..len],
             &mut regimes[..len],
         );
+        // what the command asks for that the axis has not answered yet: the
+        // pairs ending in the horizon, or, where the method predicts without
+        // the horizon's command, in the window's last `len` samples (an
+        // extrapolated command is a guess, not something asked for)
+        let asked = if horizon_known || command.len() < len {
+            command
+        } else {
+            &command[..command.len() - len]
+        };
+        let (asked_reach, asked_swerve) = self.command_seen.whole_horizon_of(asked, len);
         let command = if horizon_known || command.len() < len + 2 {
             command
         } else {
@@ -680,20 +690,37 @@ impl Guard {
         let cut = match self.config.runaway {
             Some(k) => {
                 // the command's whole-horizon figures now and as answered
-                let (reach, swerve) = self.command_seen.whole_horizon_of(command, len);
+                let (reach, swerve) = (asked_reach, asked_swerve);
                 let (r, s) = self.command_seen.seen(self.horizon);
                 // figures below a millionth of the command's travel over a
                 // horizon are its rounding (a ramp's swerve), not a motion
                 let floor = 1e-6 * r.max(reach);
-                let grow = |now: f64, before: f64| {
+                // the following error now: the axis may close it within
+                // the horizon on top of what the command asks
+                let lag = command
+                    .len()
+                    .checked_sub(len + 1)
+                    .map_or(0.0, |i| (command[i] - last).abs());
+                let lag = if lag.is_finite() { lag } else { 0.0 };
+                // the axis's own figure, grown with the command where the
+                // command asks for more than it has before (a command that
+                // has never moved gives no scale), but never beyond the
+                // command's own figure plus the following error: a command
+                // that has barely moved would otherwise grow it without end
+                let allow = |seen: f64, now: f64, before: f64| {
                     if before > floor && now > before {
-                        now / before
+                        k * seen.max((seen * (now / before)).min(now + lag))
                     } else {
-                        1.0
+                        k * seen
                     }
                 };
-                let kappa = (k * grow(reach, r), k * grow(swerve, s));
-                self.envelope.cut(values, last, |_| kappa, lower, upper)
+                self.envelope.cut(
+                    values,
+                    last,
+                    |_, d, sw| (allow(d, reach, r), allow(sw, swerve, s)),
+                    lower,
+                    upper,
+                )
             }
             None => 0,
         };
@@ -887,6 +914,114 @@ mod tests {
             start += h;
         }
         assert!(replaced.is_empty(), "{replaced:?}");
+    }
+
+    /// Guard the predictions `predict(start)` of horizons of `h` samples
+    /// every `h` from sample 20 (windows of 20) of the measured `y` under the
+    /// command `u`; returns each horizon's start and its guarded values.
+    fn guard_predictions(
+        y: &[f64],
+        u: &[f64],
+        h: usize,
+        horizon_known: bool,
+        predict: impl Fn(usize) -> Vec<f64>,
+    ) -> Vec<(usize, Vec<f64>)> {
+        let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
+        let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
+        let mut regimes = vec![Regime::Rest; h];
+        let mut out = Vec::new();
+        let mut start = 20;
+        while start + h <= y.len() {
+            g.observe(start - 20, start, |k| y[k], |_, _| {});
+            let mut pred = predict(start);
+            g.predicted(
+                start,
+                &mut pred,
+                y[start - 1],
+                1e-6,
+                &u[start - 20..start + h],
+                horizon_known,
+                &mut lo,
+                &mut hi,
+                &mut regimes,
+            );
+            out.push((start, pred));
+            start += h;
+        }
+        out
+    }
+
+    #[test]
+    fn a_command_that_has_barely_moved_bounds_the_envelope_by_its_own_travel() {
+        // an axis at rest (noise of 1 µm) under a command that creeps away
+        // from rest as t³ from sample 100 (a jerk-limited start): a model
+        // predicting a geometric run-away is cut back to what the axis and
+        // the command have shown (µm), however small the command's travel
+        // before was compared with now
+        let h = 10;
+        let n: usize = 200;
+        let y: Vec<f64> = (0..n)
+            .map(|k| 1e-6 * ((k * 7 % 5) as f64 - 2.0) / 2.0)
+            .collect();
+        let u: Vec<f64> = (0..n)
+            .map(|k| {
+                if k < 100 {
+                    0.0
+                } else {
+                    1e-12 * ((k - 100) as f64).powi(3)
+                }
+            })
+            .collect();
+        let runaway = |start: usize| -> Vec<f64> {
+            (1..=h)
+                .map(|j| y[start - 1] - 1e-6 * 2f64.powi(j as i32 + 4))
+                .collect()
+        };
+        for (start, pred) in guard_predictions(&y, &u, h, true, runaway) {
+            let travel = u[start + h - 1] - u[start.saturating_sub(2 * h)];
+            let allowed = 1.5 * (2e-6 + travel.abs() + 2e-6) + 1e-12;
+            for v in &pred {
+                assert!(
+                    (v - y[start - 1]).abs() <= allowed,
+                    "start {start}: {v} from {} (allowed {allowed})",
+                    y[start - 1]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn an_extrapolated_command_does_not_widen_the_envelope() {
+        // a square wave of 1 followed with a lag of 5 samples: at the step
+        // in the window's last sample, a method that predicts without the
+        // horizon's command sees it extrapolated (ten times the step within
+        // a horizon); a prediction that follows that guess is cut back to
+        // 1.5 times the reach the axis has shown
+        let h = 10;
+        let n: usize = 400;
+        let u: Vec<f64> = (0..n)
+            .map(|k| if ((k + 1) / 60) % 2 == 1 { 1.0 } else { 0.0 })
+            .collect();
+        let y: Vec<f64> = (0..n).map(|k| u[k.saturating_sub(5)]).collect();
+        let follow_the_guess = |start: usize| -> Vec<f64> {
+            let (a, b) = (u[start - 2], u[start - 1]);
+            (1..=h).map(|j| b + j as f64 * (b - a)).collect()
+        };
+        let guarded = guard_predictions(&y, &u, h, false, follow_the_guess);
+        // the steps at 119, 179, 239, … fall on the last sample of a window
+        let at_steps: Vec<_> = guarded
+            .iter()
+            .filter(|(start, _)| start % 60 == 0 && *start >= 120)
+            .collect();
+        assert!(!at_steps.is_empty());
+        for (start, pred) in at_steps {
+            for v in pred {
+                assert!(
+                    (v - y[start - 1]).abs() <= 1.5 + 1e-12,
+                    "start {start}: {v}"
+                );
+            }
+        }
     }
 
     #[test]

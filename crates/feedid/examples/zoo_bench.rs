@@ -48,6 +48,10 @@
 //!   (the library's default [`feedid::ident::GuardConfig`]); `n/a` for the
 //!   baselines.
 //!
+//! `--candidates` also runs each of `auto`'s candidates alone (`auto` with
+//! that one candidate) and prints `auto`'s rms against the best of them on
+//! each member.
+//!
 //! `--baseline-phase P` (0 … 9) starts the blocks of `hold` and `arx220` `P`
 //! samples later for the main table; a second table counts each library
 //! method's losses at every phase. The methods' own blocks start where their first window
@@ -83,7 +87,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use feedid::ident::{engine, EngineConfig, Method, Regime};
+use feedid::ident::{engine, AutoConfig, EngineConfig, Method, Regime};
 use feedid::zoo::{Zoo, ZooMember};
 use feedid::Recording;
 use nalgebra::{DMatrix, DVector};
@@ -95,6 +99,8 @@ static OFFSET: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
 static VIA: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
 /// `--baseline-phase`: samples by which the baselines' blocks start later.
 static PHASE: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+/// `--candidates`: also run each of `auto`'s candidates alone.
+static CANDIDATES: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
 /// Horizon of the benchmark \[samples\].
 const H: usize = 10;
@@ -182,6 +188,31 @@ fn run_library_methods(rec: &Recording) -> Vec<Predictions> {
                     error: Some(e.to_string()),
                 },
             }
+        })
+        .collect()
+}
+
+/// Each of `auto`'s default candidates alone (`auto` with that one
+/// candidate, its default window, H = 10): their names and predictions.
+fn run_auto_candidates(rec: &Recording) -> Vec<(String, Vec<f64>, Vec<bool>)> {
+    let signals = rec.signals();
+    AutoConfig::default_candidates()
+        .into_iter()
+        .filter_map(|c| {
+            let name = c.to_string();
+            let spec = Method::Auto(AutoConfig {
+                candidates: vec![c],
+                ..AutoConfig::default()
+            });
+            let mut est = spec.build().ok()?;
+            let cfg = EngineConfig {
+                window: spec.default_window(),
+                horizon: H,
+                hop: None,
+                warm_up: 0,
+            };
+            let r = engine::run(&mut est, &signals, &cfg).ok()?;
+            Some((name, r.predicted, r.has_prediction))
         })
         .collect()
 }
@@ -428,6 +459,13 @@ struct Row {
     /// At the samples of a start of motion: the squared errors of the method
     /// and of the hold baseline, and their number.
     starts: (f64, f64, usize),
+    /// The same at the first start of the recording (the command's first
+    /// motion and the 2H samples after it): nothing has moved before.
+    first_starts: (f64, f64, usize),
+    /// `auto` only, with `--candidates`: its rms over that of its best
+    /// candidate alone (each pair on the samples both predict; the largest
+    /// ratio over the candidates) and that candidate's name.
+    candidate_ratio: Option<(f64, String)>,
     seconds: f64,
     note: String,
     /// Gaps of dropped samples in the member (0 for a regular one).
@@ -467,6 +505,8 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
         interval_coverage: None,
         by_regime: [(0, 0); 5],
         starts: (0.0, 0.0, 0),
+        first_starts: (0.0, 0.0, 0),
+        candidate_ratio: None,
         seconds: 0.0,
         note: String::new(),
         gaps: 0,
@@ -512,6 +552,11 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
         ..base
     };
     let mut all = run_library_methods(&rec);
+    let candidates = if CANDIDATES.get().copied().unwrap_or(false) && rec.gaps().is_empty() {
+        run_auto_candidates(&rec)
+    } else {
+        Vec::new()
+    };
     // the same methods on the member the rows were dropped from, for the cost
     // of the gaps on the samples both predict
     let without_gaps: Option<(Vec<Predictions>, Vec<usize>)> = s.gap_source.and_then(|src| {
@@ -574,7 +619,19 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
             // at starts of motion: squared errors of the method and of holding
             // (the hold baseline) on the same samples
             let mut starts = (0.0, 0.0, 0usize);
+            let mut first_starts = (0.0, 0.0, 0usize);
             let hold = by_name["hold"];
+            // the command's first motion (a step of more than 1.83 % of its
+            // largest): the start samples up to 2H after it are the first start
+            let u = &m.command;
+            let top = u
+                .windows(2)
+                .map(|w| (w[1] - w[0]).abs())
+                .fold(0.0, f64::max);
+            let first_move = u
+                .windows(2)
+                .position(|w| (w[1] - w[0]).abs() > 0.0183 * top)
+                .map_or(n, |k| k + 1);
             let interval_coverage = p.interval.as_ref().map(|(lo, hi, regime)| {
                 let (mut inside, mut total) = (0usize, 0usize);
                 for k in 0..n {
@@ -589,6 +646,11 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                             starts.0 += (y[k] - p.value[k]).powi(2);
                             starts.1 += (y[k] - hold.value[k]).powi(2);
                             starts.2 += 1;
+                            if k < first_move + 2 * H {
+                                first_starts.0 += (y[k] - p.value[k]).powi(2);
+                                first_starts.1 += (y[k] - hold.value[k]).powi(2);
+                                first_starts.2 += 1;
+                            }
                         }
                     }
                 }
@@ -607,6 +669,28 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                 interval_coverage,
                 by_regime,
                 starts,
+                first_starts,
+                candidate_ratio: (p.name == "auto" && !candidates.is_empty())
+                    .then(|| {
+                        candidates
+                            .iter()
+                            .filter_map(|(name, value, has)| {
+                                let c = Predictions {
+                                    name: "candidate",
+                                    value: value.clone(),
+                                    has: has.clone(),
+                                    interval: None,
+                                    first: 0,
+                                    seconds: 0.0,
+                                    error: None,
+                                };
+                                let (a, b) = shared_rms(y, p, &c, &scored)?;
+                                Some((a / b, name.clone()))
+                            })
+                            .filter(|(q, _)| q.is_finite())
+                            .max_by(|a, b| a.0.total_cmp(&b.0))
+                    })
+                    .flatten(),
                 gap_cost: without_gaps.as_ref().and_then(|(full, kept)| {
                     let q = full.iter().find(|q| q.name == p.name)?;
                     let (mut a, mut b, mut n_shared) = (0.0, 0.0, 0usize);
@@ -705,6 +789,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         match a.as_str() {
             "--members" => members = parse_members(&args.next().unwrap_or_default(), &zoo)?,
             "--csv" => csv = args.next().map(PathBuf::from),
+            "--candidates" => CANDIDATES
+                .set(true)
+                .map_err(|_| "--candidates given twice")?,
             "--offset" => {
                 let v: f64 = args
                     .next()
@@ -736,7 +823,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             _ => {
                 return Err(format!(
                     "unknown argument `{a}` (--members SET, --csv FILE, --offset METRES, \
-                     --via-unit mm|um|nm, --baseline-phase P)"
+                     --via-unit mm|um|nm, --baseline-phase P, --candidates)"
                 )
                 .into())
             }
@@ -756,11 +843,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut text = String::from(
             "member,method,plant,command,samples,predicted,coverage_percent,\
              coverage_after_first_window_percent,rms_m,max_m,ratio_to_best_fixed,beaten_by_baseline,worst_baseline_ratio,loses_significantly,interval_coverage_percent,\
-             seconds,note,disturbance,label\n",
+             seconds,note,disturbance,candidate_ratio,candidate,label\n",
         );
         for r in &rows {
             text += &format!(
-                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{:.6},\"{}\",{},\"{}\"\n",
+                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{:.6},\"{}\",{},{},\"{}\",\"{}\"\n",
                 r.member,
                 r.method,
                 r.plant,
@@ -779,6 +866,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.seconds,
                 r.note.replace('"', "'"),
                 r.disturbance.unwrap_or(""),
+                r.candidate_ratio
+                    .as_ref()
+                    .map_or(String::new(), |c| c.0.to_string()),
+                r.candidate_ratio.as_ref().map_or("", |c| c.1.as_str()),
                 r.label.replace('"', "'")
             );
         }
@@ -832,6 +923,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          hold's on the same member:\n"
     );
     interval_table(&scored);
+    candidate_table(&scored);
     // the same count for every phase of the baselines' blocks
     println!(
         "\nRecordings where each library method loses to a baseline when the baselines' blocks \
@@ -1002,11 +1094,47 @@ fn main_table(scored: &[&Row]) {
     }
 }
 
+/// `auto` against its best candidate alone (`--candidates`).
+fn candidate_table(scored: &[&Row]) {
+    let ratios: Vec<(f64, &str, usize)> = scored
+        .iter()
+        .filter(|r| r.method == "auto")
+        .filter_map(|r| {
+            r.candidate_ratio
+                .as_ref()
+                .map(|(q, n)| (*q, n.as_str(), r.member))
+        })
+        .collect();
+    if ratios.is_empty() {
+        return;
+    }
+    let q: Vec<f64> = ratios.iter().map(|r| r.0).collect();
+    let within = q.iter().filter(|&&v| v <= 1.2).count();
+    let worst = ratios
+        .iter()
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(String::new(), |w| {
+            format!("{:.2} (member {}, {})", w.0, w.2, w.1)
+        });
+    println!(
+        "\n`auto` against each of its candidates alone (`--candidates`; rms of auto / rms of the \
+         candidate on the samples both predict, the largest over the candidates):\n"
+    );
+    println!("| members | auto within 1.2× its best candidate | median | 90th pct | worst |");
+    println!("|---:|---:|---:|---:|---|");
+    println!(
+        "| {} | {within} | {} | {} | {worst} |",
+        q.len(),
+        fmt(quantile(&q, 0.5), 3),
+        fmt(quantile(&q, 0.9), 3)
+    );
+}
+
 /// Intervals and largest errors: coverage per member and per regime, the
 /// largest error against the hold's, the starts of motion.
 fn interval_table(scored: &[&Row]) {
-    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median | first starts: members (above the hold's) | first starts: rms / hold's, median |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for method in LIBRARY {
         let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == method).collect();
         let within = mine
@@ -1043,8 +1171,14 @@ fn interval_table(scored: &[&Row]) {
             .map(|r| (r.starts.0 / r.starts.1).sqrt())
             .collect();
         let above = start_ratios.iter().filter(|&&q| q > 1.0).count();
+        let first_ratios: Vec<f64> = mine
+            .iter()
+            .filter(|r| r.first_starts.2 > 0 && r.first_starts.1 > 0.0)
+            .map(|r| (r.first_starts.0 / r.first_starts.1).sqrt())
+            .collect();
+        let first_above = first_ratios.iter().filter(|&&q| q > 1.0).count();
         println!(
-            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} | {} ({above}) | {} |",
+            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} | {} ({above}) | {} | {} ({first_above}) | {} |",
             mine.len(),
             pairs.len(),
             if worst_regime.is_finite() {
@@ -1062,6 +1196,8 @@ fn interval_table(scored: &[&Row]) {
             ),
             start_ratios.len(),
             fmt(quantile(&start_ratios, 0.5), 3),
+            first_ratios.len(),
+            fmt(quantile(&first_ratios, 0.5), 3),
         );
     }
 }

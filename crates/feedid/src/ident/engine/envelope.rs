@@ -45,7 +45,12 @@
 //! fitted on a window at rest that predicts a jump onto a stepped command
 //! the axis has never shown it can follow. The samples of a prediction
 //! outside it are *cut back* to its edge and their interval is widened to
-//! span the hold and the cut value (see [`Envelope::cut`]).
+//! span the hold and the cut value; a sample beyond `κ` times the edge's
+//! distance marks the prediction as run away, and from it on the horizon
+//! holds the last position (see [`Envelope::cut`]): a model that has left
+//! the envelope that far says nothing about where the axis goes, and the
+//! edge, on the side it ran to, would still be wrong by `(1 + κ)·D_j` where
+//! the axis goes the other way.
 //!
 //! Why these bounds: a position servo's speed and acceleration are limited
 //! (by its drive, its gains and its mass), and the recording shows them.
@@ -230,19 +235,25 @@ impl Envelope {
 
     /// Cut `values` (the prediction of the next samples from `last`) back
     /// into the envelope, its reach and swerve at step `j` allowed as
-    /// `widths(j, D_j, S_j)` (see [`Envelope::bounds`]); the interval of a cut
-    /// sample becomes `[min(last, ŷ) − q, max(last, ŷ) + q]` with `ŷ` the
-    /// cut value and `q` its half-width before (from `lower`/`upper`).
-    /// Returns the number of samples cut.
+    /// `widths(j, D_j, S_j)` (see [`Envelope::bounds`]). A sample outside is
+    /// set to the envelope's edge; a sample farther from `last` than `far`
+    /// times the edge marks the prediction as run away, and it and every
+    /// later sample of the horizon become the hold (`last`, within the
+    /// envelope). The interval of a changed sample becomes
+    /// `[min(last, ŷ) − q, max(last, ŷ) + q]` with `ŷ` its new value and `q`
+    /// its half-width before (from `lower`/`upper`).
+    /// Returns the number of samples changed.
     pub fn cut(
         &self,
         values: &mut [f64],
         last: f64,
         widths: impl Fn(usize, f64, f64) -> (f64, f64),
+        far: f64,
         lower: &mut [f64],
         upper: &mut [f64],
     ) -> usize {
         let mut cut = 0;
+        let mut run_away = false;
         for (i, ((v, lo), hi)) in values
             .iter_mut()
             .zip(lower.iter_mut())
@@ -254,11 +265,16 @@ impl Envelope {
             };
             // (bounds that are not ordered, NaN included, cut nothing)
             let ordered = matches!(a.partial_cmp(&b), Some(o) if o.is_le());
-            if !ordered || (*v >= a && *v <= b) {
+            if !ordered || (!run_away && *v >= a && *v <= b) {
                 continue;
             }
+            let edge = v.clamp(a, b);
+            // (a NaN prediction is as far as it gets)
+            if !((*v - last).abs() <= far * (edge - last).abs()) {
+                run_away = true;
+            }
             let q = 0.5 * (*hi - *lo).abs();
-            *v = v.clamp(a, b);
+            *v = if run_away { last.clamp(a, b) } else { edge };
             *lo = last.min(*v) - q;
             *hi = last.max(*v) + q;
             cut += 1;
@@ -329,6 +345,7 @@ mod tests {
             &mut pred,
             last,
             |_, d, s| (1.5 * d, 1.5 * s),
+            f64::INFINITY,
             &mut lo,
             &mut hi,
         );
@@ -346,6 +363,52 @@ mod tests {
     }
 
     #[test]
+    fn a_prediction_far_beyond_the_envelope_holds_for_the_rest_of_its_horizon() {
+        // the ramp of the test above, the error doubling every step (cut
+        // from step 6, farther than 1.5 times the edge from step 8): the
+        // samples just outside are cut to the edge; from the first one
+        // farther than 1.5 times the edge's distance, the horizon holds
+        let mut e = Envelope::new(10);
+        for k in 0..100 {
+            e.track(k as f64);
+        }
+        let last = 99.0;
+        let original: Vec<f64> = (1..=10)
+            .map(|j| last + j as f64 + 0.05 * 2f64.powi(j))
+            .collect();
+        let mut pred = original.clone();
+        let mut lo: Vec<f64> = pred.iter().map(|v| v - 0.1).collect();
+        let mut hi: Vec<f64> = pred.iter().map(|v| v + 0.1).collect();
+        let cut = e.cut(
+            &mut pred,
+            last,
+            |_, d, s| (1.5 * d, 1.5 * s),
+            1.5,
+            &mut lo,
+            &mut hi,
+        );
+        let edge = |j: usize| last + 1.5 * j as f64;
+        let far = (1..=10)
+            .find(|&j| original[j - 1] - last > 1.5 * (edge(j) - last))
+            .unwrap();
+        let first_cut = (1..=10).find(|&j| original[j - 1] > edge(j)).unwrap();
+        assert!(first_cut < far, "{first_cut} {far}");
+        for j in 1..=10 {
+            let v = pred[j - 1];
+            if j < first_cut {
+                assert_eq!(v, original[j - 1]);
+            } else if j < far {
+                assert!((v - edge(j)).abs() < 1e-12, "{j}: {v}");
+            } else {
+                assert_eq!(v, last, "{j}");
+                // its interval is about the hold
+                assert!(lo[j - 1] <= last && hi[j - 1] >= last);
+            }
+        }
+        assert_eq!(cut, 11 - first_cut);
+    }
+
+    #[test]
     fn before_any_motion_a_jump_is_cut_to_the_noise() {
         let mut e = Envelope::new(4);
         for k in 0..50 {
@@ -358,6 +421,7 @@ mod tests {
                 &mut pred,
                 0.0,
                 |_, d, s| (1.5 * d, 1.5 * s),
+                f64::INFINITY,
                 &mut lo,
                 &mut hi
             ),
@@ -382,6 +446,7 @@ mod tests {
                 &mut p,
                 y[79] * scale,
                 |_, d, s| (1.5 * d, 1.5 * s),
+                f64::INFINITY,
                 &mut lo,
                 &mut hi,
             );

@@ -49,7 +49,9 @@
 //! shown ([`Envelope`]: `κ` times the largest distance travelled and the
 //! largest departure from the last velocity in `j` samples, `κ` =
 //! [`GuardConfig::runaway`]) is cut back to the envelope's edge, and the
-//! interval of a cut sample spans the hold and the cut value. It applies to
+//! interval of a cut sample spans the hold and the cut value; from a sample
+//! beyond `κ` times the edge's distance on, the prediction has run away and
+//! the rest of its horizon holds the last position. It applies to
 //! every method (the paper's reproduction turns it off to stay as
 //! published); the windows and samples cut are counted.
 //!
@@ -718,6 +720,7 @@ impl Guard {
                     values,
                     last,
                     |_, d, sw| (allow(d, reach, r), allow(sw, swerve, s)),
+                    k,
                     lower,
                     upper,
                 )

@@ -270,7 +270,10 @@ impl Envelope {
             }
             let edge = v.clamp(a, b);
             // (a NaN prediction is as far as it gets)
-            if !((*v - last).abs() <= far * (edge - last).abs()) {
+            let distance = (*v - last).abs();
+            let near =
+                matches!(distance.partial_cmp(&(far * (edge - last).abs())), Some(o) if o.is_le());
+            if !near {
                 run_away = true;
             }
             let q = 0.5 * (*hi - *lo).abs();
@@ -406,6 +409,27 @@ mod tests {
             }
         }
         assert_eq!(cut, 11 - first_cut);
+    }
+
+    #[test]
+    fn a_non_finite_prediction_holds_for_the_rest_of_its_horizon() {
+        let mut e = Envelope::new(4);
+        for k in 0..50 {
+            e.track(k as f64);
+        }
+        let mut pred = vec![50.0, f64::NAN, 52.0, 53.0];
+        let (mut lo, mut hi) = (vec![49.0; 4], vec![54.0; 4]);
+        let cut = e.cut(
+            &mut pred,
+            49.0,
+            |_, d, s| (1.5 * d, 1.5 * s),
+            1.5,
+            &mut lo,
+            &mut hi,
+        );
+        assert_eq!(cut, 3);
+        assert_eq!(pred, vec![50.0, 49.0, 49.0, 49.0]);
+        assert!(lo.iter().chain(&hi).all(|v| v.is_finite()));
     }
 
     #[test]

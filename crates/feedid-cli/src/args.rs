@@ -55,7 +55,9 @@ pub enum D1Arg {
 /// `feedid model`.
 #[derive(Debug, Args)]
 pub struct ModelArgs {
-    /// Rig parameters (TOML); default: the built-in default rig.
+    /// Rig parameters (TOML), or a drive structure file (its `[drive]` and
+    /// `[mechanics]` tables: loops, drive gain, mass, friction law; see
+    /// examples/emps.toml); default: the built-in default rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
     /// Print one JSON object instead of text.
@@ -137,7 +139,13 @@ pub struct SimulateArgs {
         requires = "command"
     )]
     pub command_column: String,
-    /// Rig parameters (TOML); default: the built-in default rig.
+    /// Time column (or `.mat` variable) of --command, by name or 1-based index;
+    /// default: found by its name (time_s, time, t) in a CSV.
+    #[arg(long, value_name = "NAME|N", requires = "command")]
+    pub time_column: Option<String>,
+    /// Rig parameters (TOML), or a drive structure file (examples/emps.toml:
+    /// loops, drive gain, mass, friction law; a sampled controller runs at
+    /// the command's rate); default: the built-in default rig.
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
     /// Nonlinear effects of the virtual rig: a TOML file of any of the keys friction

@@ -51,12 +51,38 @@ pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigPara
     let params = match path {
         // bounded: `--params /dev/zero` must not read forever
         Some(p) => {
-            feedid::drive::RigParams::from_toml_str(&feedid::io::read_small_text(p)?, Some(p))?
+            let text = feedid::io::read_small_text(p)?;
+            if feedid::drive::DriveStructure::describes(&text) {
+                anyhow::bail!(
+                    "{}: a drive structure file ([drive], [mechanics]): `feedid model` and \
+                     `feedid simulate` read it; this command needs the paper's rig parameters",
+                    p.display()
+                );
+            }
+            feedid::drive::RigParams::from_toml_str(&text, Some(p))?
         }
         None => feedid::drive::RigParams::default(),
     };
     feedid::drive::check_model(&params).map_err(|e| params_error(path, e))?;
     Ok(params)
+}
+
+/// A drive structure file (`--params` with `[drive]`/`[mechanics]` tables),
+/// or `None` for the paper's rig parameters (or none given).
+pub fn load_structure(
+    path: Option<&Path>,
+) -> anyhow::Result<Option<feedid::drive::DriveStructure>> {
+    let Some(p) = path else {
+        return Ok(None);
+    };
+    let text = feedid::io::read_small_text(p)?;
+    if !feedid::drive::DriveStructure::describes(&text) {
+        return Ok(None);
+    }
+    Ok(Some(feedid::drive::DriveStructure::from_toml_str(
+        &text,
+        Some(p),
+    )?))
 }
 
 /// [`load_params`] for a model that is simulated or inverted: an unstable

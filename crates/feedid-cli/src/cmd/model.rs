@@ -14,6 +14,9 @@ pub fn run(a: &ModelArgs) -> Result<()> {
             &[p],
         )?;
     }
+    if let Some(structure) = crate::cmd::load_structure(a.params.as_deref())? {
+        return print_structure(a, &structure);
+    }
     let params = load_params(a.params.as_deref())?;
     let variant = match a.d1 {
         D1Arg::Corrected => D1Variant::Corrected,
@@ -29,6 +32,26 @@ pub fn run(a: &ModelArgs) -> Result<()> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
+        println!("{summary}");
+    }
+    Ok(())
+}
+
+/// `feedid model --params structure.toml`: the closed loop of a drive structure.
+fn print_structure(a: &ModelArgs, s: &feedid::drive::DriveStructure) -> Result<()> {
+    let name = a.params.as_deref();
+    let summary = s.closed_loop().map_err(|e| params_error(name, e))?;
+    if let Some(p) = &a.save_params {
+        let mut outputs = Outputs::default();
+        outputs.add_text(p, s.to_toml_string())?;
+        outputs.commit()?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        if let Some(src) = &s.source {
+            println!("source: {src}");
+        }
         println!("{summary}");
     }
     Ok(())

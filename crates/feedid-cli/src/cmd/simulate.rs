@@ -19,6 +19,9 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         .map(|p| p.as_path())
         .collect();
     check_distinct(&inputs, &[a.output.as_path()])?;
+    if let Some(structure) = crate::cmd::load_structure(a.params.as_deref())? {
+        return simulate_structure(a, &structure);
+    }
     let params = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let effects = if a.linear {
         RigEffects::linear()
@@ -29,9 +32,24 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
     };
     // the command: a scenario, or a file's command run from rest at its
     // first value (the rig starts at 0, which stands for that value)
-    let (what, rate, command, offset) = match (&a.command, &a.scenario) {
+    let (what, rate, command, offset) = command_of(a)?;
+    let duration = command.len() as f64 / rate;
+    let rig = VirtualRig::new(params)
+        .with_effects(effects)
+        .with_seed(a.seed);
+    simulate_rig(a, rig, what, rate, command, offset, duration)
+}
+
+/// The command to simulate: `(what, rate, command from 0, offset)`.
+fn command_of(a: &SimulateArgs) -> Result<(String, f64, Vec<f64>, f64)> {
+    Ok(match (&a.command, &a.scenario) {
         (Some(path), _) => {
             let opts = ReadOptions {
+                time: a
+                    .time_column
+                    .as_deref()
+                    .map(ChannelRef::parse)
+                    .transpose()?,
                 command: Some(ChannelRef::parse(&a.command_column)?),
                 position: Some(ChannelRef::parse(&a.command_column)?),
                 ..ReadOptions::default()
@@ -48,11 +66,20 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
             (scenario.name().to_string(), a.rate, command, 0.0)
         }
         (None, None) => anyhow::bail!("give --scenario NAME or --command cmd.csv"),
-    };
-    let duration = command.len() as f64 / rate;
-    let rig = VirtualRig::new(params)
-        .with_effects(effects)
-        .with_seed(a.seed);
+    })
+}
+
+/// Run the paper's rig and write its recording.
+#[allow(clippy::too_many_arguments)]
+fn simulate_rig(
+    a: &SimulateArgs,
+    rig: VirtualRig,
+    what: String,
+    rate: f64,
+    command: Vec<f64>,
+    offset: f64,
+    duration: f64,
+) -> Result<()> {
     let bar = ProgressBar::new("simulate", "samples");
     let update = |done: u64, total: u64| bar.update(done, total);
     let out = rig.simulate_with_progress(&command, rate, &update);
@@ -109,6 +136,63 @@ pub fn run(a: &SimulateArgs) -> Result<()> {
         what,
         1e3 * peak,
         if a.linear { "off (linear)" } else { "on" }
+    );
+    Ok(())
+}
+
+/// `feedid simulate --params structure.toml`: a command run on a drive
+/// structure, written as `time_s,command_m,position_m,velocity_m_per_s,output`.
+fn simulate_structure(a: &SimulateArgs, s: &feedid::drive::DriveStructure) -> Result<()> {
+    if a.effects.is_some() || a.linear {
+        anyhow::bail!(
+            "{}: a drive structure has its own friction law and limits; --effects and --linear are for the paper's rig",
+            a.params.as_deref().map_or_else(String::new, |p| p.display().to_string())
+        );
+    }
+    let (what, rate, command, offset) = command_of(a)?;
+    let run = s
+        .simulate(&command, rate, 0.0)
+        .map_err(|e| params_error(a.params.as_deref(), e))?;
+    for (name, v) in [
+        ("position_m", &run.position),
+        ("velocity_m_per_s", &run.velocity),
+    ] {
+        if let Some(k) = v.iter().position(|x| !feedid::recording::is_usable(*x)) {
+            anyhow::bail!(
+                "{}: the simulation diverged: {name} reaches {:e} at t = {} s; nothing written",
+                a.output.display(),
+                v[k],
+                run.time[k]
+            );
+        }
+    }
+    let mut outputs = Outputs::default();
+    outputs.add(&a.output, |w| {
+        writeln!(w, "time_s,command_m,position_m,velocity_m_per_s,output")?;
+        for k in 0..run.time.len() {
+            writeln!(
+                w,
+                "{},{},{},{},{}",
+                run.time[k],
+                run.command[k] + offset,
+                run.position[k] + offset,
+                run.velocity[k],
+                run.output[k]
+            )?;
+        }
+        Ok(())
+    })?;
+    outputs.commit()?;
+    println!(
+        "{}: {} samples at {} Hz ({:.3} s), {} command on the drive structure {}",
+        a.output.display(),
+        run.time.len(),
+        rate,
+        command.len() as f64 / rate,
+        what,
+        a.params
+            .as_deref()
+            .map_or_else(String::new, |p| p.display().to_string())
     );
     Ok(())
 }

@@ -7,6 +7,7 @@ mod nominal;
 mod params;
 mod rig;
 mod stability;
+mod structure;
 mod summary;
 
 pub use closed_loop::{
@@ -23,4 +24,8 @@ pub use rig::{
     DEFAULT_MAX_STEP,
 };
 pub use stability::{check_model, require_stable, ModelCheck};
+pub use structure::{
+    Controller, Drive, DriveStructure, FeedForward, FrictionLaw, LoopGains, LoopKind, Mechanics,
+    StructureRun, StructureSummary, VelocityEstimate,
+};
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

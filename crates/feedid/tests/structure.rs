@@ -1,0 +1,244 @@
+//! Drive structures described in a parameter file: the linear closed loop
+//! against closed forms, the simulation against the linear closed loop, and
+//! the EMPS reference model against the measured EMPS run.
+
+use std::path::Path;
+
+use feedid::drive::{DriveStructure, LoopKind};
+
+fn emps() -> DriveStructure {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/emps.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    DriveStructure::from_toml_str(&text, Some(&path)).unwrap()
+}
+
+#[test]
+fn the_emps_file_reads_with_its_published_values() {
+    let s = emps();
+    assert_eq!(s.position.kind, LoopKind::P);
+    assert_eq!((s.position.kp, s.velocity.kp), (160.18, 243.45));
+    assert_eq!((s.drive.gain, s.drive.limit), (35.1507, Some(10.0)));
+    assert_eq!(s.mechanics.mass, 95.1089);
+    assert_eq!(
+        (s.friction.viscous, s.friction.coulomb, s.friction.offset),
+        (203.5034, 20.3935, -3.1648)
+    );
+    assert_eq!(s.controller.sample_time, Some(0.001));
+    assert!(s.source.as_deref().unwrap_or("").contains("Janot"));
+    // what it writes it reads back
+    let again = DriveStructure::from_toml_str(&s.to_toml_string(), None).unwrap();
+    assert_eq!(again, s);
+}
+
+#[test]
+fn a_p_p_loop_on_a_rigid_mass_is_the_closed_form_second_order_system() {
+    // X/Xs = g·kv·kp / (M s² + (Fv + g·kv) s + g·kv·kp)
+    let s = emps();
+    let (g, kv, kp, m, fv) = (35.1507, 243.45, 160.18, 95.1089, 203.5034);
+    let summary = s.closed_loop().unwrap();
+    let den = &summary.denominator;
+    let num = &summary.numerator;
+    assert_eq!(den.len(), 3);
+    let expect_den = [m, fv + g * kv, g * kv * kp];
+    for (a, b) in den.iter().zip(expect_den) {
+        assert!((a - b).abs() <= 1e-12 * b.abs(), "{den:?}");
+    }
+    assert_eq!(num.len(), 1);
+    assert!((num[0] - g * kv * kp).abs() <= 1e-12 * num[0]);
+    let wn = (g * kv * kp / m).sqrt();
+    let zeta = (fv + g * kv) / (2.0 * (m * g * kv * kp).sqrt());
+    assert!(summary.stable);
+    for p in &summary.poles {
+        assert!((p.freq_hz - wn / (2.0 * std::f64::consts::PI)).abs() < 1e-9 * wn);
+        assert!((p.damping - zeta).abs() < 1e-9);
+    }
+    let e = summary.following_error_per_velocity.unwrap();
+    assert!((e - (fv + g * kv) / (g * kv * kp)).abs() < 1e-12);
+}
+
+#[test]
+fn integral_action_removes_the_following_error_and_feed_forward_halves_it() {
+    let base = "[position]\nkp = 50.0\n[velocity]\nkp = 100.0\n[drive]\ngain = 10.0\n\
+                [mechanics]\nmass = 5.0\n[friction]\nviscous = 20.0\n";
+    let p = DriveStructure::from_toml_str(base, None).unwrap();
+    let e0 = p
+        .closed_loop()
+        .unwrap()
+        .following_error_per_velocity
+        .unwrap();
+    // v·(1/kp + Fv/(g·kv·kp))
+    assert!((e0 - (1.0 / 50.0 + 20.0 / (10.0 * 100.0 * 50.0))).abs() < 1e-12);
+    // a PI velocity loop makes the loop type 2 as far as the velocity is concerned:
+    // the ramp error is v·(1 − kvff)/kp
+    let pi = base.replace(
+        "[velocity]\nkp = 100.0",
+        "[velocity]\nkind = \"PI\"\nkp = 100.0\nki = 10.0",
+    );
+    let e1 = DriveStructure::from_toml_str(&pi, None)
+        .unwrap()
+        .closed_loop()
+        .unwrap()
+        .following_error_per_velocity
+        .unwrap();
+    assert!((e1 - 1.0 / 50.0).abs() < 1e-12, "{e1}");
+    let ff = format!("{pi}[feed_forward]\nvelocity = 0.5\n");
+    let e2 = DriveStructure::from_toml_str(&ff, None)
+        .unwrap()
+        .closed_loop()
+        .unwrap()
+        .following_error_per_velocity
+        .unwrap();
+    assert!((e2 - 0.5 / 50.0).abs() < 1e-12, "{e2}");
+    // a PI position loop commanding the force directly: no ramp error
+    let pid =
+        "[position]\nkind = \"PID\"\nkp = 2000.0\nki = 20.0\nkd = 0.02\n[drive]\ngain = 1.0\n\
+               [mechanics]\nmass = 1.0\n[friction]\nviscous = 5.0\n";
+    let s = DriveStructure::from_toml_str(pid, None).unwrap();
+    let summary = s.closed_loop().unwrap();
+    assert!(summary.stable, "{summary}");
+    assert_eq!(summary.following_error_per_velocity, Some(0.0));
+}
+
+#[test]
+fn the_linear_continuous_simulation_follows_the_transfer_function() {
+    // no friction but viscous, no saturation, continuous: the simulated ramp
+    // response is the transfer function's (to the integration's accuracy)
+    let text = "[position]\nkind = \"PI\"\nkp = 50.0\nki = 5.0\n[velocity]\nkind = \"PI\"\nkp = 100.0\nki = 20.0\n\
+                [drive]\ngain = 10.0\n[mechanics]\nmass = 5.0\n[friction]\nviscous = 20.0\n\
+                [feed_forward]\nvelocity = 0.8\n";
+    let s = DriveStructure::from_toml_str(text, None).unwrap();
+    let rate = 2000.0;
+    let n = 2000;
+    let cmd: Vec<f64> = (0..n).map(|k| 0.05 * (k as f64 / rate)).collect();
+    let run = s.simulate(&cmd, rate, 0.0).unwrap();
+    let tf = s.transfer_function().unwrap();
+    let exact = tf.ramp_response(0.05, 1.0 / rate, n).unwrap();
+    let worst = run
+        .position
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "{worst}");
+}
+
+#[test]
+fn bad_structures_are_refused_with_the_key_named() {
+    for (text, key) in [
+        ("[position]\nkp = -1.0\n[drive]\ngain = 1.0\n[mechanics]\nmass = 1.0\n", "position.kp"),
+        ("[position]\nkp = 1.0\n[drive]\ngain = 1.0\n[mechanics]\nmass = 0.0\n", "mechanics.mass"),
+        (
+            "[position]\nkp = 1.0\n[velocity]\nkind = \"PID\"\nkp = 1.0\n[drive]\ngain = 1.0\n[mechanics]\nmass = 1.0\n",
+            "velocity.kind",
+        ),
+        (
+            "[position]\nkp = 1.0\n[drive]\ngain = 1.0\n[mechanics]\nmass = 1.0\n[feed_forward]\nvelocity = 1.0\n",
+            "feed_forward.velocity",
+        ),
+        ("[position]\nkp = 1.0\n[drive]\ngain = 1.0\n[mechanics]\nmass = 1.0\nweight = 3\n", "weight"),
+    ] {
+        let e = DriveStructure::from_toml_str(text, Some(Path::new("axis.toml"))).unwrap_err();
+        let m = e.to_string();
+        assert!(m.contains(key) && m.contains("axis.toml"), "{m}");
+    }
+    assert!(DriveStructure::describes("[drive]\ngain = 1.0\n"));
+    assert!(!DriveStructure::describes("[control]\nkv = 30.0\n"));
+}
+
+#[test]
+fn the_emps_reference_model_reproduces_the_measured_run() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
+    if !path.exists() {
+        eprintln!(
+            "skipped: {} is absent (the EMPS data set, see its README)",
+            path.display()
+        );
+        return;
+    }
+    let opts = feedid::io::ReadOptions {
+        time: Some(feedid::io::ChannelRef::parse("t").unwrap()),
+        command: Some(feedid::io::ChannelRef::parse("qg").unwrap()),
+        position: Some(feedid::io::ChannelRef::parse("qm").unwrap()),
+        ..Default::default()
+    };
+    let rec = feedid::io::read_recording(&path, &opts).unwrap();
+    let (qg, qm) = (rec.command(), rec.position());
+    let run = emps().simulate(qg, rec.rate_hz(), qm[0]).unwrap();
+    let rms = |f: &dyn Fn(usize) -> f64| {
+        ((0..qm.len()).map(|k| f(k).powi(2)).sum::<f64>() / qm.len() as f64).sqrt()
+    };
+    let tracking = rms(&|k| qg[k] - qm[k]);
+    let error = rms(&|k| run.position[k] - qm[k]);
+    eprintln!("EMPS: tracking error rms {tracking:.3e} m, reference model error rms {error:.3e} m");
+    // the reference model inside the known controller explains the run:
+    // its error is a small part of the tracking error it reproduces
+    assert!(error < 0.01 * tracking, "{error} vs {tracking}");
+}
+
+#[test]
+fn a_pid_position_loop_commanding_force_follows_its_transfer_function() {
+    let text =
+        "[position]\nkind = \"PID\"\nkp = 2000.0\nki = 20.0\nkd = 0.02\n[drive]\ngain = 1.0\n\
+                [mechanics]\nmass = 1.0\n[friction]\nviscous = 5.0\n";
+    let s = DriveStructure::from_toml_str(text, None).unwrap();
+    let rate = 5000.0;
+    let n = 2500;
+    let cmd: Vec<f64> = (0..n).map(|k| 0.02 * (k as f64 / rate)).collect();
+    let run = s.simulate(&cmd, rate, 0.0).unwrap();
+    let exact = s
+        .transfer_function()
+        .unwrap()
+        .ramp_response(0.02, 1.0 / rate, n)
+        .unwrap();
+    let worst = run
+        .position
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "{worst}");
+}
+
+#[test]
+fn a_sampled_controller_approaches_the_continuous_one_as_its_rate_rises() {
+    let base = "[position]\nkp = 50.0\n[velocity]\nkp = 100.0\n[drive]\ngain = 10.0\n\
+                [mechanics]\nmass = 5.0\n[friction]\nviscous = 20.0\ncoulomb = 2.0\n";
+    let continuous = DriveStructure::from_toml_str(base, None).unwrap();
+    let gap = |rate: f64| {
+        let sampled = DriveStructure::from_toml_str(
+            &format!(
+                "{base}[controller]\nsample_time = {}\nvelocity_estimate = \"backward\"\n",
+                1.0 / rate
+            ),
+            None,
+        )
+        .unwrap();
+        let n = (0.5 * rate) as usize;
+        let cmd: Vec<f64> = (0..n).map(|k| 0.01 * (k as f64 / rate)).collect();
+        let a = continuous.simulate(&cmd, rate, 0.0).unwrap();
+        let b = sampled.simulate(&cmd, rate, 0.0).unwrap();
+        a.position
+            .iter()
+            .zip(&b.position)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    let (slow, fast) = (gap(1000.0), gap(10_000.0));
+    assert!(fast < 0.2 * slow, "{slow} {fast}");
+    assert!(fast < 1e-5, "{fast}");
+}
+
+#[test]
+fn full_feed_forward_on_a_frictionless_mass_tracks_exactly() {
+    // kvff = kaff = 1, no friction: N = D, X/Xs = 1 and no following error
+    let text = "[position]\nkp = 30.0\n[velocity]\nkind = \"PI\"\nkp = 80.0\nki = 15.0\n[drive]\ngain = 2.0\n\
+                [mechanics]\nmass = 7.0\n[feed_forward]\nvelocity = 1.0\nacceleration = 1.0\n";
+    let s = DriveStructure::from_toml_str(text, None).unwrap();
+    let summary = s.closed_loop().unwrap();
+    assert_eq!(summary.numerator.len(), summary.denominator.len());
+    for (a, b) in summary.numerator.iter().zip(&summary.denominator) {
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{summary}");
+    }
+    assert_eq!(summary.following_error_per_velocity, Some(0.0));
+}

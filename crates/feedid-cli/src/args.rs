@@ -499,13 +499,17 @@ pub struct GreyboxArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Starting (nominal) rig parameters; the others stay fixed at these values [default: the built-in rig].
+    /// Starting (nominal) rig parameters, or a drive structure file (examples/emps.toml);
+    /// the others stay fixed at these values [default: the built-in rig].
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
-    /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc.
+    /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc;
+    /// for a drive structure: M, Fv, Fc, offset, gain, kp, kv.
     #[arg(long, value_name = "LIST")]
     pub estimate: String,
-    /// Measured motor-current column/variable [A], used as a second output.
+    /// Measured motor-current column/variable [A], used as a second output; for a
+    /// drive structure, the controller output (force = drive gain × it), for an
+    /// inverse-dynamics (IDIM-LS) cross-check.
     #[arg(long, value_name = "NAME")]
     pub current: Option<String>,
     /// Simulate the nonlinear virtual rig (friction, variable stiffness, limits) instead of the linear model.

@@ -120,3 +120,78 @@ fn commands_that_need_the_papers_rig_name_a_structure_file() {
     assert_fails(&o, &["emps.toml", "drive structure", "feedid model"]);
     assert!(!p.exists());
 }
+
+#[test]
+fn greybox_recovers_a_structures_parameters_from_its_simulated_run() {
+    // the EMPS structure run on a multisine at its 1 kHz; estimated from a
+    // file whose mass, viscous and Coulomb friction are 25 % off and whose
+    // offset is 0
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("run.csv");
+    let f = emps_toml();
+    let o = feedid(&[
+        "simulate",
+        "--params",
+        &f,
+        "--scenario",
+        "multisine",
+        "--rate",
+        "1000",
+        "-o",
+        rec.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&f).unwrap();
+    let off = text
+        .replace("mass = 95.1089", "mass = 118.886")
+        .replace("viscous = 203.5034", "viscous = 152.6276")
+        .replace("coulomb = 20.3935", "coulomb = 25.4919")
+        .replace("offset = -3.1648", "offset = 0.0");
+    let start = dir.path().join("start.toml");
+    std::fs::write(&start, off).unwrap();
+    let out = dir.path().join("estimated.toml");
+    let summary = dir.path().join("gb.json");
+    let o = feedid(&[
+        "greybox",
+        rec.to_str().unwrap(),
+        "--params",
+        start.to_str().unwrap(),
+        "--estimate",
+        "M,Fv,Fc,offset",
+        "--params-out",
+        out.to_str().unwrap(),
+        "--summary",
+        summary.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let value = |name: &str| {
+        v["estimates"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["param"] == name)
+            .unwrap()["value"]
+            .as_f64()
+            .unwrap()
+    };
+    for (name, truth) in [("M", 95.1089), ("Fv", 203.5034), ("Fc", 20.3935)] {
+        let rel = (value(name) - truth) / truth;
+        assert!(rel.abs() < 1e-3, "{name}: {rel:e}");
+    }
+    assert!((value("offset") + 3.1648).abs() < 0.01);
+    // the written structure reads back as a structure
+    let o = feedid(&["model", "--params", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // an unknown name is refused with the known ones
+    let o = feedid(&[
+        "greybox",
+        rec.to_str().unwrap(),
+        "--params",
+        &f,
+        "--estimate",
+        "M,Kv",
+    ]);
+    assert_fails(&o, &["Kv", "M, Fv, Fc, offset"]);
+}

@@ -242,3 +242,186 @@ fn full_feed_forward_on_a_frictionless_mass_tracks_exactly() {
     }
     assert_eq!(summary.following_error_per_velocity, Some(0.0));
 }
+
+fn emps_recording() -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
+    if !path.exists() {
+        eprintln!(
+            "skipped: {} is absent (the EMPS data set, see its README)",
+            path.display()
+        );
+        return None;
+    }
+    let opts = feedid::io::ReadOptions {
+        time: Some(feedid::io::ChannelRef::parse("t").unwrap()),
+        command: Some(feedid::io::ChannelRef::parse("qg").unwrap()),
+        position: Some(feedid::io::ChannelRef::parse("qm").unwrap()),
+        ..Default::default()
+    };
+    let rec = feedid::io::read_recording(&path, &opts).unwrap();
+    Some((
+        rec.command().to_vec(),
+        rec.position().to_vec(),
+        rec.rate_hz(),
+    ))
+}
+
+#[test]
+fn the_emps_mass_and_friction_are_recovered_from_command_and_position() {
+    use feedid::drive::StructureParam as P;
+    let Some((qg, qm, rate)) = emps_recording() else {
+        return;
+    };
+    // start 30 % off every reference value, the offset at 0
+    let mut start = emps();
+    start.mechanics.mass *= 1.3;
+    start.friction.viscous *= 0.7;
+    start.friction.coulomb *= 1.3;
+    start.friction.offset = 0.0;
+    let fit = start
+        .fit(
+            &qg,
+            &qm,
+            rate,
+            &[P::Mass, P::Viscous, P::Coulomb, P::Offset],
+        )
+        .unwrap();
+    eprintln!("{fit}");
+    let reference = emps();
+    let rel = |p: P| {
+        let e = fit.estimates.iter().find(|e| e.param == p).unwrap();
+        let r = match p {
+            P::Mass => reference.mechanics.mass,
+            P::Viscous => reference.friction.viscous,
+            P::Coulomb => reference.friction.coulomb,
+            _ => unreachable!(),
+        };
+        (e.value - r) / r
+    };
+    for p in [P::Mass, P::Viscous, P::Coulomb] {
+        assert!(
+            rel(p).abs() < 0.05,
+            "{}: {:+.2} %",
+            p.name(),
+            100.0 * rel(p)
+        );
+    }
+    let offset = fit
+        .estimates
+        .iter()
+        .find(|e| e.param == P::Offset)
+        .unwrap()
+        .value;
+    assert!(
+        (offset - reference.friction.offset).abs() < 1.0,
+        "offset {offset}"
+    );
+    // the estimates explain the run at least as well as the reference does
+    let reference_rms = {
+        let run = reference.simulate(&qg, rate, qm[0]).unwrap();
+        (run.position
+            .iter()
+            .zip(&qm)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            / qm.len() as f64)
+            .sqrt()
+    };
+    assert!(
+        fit.rms <= reference_rms * (1.0 + 1e-9),
+        "{} vs {reference_rms}",
+        fit.rms
+    );
+}
+
+#[test]
+fn inverse_dynamics_recovers_a_simulated_axis_and_the_emps_reference() {
+    use feedid::drive::{inverse_dynamics, IdimConfig};
+    // a simulated axis with known parameters: force = gain · output
+    let mut s = emps();
+    s.controller.sample_time = None;
+    let rate = 1000.0;
+    let cmd: Vec<f64> = (0..20_000)
+        .map(|k| {
+            let t = k as f64 / rate;
+            0.05 * (0.7 * t).sin() + 0.02 * (2.3 * t).sin()
+        })
+        .collect();
+    let run = s.simulate(&cmd, rate, 0.0).unwrap();
+    let force: Vec<f64> = run.output.iter().map(|u| s.drive.gain * u).collect();
+    let fit = inverse_dynamics(&run.position, &force, rate, &IdimConfig::default()).unwrap();
+    let rel = |x: f64, truth: f64| ((x - truth) / truth).abs();
+    assert!(rel(fit.mass.0, 95.1089) < 0.01, "{fit:?}");
+    assert!(rel(fit.viscous.0, 203.5034) < 0.01, "{fit:?}");
+    assert!(rel(fit.coulomb.0, 20.3935) < 0.02, "{fit:?}");
+    assert!((fit.offset.0 + 3.1648).abs() < 0.2, "{fit:?}");
+    // EMPS: force = gtau · vir, beside the measured position
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
+    if !path.exists() {
+        eprintln!(
+            "skipped: {} is absent (the EMPS data set, see its README)",
+            path.display()
+        );
+        return;
+    }
+    let read = |name: &str| {
+        let opts = feedid::io::ReadOptions {
+            time: Some(feedid::io::ChannelRef::parse("t").unwrap()),
+            command: Some(feedid::io::ChannelRef::parse("qg").unwrap()),
+            position: Some(feedid::io::ChannelRef::parse(name).unwrap()),
+            ..Default::default()
+        };
+        feedid::io::read_recording(&path, &opts).unwrap()
+    };
+    let (qm, vir) = (read("qm"), read("vir"));
+    let force: Vec<f64> = vir.position().iter().map(|u| 35.1507 * u).collect();
+    let fit =
+        inverse_dynamics(qm.position(), &force, qm.rate_hz(), &IdimConfig::default()).unwrap();
+    eprintln!("EMPS IDIM-LS: {fit:?}");
+    assert!(rel(fit.mass.0, 95.1089) < 0.02, "{fit:?}");
+    assert!(rel(fit.viscous.0, 203.5034) < 0.02, "{fit:?}");
+    assert!(rel(fit.coulomb.0, 20.3935) < 0.02, "{fit:?}");
+    assert!((fit.offset.0 + 3.1648).abs() < 1.0, "{fit:?}");
+}
+
+#[test]
+fn the_friction_law_has_its_levels_dip_and_asymmetry() {
+    use feedid::drive::FrictionLaw;
+    let f = FrictionLaw {
+        viscous: 10.0,
+        coulomb: 5.0,
+        coulomb_negative: Some(7.0),
+        r#static: Some(8.0),
+        stribeck_velocity: Some(1e-3),
+        offset: -1.0,
+        smoothing_velocity: Some(1e-6),
+    };
+    // far above the Stribeck velocity: viscous + Coulomb + offset
+    assert!((f.force(0.1) - (1.0 + 5.0 - 1.0)).abs() < 1e-9);
+    assert!((f.force(-0.1) - (-1.0 - 7.0 - 1.0)).abs() < 1e-9);
+    // just moving: the static level
+    assert!((f.force(1e-5) - (8.0 - 1.0)).abs() < 1e-2);
+    // at rest: the offset alone
+    assert_eq!(f.force(0.0), -1.0);
+}
+
+#[test]
+fn a_fit_refuses_what_it_cannot_do_with_a_reason() {
+    use feedid::drive::StructureParam as P;
+    let s = emps();
+    let cmd = vec![0.0; 100];
+    assert!(s.fit(&cmd, &cmd[..99], 1000.0, &[P::Mass]).is_err());
+    assert!(s.fit(&cmd, &cmd, 1000.0, &[]).is_err());
+    let mut bad = cmd.clone();
+    bad[5] = f64::NAN;
+    let e = s.fit(&cmd, &bad, 1000.0, &[P::Mass]).unwrap_err();
+    assert!(e.to_string().contains("position"), "{e}");
+    // a parameter estimated as positive needs a positive start
+    let mut zero = s.clone();
+    zero.friction.coulomb = 0.0;
+    assert!(zero.fit(&cmd, &cmd, 1000.0, &[P::Coulomb]).is_err());
+    let e = "Kv".parse::<P>().unwrap_err();
+    assert!(e.to_string().contains("M, Fv, Fc, offset"), "{e}");
+}

@@ -30,6 +30,9 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     outs.extend(a.params_out.as_deref());
     outs.extend(a.track_out.as_deref());
     check_distinct(&ins, &outs)?;
+    if let Some(structure) = crate::cmd::load_structure(a.params.as_deref())? {
+        return fit_structure(a, &structure);
+    }
     let estimate = PhysicalParameter::parse_list(&a.estimate)?;
     let start = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let position_loop: LoopModel = a.position_loop.parse()?;
@@ -412,6 +415,99 @@ fn write_track_csv(
                 "not_excited"
             }
         )?;
+    }
+    Ok(())
+}
+
+/// `feedid greybox rec --params structure.toml --estimate M,Fv,…`: a drive
+/// structure's parameters from command and position (output error).
+fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> Result<()> {
+    let Some(input) = &a.input else {
+        bail!(
+            "--from-model is for the paper's rig; a drive structure is estimated from a recording"
+        );
+    };
+    if a.friction || a.effects.is_some() || a.track_window.is_some() {
+        bail!(
+            "--friction, --effects and --track-window are for the paper's rig; \
+             a drive structure simulates its own friction law"
+        );
+    }
+    let estimate = a
+        .estimate
+        .split(',')
+        .filter(|t| !t.trim().is_empty())
+        .map(|t| t.parse::<feedid::drive::StructureParam>())
+        .collect::<feedid::Result<Vec<_>>>()?;
+    let rec = recording::load(input, &a.recording)?;
+    let fit = structure
+        .fit(rec.command(), rec.position(), rec.rate_hz(), &estimate)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    // the controller output beside the position: the inverse-dynamics cross-check
+    let idim = match &a.current {
+        Some(name) => {
+            let output = rec
+                .extra()
+                .iter()
+                .find(|(n, _)| n == name || n.eq_ignore_ascii_case(name))
+                .map(|(_, v)| v.as_slice())
+                .ok_or_else(|| {
+                    let names: Vec<&str> = rec.extra().iter().map(|(n, _)| n.as_str()).collect();
+                    anyhow::anyhow!(
+                        "{}: no controller-output column `{name}`; numeric columns besides time, command and position: {}",
+                        input.display(),
+                        if names.is_empty() { "none".to_string() } else { names.join(", ") }
+                    )
+                })?;
+            let force: Vec<f64> = output.iter().map(|u| structure.drive.gain * u).collect();
+            Some(
+                feedid::drive::inverse_dynamics(
+                    rec.position(),
+                    &force,
+                    rec.rate_hz(),
+                    &feedid::drive::IdimConfig::default(),
+                )
+                .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?,
+            )
+        }
+        None => None,
+    };
+    let mut outputs = Outputs::default();
+    if let Some(p) = &a.params_out {
+        outputs.add_text(p, fit.structure.to_toml_string())?;
+    }
+    if let Some(p) = &a.summary {
+        let mut v = serde_json::to_value(&fit)?;
+        if let (Some(o), Some(i)) = (v.as_object_mut(), &idim) {
+            o.insert("inverse_dynamics".into(), serde_json::to_value(i)?);
+        }
+        outputs.add_text(p, format!("{}\n", serde_json::to_string_pretty(&v)?))?;
+    }
+    outputs.commit()?;
+    println!(
+        "{}: {} samples at {} Hz, drive structure {}",
+        input.display(),
+        rec.len(),
+        rec.rate_hz(),
+        a.params
+            .as_deref()
+            .map_or_else(String::new, |p| p.display().to_string())
+    );
+    print!("{fit}");
+    if let Some(i) = idim {
+        println!(
+            "inverse dynamics (IDIM-LS, force = gain × {}; {} rows): M {:.4} ± {:.2e} kg, Fv {:.4} ± {:.2e} N·s/m, Fc {:.4} ± {:.2e} N, offset {:.4} ± {:.2e} N",
+            a.current.as_deref().unwrap_or(""),
+            i.rows,
+            i.mass.0,
+            i.mass.1,
+            i.viscous.0,
+            i.viscous.1,
+            i.coulomb.0,
+            i.coulomb.1,
+            i.offset.0,
+            i.offset.1
+        );
     }
     Ok(())
 }

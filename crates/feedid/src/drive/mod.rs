@@ -25,7 +25,8 @@ pub use rig::{
 };
 pub use stability::{check_model, require_stable, ModelCheck};
 pub use structure::{
-    Controller, Drive, DriveStructure, FeedForward, FrictionLaw, LoopGains, LoopKind, Mechanics,
+    inverse_dynamics, Controller, Drive, DriveStructure, FeedForward, FrictionLaw, IdimConfig,
+    IdimFit, LoopGains, LoopKind, Mechanics, StructureEstimate, StructureFit, StructureParam,
     StructureRun, StructureSummary, VelocityEstimate,
 };
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

@@ -36,6 +36,7 @@
 //! ```
 
 mod balance;
+mod butterworth;
 mod discrete;
 mod eig;
 mod expm;
@@ -43,6 +44,7 @@ mod poly;
 mod ss;
 mod tf;
 
+pub use butterworth::{butterworth_lowpass, filtfilt, Biquad};
 pub use discrete::DiscreteStateSpace;
 pub use nalgebra::Complex;
 pub use poly::{poly_eval, poly_from_roots, poly_roots};

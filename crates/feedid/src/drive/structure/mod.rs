@@ -56,6 +56,8 @@
 //! the screw's stiffness) is the rig parameter file ([`crate::drive::RigParams`]);
 //! this structure covers the axes whose current loop is a force source.
 
+mod fit;
+mod idim;
 mod linear;
 mod simulate;
 
@@ -65,6 +67,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
+pub use fit::{StructureEstimate, StructureFit, StructureParam};
+pub use idim::{inverse_dynamics, IdimConfig, IdimFit};
 pub use linear::StructureSummary;
 pub use simulate::StructureRun;
 

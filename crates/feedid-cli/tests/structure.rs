@@ -181,6 +181,38 @@ fn greybox_recovers_a_structures_parameters_from_its_simulated_run() {
         assert!(rel.abs() < 1e-3, "{name}: {rel:e}");
     }
     assert!((value("offset") + 3.1648).abs() < 0.01);
+    // validated on another run of the axis (a chirp): the estimates explain it
+    let other = dir.path().join("chirp.csv");
+    let o = feedid(&[
+        "simulate",
+        "--params",
+        &f,
+        "--scenario",
+        "chirp",
+        "--rate",
+        "1000",
+        "-o",
+        other.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = feedid(&[
+        "greybox",
+        rec.to_str().unwrap(),
+        "--params",
+        start.to_str().unwrap(),
+        "--estimate",
+        "M,Fv,Fc,offset",
+        "--validate",
+        other.to_str().unwrap(),
+        "--summary",
+        summary.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("validation on"), "{}", stdout(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let fit = v["validation"]["fit_percent"].as_f64().unwrap();
+    assert!(fit > 99.9, "{fit}");
     // the written structure reads back as a structure
     let o = feedid(&["model", "--params", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -23,6 +23,7 @@ use crate::cmd::{check_distinct, load_effects, load_model_params, recording, Out
 /// Run the fit(s), write the outputs, print the report.
 pub fn run(a: &GreyboxArgs) -> Result<()> {
     let mut ins: Vec<&Path> = a.input.iter().map(|p| p.as_path()).collect();
+    ins.extend(a.validate.as_deref());
     ins.extend(a.from_model.as_deref());
     ins.extend(a.params.as_deref());
     ins.extend(a.effects.as_deref());
@@ -32,6 +33,9 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     check_distinct(&ins, &outs)?;
     if let Some(structure) = crate::cmd::load_structure(a.params.as_deref())? {
         return fit_structure(a, &structure);
+    }
+    if a.validate.is_some() {
+        bail!("--validate simulates a drive structure (--params structure.toml); for the paper's rig it is not there yet");
     }
     let estimate = PhysicalParameter::parse_list(&a.estimate)?;
     let start = load_model_params(a.params.as_deref(), a.allow_unstable)?;
@@ -472,6 +476,17 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
         }
         None => None,
     };
+    let validation = match &a.validate {
+        Some(path) => {
+            let other = recording::load(path, &a.recording)?;
+            let v = fit
+                .structure
+                .validate_on(other.command(), other.position(), other.rate_hz())
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            Some((path, v))
+        }
+        None => None,
+    };
     let mut outputs = Outputs::default();
     if let Some(p) = &a.params_out {
         outputs.add_text(p, fit.structure.to_toml_string())?;
@@ -480,6 +495,9 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
         let mut v = serde_json::to_value(&fit)?;
         if let (Some(o), Some(i)) = (v.as_object_mut(), &idim) {
             o.insert("inverse_dynamics".into(), serde_json::to_value(i)?);
+        }
+        if let (Some(o), Some((_, val))) = (v.as_object_mut(), &validation) {
+            o.insert("validation".into(), serde_json::to_value(val)?);
         }
         outputs.add_text(p, format!("{}\n", serde_json::to_string_pretty(&v)?))?;
     }
@@ -494,6 +512,17 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
             .map_or_else(String::new, |p| p.display().to_string())
     );
     print!("{fit}");
+    if let Some((path, v)) = &validation {
+        println!(
+            "validation on {} ({} samples): rms error {:.3} µm, max {:.3} µm, fit {:.3} % (tracking error there {:.3} µm rms)",
+            path.display(),
+            v.samples,
+            1e6 * v.rms,
+            1e6 * v.max,
+            v.fit_percent,
+            1e6 * v.tracking_rms
+        );
+    }
     if let Some(i) = idim {
         println!(
             "inverse dynamics (IDIM-LS, force = gain × {}; {} rows): M {:.4} ± {:.2e} kg, Fv {:.4} ± {:.2e} N·s/m, Fc {:.4} ± {:.2e} N, offset {:.4} ± {:.2e} N",

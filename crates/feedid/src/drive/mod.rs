@@ -27,6 +27,6 @@ pub use stability::{check_model, require_stable, ModelCheck};
 pub use structure::{
     inverse_dynamics, Controller, Drive, DriveStructure, FeedForward, FrictionLaw, IdimConfig,
     IdimFit, LoopGains, LoopKind, Mechanics, StructureEstimate, StructureFit, StructureParam,
-    StructureRun, StructureSummary, VelocityEstimate,
+    StructureRun, StructureSummary, StructureValidation, VelocityEstimate,
 };
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

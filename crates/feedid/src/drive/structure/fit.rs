@@ -318,6 +318,73 @@ impl DriveStructure {
     }
 }
 
+/// How a structure's simulation matches a recording it was not fitted on.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StructureValidation {
+    /// Samples compared.
+    pub samples: usize,
+    /// Rms of simulated − measured position \[m\].
+    pub rms: f64,
+    /// Largest |simulated − measured| \[m\].
+    pub max: f64,
+    /// Fit `100·(1 − ‖y − ŷ‖/‖y − ȳ‖)` \[%\].
+    pub fit_percent: f64,
+    /// Rms of command − measured position (the tracking error it explains) \[m\].
+    pub tracking_rms: f64,
+}
+
+impl DriveStructure {
+    /// Simulate the structure on another recording's `command` (from its
+    /// measured first position) and compare with its measured `position`.
+    pub fn validate_on(
+        &self,
+        command: &[f64],
+        position: &[f64],
+        rate_hz: f64,
+    ) -> Result<StructureValidation> {
+        if command.len() != position.len() {
+            return Err(Error::LengthMismatch {
+                what: "command and position",
+                expected: command.len(),
+                actual: position.len(),
+            });
+        }
+        let first = position.first().copied().unwrap_or(0.0);
+        let run = self.simulate(command, rate_hz, first)?;
+        let n = position.len();
+        let err: Vec<f64> = run
+            .position
+            .iter()
+            .zip(position)
+            .map(|(s, y)| s - y)
+            .collect();
+        let mean = position.iter().sum::<f64>() / n as f64;
+        let spread = position
+            .iter()
+            .map(|y| (y - mean).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let norm = err.iter().map(|e| e * e).sum::<f64>().sqrt();
+        Ok(StructureValidation {
+            samples: n,
+            rms: norm / (n as f64).sqrt(),
+            max: err.iter().fold(0.0, |m, e| m.max(e.abs())),
+            fit_percent: if spread > 0.0 {
+                100.0 * (1.0 - norm / spread)
+            } else {
+                f64::NAN
+            },
+            tracking_rms: (command
+                .iter()
+                .zip(position)
+                .map(|(c, y)| (c - y).powi(2))
+                .sum::<f64>()
+                / n as f64)
+                .sqrt(),
+        })
+    }
+}
+
 impl fmt::Display for StructureFit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(

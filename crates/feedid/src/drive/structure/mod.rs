@@ -67,7 +67,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
-pub use fit::{StructureEstimate, StructureFit, StructureParam};
+pub use fit::{StructureEstimate, StructureFit, StructureParam, StructureValidation};
 pub use idim::{inverse_dynamics, IdimConfig, IdimFit};
 pub use linear::StructureSummary;
 pub use simulate::StructureRun;

@@ -227,3 +227,45 @@ fn greybox_recovers_a_structures_parameters_from_its_simulated_run() {
     ]);
     assert_fails(&o, &["Kv", "M, Fv, Fc, offset"]);
 }
+
+#[test]
+fn tune_proposes_gains_and_writes_the_retuned_structure() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tuned.toml");
+    let f = emps_toml();
+    let o = feedid(&[
+        "tune",
+        "--params",
+        &f,
+        "--bandwidth",
+        "40",
+        "--verify",
+        "scurve",
+        "--params-out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = stdout(&o);
+    assert!(s.contains("40.000 Hz") && s.contains("proposed"), "{s}");
+    assert!(s.contains("nonlinear simulation, scurve"), "{s}");
+    // the written structure has the new gains and the same axis
+    let o = feedid(&["model", "--params", out.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!((v["bandwidth_hz"].as_f64().unwrap() - 40.0).abs() < 1e-3);
+    let o = feedid(&["tune", "--params", &f, "--bandwidth", "40", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!(v["overshoot_percent"][1].as_f64().unwrap() < 5.0);
+    // not a structure, or a bandwidth below what friction gives: exit 2
+    let rig = dir.path().join("rig.toml");
+    std::fs::write(&rig, "[control]\nkv = 30.0\n").unwrap();
+    let o = feedid(&[
+        "tune",
+        "--params",
+        rig.to_str().unwrap(),
+        "--bandwidth",
+        "40",
+    ]);
+    assert_fails(&o, &["rig.toml", "drive structure"]);
+    let o = feedid(&["tune", "--params", &f, "--bandwidth", "0.1"]);
+    assert_fails(&o, &["bandwidth", "viscous friction"]);
+}

@@ -425,3 +425,78 @@ fn a_fit_refuses_what_it_cannot_do_with_a_reason() {
     let e = "Kv".parse::<P>().unwrap_err();
     assert!(e.to_string().contains("M, Fv, Fc, offset"), "{e}");
 }
+
+#[test]
+fn tuning_a_p_p_loop_hits_the_bandwidth_and_damping_asked() {
+    use feedid::drive::TuneTarget;
+    let s = emps();
+    for (bw, z) in [
+        (10.0, 0.5),
+        (40.0, std::f64::consts::FRAC_1_SQRT_2),
+        (60.0, 1.0),
+    ] {
+        let t = s
+            .tune(&TuneTarget {
+                bandwidth_hz: bw,
+                damping: z,
+            })
+            .unwrap();
+        assert!(
+            (t.after.bandwidth_hz.unwrap() - bw).abs() < 1e-6 * bw,
+            "{bw}"
+        );
+        for p in &t.after.poles {
+            assert!((p.damping - z).abs() < 1e-6, "{bw} {z}: {}", p.damping);
+        }
+        // the second-order overshoot exp(−πζ/√(1−ζ²))
+        let expected = if z < 1.0 {
+            100.0 * (-std::f64::consts::PI * z / (1.0 - z * z).sqrt()).exp()
+        } else {
+            0.0
+        };
+        assert!(
+            (t.overshoot_percent.1 - expected).abs() < 0.05,
+            "{} {expected}",
+            t.overshoot_percent.1
+        );
+        // the mass, friction and drive are kept
+        assert_eq!(t.structure.mechanics, s.mechanics);
+        assert_eq!(t.structure.friction, s.friction);
+        assert_eq!(t.position_kp.0, 160.18);
+    }
+    // a bandwidth the viscous friction alone exceeds cannot be asked for
+    assert!(s
+        .tune(&TuneTarget {
+            bandwidth_hz: 0.1,
+            damping: 0.7
+        })
+        .is_err());
+    // another loop structure is refused with the reason
+    let mut pi = s.clone();
+    pi.velocity.kind = feedid::drive::LoopKind::PI;
+    pi.velocity.ki = 10.0;
+    let e = pi
+        .tune(&TuneTarget {
+            bandwidth_hz: 40.0,
+            damping: 0.7,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("P position loop"), "{e}");
+    // the tuned gains run through the nonlinear simulation: a smaller
+    // following error on a move within the drive's limit
+    let t = s
+        .tune(&TuneTarget {
+            bandwidth_hz: 40.0,
+            damping: std::f64::consts::FRAC_1_SQRT_2,
+        })
+        .unwrap();
+    let cmd = feedid::signal::Scenario::Scurve
+        .command(1000.0, 1.0, 0)
+        .unwrap();
+    let (before, after) = (
+        s.run_figures(&cmd, 1000.0).unwrap(),
+        t.structure.run_figures(&cmd, 1000.0).unwrap(),
+    );
+    eprintln!("{before:?}\n{after:?}");
+    assert!(after.rms_error < before.rms_error, "{before:?} {after:?}");
+}

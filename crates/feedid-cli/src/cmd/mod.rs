@@ -18,6 +18,7 @@ mod greybox;
 mod learn;
 mod report;
 mod sweep;
+pub(crate) mod tune;
 pub(crate) mod zoo;
 
 use std::io::Write;
@@ -40,6 +41,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Greybox(a) => greybox::run(&a),
         Command::Compensate(a) => compensate::run(&a),
         Command::Zoo(a) => zoo::run(&a),
+        Command::Tune(a) => tune::run(&a),
     }
 }
 

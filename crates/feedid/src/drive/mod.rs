@@ -26,7 +26,8 @@ pub use rig::{
 pub use stability::{check_model, require_stable, ModelCheck};
 pub use structure::{
     inverse_dynamics, Controller, Drive, DriveStructure, FeedForward, FrictionLaw, IdimConfig,
-    IdimFit, LoopGains, LoopKind, Mechanics, StructureEstimate, StructureFit, StructureParam,
-    StructureRun, StructureSummary, StructureValidation, VelocityEstimate,
+    IdimFit, LoopGains, LoopKind, Mechanics, RunFigures, StructureEstimate, StructureFit,
+    StructureParam, StructureRun, StructureSummary, StructureValidation, TuneTarget, Tuned,
+    VelocityEstimate,
 };
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

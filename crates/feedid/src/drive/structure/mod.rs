@@ -60,6 +60,7 @@ mod fit;
 mod idim;
 mod linear;
 mod simulate;
+mod tune;
 
 use std::path::Path;
 
@@ -71,6 +72,7 @@ pub use fit::{StructureEstimate, StructureFit, StructureParam, StructureValidati
 pub use idim::{inverse_dynamics, IdimConfig, IdimFit};
 pub use linear::StructureSummary;
 pub use simulate::StructureRun;
+pub use tune::{RunFigures, TuneTarget, Tuned};
 
 /// Kind of a loop's controller: `C(s) = kp·(1 + ki/s + kd·s)` with the terms
 /// its name has.

@@ -43,6 +43,10 @@ __all__ = [
     "model",
     "compensate",
     "learn",
+    "structure",
+    "simulate_structure",
+    "fit_structure",
+    "tune",
     "__version__",
 ]
 
@@ -906,4 +910,57 @@ def learn(
     out["command"] = command
     out["predicted"] = predicted
     out["history"] = json.loads(new_history)
+    return out
+
+
+def structure(path: PathLike) -> Dict[str, Any]:
+    """The closed loop of a drive structure file (``examples/emps.toml``), as
+    ``feedid model --params s.toml --json``: numerator and denominator,
+    poles, stability, bandwidth [Hz], following error per velocity [s]."""
+    return json.loads(_feedid.structure_model(os.fspath(path)))
+
+
+def simulate_structure(
+    path: PathLike, command: Any, rate: float, initial_position: Optional[float] = None
+) -> Dict[str, np.ndarray]:
+    """Run ``command`` [m] sampled at ``rate`` [Hz] through a drive structure's
+    nonlinear simulation (friction, output limit, its controller), from rest
+    at ``initial_position`` (default the command's first value). Returns
+    ``position`` [m], ``velocity`` [m/s] and ``output`` (the controller's)."""
+    position, velocity, output = _feedid.structure_simulate(
+        os.fspath(path), _array(command, "command"), rate, initial_position=initial_position
+    )
+    return {"position": position, "velocity": velocity, "output": output}
+
+
+def fit_structure(
+    path: PathLike, command: Any, position: Any, rate: float, estimate: Sequence[str]
+) -> Dict[str, Any]:
+    """Estimate a drive structure's parameters (``M``, ``Fv``, ``Fc``,
+    ``offset``, ``gain``, ``kp``, ``kv``) from command and measured position
+    by output error, as ``feedid greybox --params s.toml --estimate …``. The
+    result has the estimates with standard errors, the rms error before and
+    after, the fit [%], and ``toml``: the structure with the estimates."""
+    if isinstance(estimate, str):
+        estimate = [e for e in estimate.split(",") if e.strip()]
+    fit, toml = _feedid.structure_fit(
+        os.fspath(path),
+        _array(command, "command"),
+        _array(position, "position"),
+        rate,
+        [str(e) for e in estimate],
+    )
+    out: Dict[str, Any] = json.loads(fit)
+    out["toml"] = toml
+    return out
+
+
+def tune(path: PathLike, bandwidth: float, damping: float = 0.7071067811865476) -> Dict[str, Any]:
+    """Gains of a P position loop around a P velocity loop for a closed-loop
+    bandwidth [Hz] and damping ratio, as ``feedid tune``: the gains before
+    and after, both closed loops, the step overshoot [%], and ``toml``: the
+    retuned structure."""
+    out_json, toml = _feedid.structure_tune(os.fspath(path), bandwidth, damping)
+    out: Dict[str, Any] = json.loads(out_json)
+    out["toml"] = toml
     return out

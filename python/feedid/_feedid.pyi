@@ -204,3 +204,19 @@ def learn(
     keep_dc_gain: bool = False,
     start: str = "rest",
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], str, str]: ...
+def structure_model(path: str) -> str: ...
+def structure_simulate(
+    path: str,
+    command: npt.NDArray[np.float64],
+    rate: float,
+    *,
+    initial_position: Optional[float] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def structure_fit(
+    path: str,
+    command: npt.NDArray[np.float64],
+    position: npt.NDArray[np.float64],
+    rate: float,
+    estimate: List[str],
+) -> Tuple[str, str]: ...
+def structure_tune(path: str, bandwidth: float, damping: float) -> Tuple[str, str]: ...

@@ -15,6 +15,7 @@ mod params;
 mod recording;
 mod rig;
 mod stream;
+mod structure;
 
 use pyo3::prelude::*;
 
@@ -30,6 +31,10 @@ fn _feedid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rig::model, m)?)?;
     m.add_function(wrap_pyfunction!(rig::compensate, m)?)?;
     m.add_function(wrap_pyfunction!(learn::learn, m)?)?;
+    m.add_function(wrap_pyfunction!(structure::structure_model, m)?)?;
+    m.add_function(wrap_pyfunction!(structure::structure_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(structure::structure_fit, m)?)?;
+    m.add_function(wrap_pyfunction!(structure::structure_tune, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -500,3 +500,20 @@ fn tuning_a_p_p_loop_hits_the_bandwidth_and_damping_asked() {
     eprintln!("{before:?}\n{after:?}");
     assert!(after.rms_error < before.rms_error, "{before:?} {after:?}");
 }
+
+#[test]
+fn a_structure_whose_simulation_would_not_end_is_refused() {
+    // a Coulomb level of 1e9 N on a 1 kg mass with a 1 nm/s knee: a stiffness
+    // no explicit integration resolves in bounded time
+    let text = "[position]\nkp = 10.0\n[velocity]\nkp = 10.0\n[drive]\ngain = 1.0\n\
+                [mechanics]\nmass = 1.0\n[friction]\ncoulomb = 1e9\nsmoothing_velocity = 1e-9\n";
+    let s = DriveStructure::from_toml_str(text, None).unwrap();
+    let e = s.simulate(&vec![0.0; 100_000], 1000.0, 0.0).unwrap_err();
+    assert!(e.to_string().contains("1e8"), "{e}");
+    // NaN and infinities in the file are refused with the key
+    for bad in ["mass = nan", "mass = inf"] {
+        let text = format!("[position]\nkp = 1.0\n[drive]\ngain = 1.0\n[mechanics]\n{bad}\n");
+        let e = DriveStructure::from_toml_str(&text, None).unwrap_err();
+        assert!(e.to_string().contains("mechanics.mass"), "{e}");
+    }
+}

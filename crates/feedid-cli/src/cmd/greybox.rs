@@ -444,6 +444,13 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
         .map(|t| t.parse::<feedid::drive::StructureParam>())
         .collect::<feedid::Result<Vec<_>>>()?;
     let rec = recording::load(input, &a.recording)?;
+    if !rec.gaps().is_empty() {
+        bail!(
+            "{}: {} dropped-sample gap(s); a drive structure is fitted on a uniformly sampled recording (cut it at the gap)",
+            input.display(),
+            rec.gaps().len()
+        );
+    }
     let fit = structure
         .fit(rec.command(), rec.position(), rec.rate_hz(), &estimate)
         .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;

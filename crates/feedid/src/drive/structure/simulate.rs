@@ -29,6 +29,9 @@ pub struct StructureRun {
     pub output: Vec<f64>,
 }
 
+/// Most RK4 steps of one simulation (substeps × samples).
+const MAX_STEPS: f64 = 1e8;
+
 /// State: position, velocity, position-loop integral, velocity-loop integral.
 type State = [f64; 4];
 
@@ -96,6 +99,13 @@ impl DriveStructure {
         let substeps = self.substeps(dt);
         let h = dt / substeps as f64;
         let n = command.len();
+        if (substeps as f64) * (n as f64) > MAX_STEPS {
+            return Err(Error::InvalidParameter {
+                name: "integration steps",
+                value: substeps as f64 * n as f64,
+                reason: "the structure's fastest pole or friction knee needs more than 1e8 steps on this command (a friction level far above the mass's scale, or a smoothing velocity far too small)",
+            });
+        }
         let mut run = StructureRun {
             time: (0..n).map(|k| k as f64 * dt).collect(),
             command: command.to_vec(),

@@ -147,24 +147,10 @@ fn bad_structures_are_refused_with_the_key_named() {
 
 #[test]
 fn the_emps_reference_model_reproduces_the_measured_run() {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
-    if !path.exists() {
-        eprintln!(
-            "skipped: {} is absent (the EMPS data set, see its README)",
-            path.display()
-        );
+    let Some((qg, qm, rate)) = emps_recording() else {
         return;
-    }
-    let opts = feedid::io::ReadOptions {
-        time: Some(feedid::io::ChannelRef::parse("t").unwrap()),
-        command: Some(feedid::io::ChannelRef::parse("qg").unwrap()),
-        position: Some(feedid::io::ChannelRef::parse("qm").unwrap()),
-        ..Default::default()
     };
-    let rec = feedid::io::read_recording(&path, &opts).unwrap();
-    let (qg, qm) = (rec.command(), rec.position());
-    let run = emps().simulate(qg, rec.rate_hz(), qm[0]).unwrap();
+    let run = emps().simulate(&qg, rate, qm[0]).unwrap();
     let rms = |f: &dyn Fn(usize) -> f64| {
         ((0..qm.len()).map(|k| f(k).powi(2)).sum::<f64>() / qm.len() as f64).sqrt()
     };
@@ -243,7 +229,9 @@ fn full_feed_forward_on_a_frictionless_mass_tracks_exactly() {
     assert_eq!(summary.following_error_per_velocity, Some(0.0));
 }
 
-fn emps_recording() -> Option<(Vec<f64>, Vec<f64>, f64)> {
+/// DATA_EMPS.mat with `qg` as the command and the variable `position`
+/// (`qm`, or `vir` read the same way), or `None` when the file is absent.
+fn emps_read(position: &str) -> Option<feedid::Recording> {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
     if !path.exists() {
@@ -256,10 +244,15 @@ fn emps_recording() -> Option<(Vec<f64>, Vec<f64>, f64)> {
     let opts = feedid::io::ReadOptions {
         time: Some(feedid::io::ChannelRef::parse("t").unwrap()),
         command: Some(feedid::io::ChannelRef::parse("qg").unwrap()),
-        position: Some(feedid::io::ChannelRef::parse("qm").unwrap()),
+        position: Some(feedid::io::ChannelRef::parse(position).unwrap()),
         ..Default::default()
     };
-    let rec = feedid::io::read_recording(&path, &opts).unwrap();
+    Some(feedid::io::read_recording(&path, &opts).unwrap())
+}
+
+/// EMPS command, measured position and rate.
+fn emps_recording() -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    let rec = emps_read("qm")?;
     Some((
         rec.command().to_vec(),
         rec.position().to_vec(),
@@ -357,25 +350,9 @@ fn inverse_dynamics_recovers_a_simulated_axis_and_the_emps_reference() {
     assert!(rel(fit.coulomb.0, 20.3935) < 0.02, "{fit:?}");
     assert!((fit.offset.0 + 3.1648).abs() < 0.2, "{fit:?}");
     // EMPS: force = gtau · vir, beside the measured position
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/emps/DATA_EMPS.mat");
-    if !path.exists() {
-        eprintln!(
-            "skipped: {} is absent (the EMPS data set, see its README)",
-            path.display()
-        );
+    let (Some(qm), Some(vir)) = (emps_read("qm"), emps_read("vir")) else {
         return;
-    }
-    let read = |name: &str| {
-        let opts = feedid::io::ReadOptions {
-            time: Some(feedid::io::ChannelRef::parse("t").unwrap()),
-            command: Some(feedid::io::ChannelRef::parse("qg").unwrap()),
-            position: Some(feedid::io::ChannelRef::parse(name).unwrap()),
-            ..Default::default()
-        };
-        feedid::io::read_recording(&path, &opts).unwrap()
     };
-    let (qm, vir) = (read("qm"), read("vir"));
     let force: Vec<f64> = vir.position().iter().map(|u| 35.1507 * u).collect();
     let fit =
         inverse_dynamics(qm.position(), &force, qm.rate_hz(), &IdimConfig::default()).unwrap();

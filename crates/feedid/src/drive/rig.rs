@@ -495,20 +495,7 @@ impl VirtualRig {
             });
         }
         positive("max_step", self.max_step)?;
-        if command.is_empty() {
-            return Err(Error::TooFewSamples {
-                what: "a rig command",
-                needed: 1,
-                actual: 0,
-            });
-        }
-        if let Some((index, &value)) = command.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                channel: "command".to_string(),
-                index,
-                value,
-            });
-        }
+        crate::signal::check_command(command, "a rig command", 1)?;
         let n = command.len();
         out.resize(n);
         let dt = 1.0 / rate_hz;

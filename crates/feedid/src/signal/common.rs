@@ -45,6 +45,27 @@ pub(crate) fn check_non_negative(name: &'static str, value: f64) -> Result<()> {
     Ok(())
 }
 
+/// Check a command given to a simulation: at least `needed` samples
+/// (`what` names it in the error), every one finite (the first that is not
+/// is named by its index).
+pub(crate) fn check_command(command: &[f64], what: &'static str, needed: usize) -> Result<()> {
+    if command.len() < needed {
+        return Err(Error::TooFewSamples {
+            what,
+            needed,
+            actual: command.len(),
+        });
+    }
+    if let Some((index, &value)) = command.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            channel: "command".to_string(),
+            index,
+            value,
+        });
+    }
+    Ok(())
+}
+
 /// Check that `value` is finite (any sign).
 pub(crate) fn check_finite(name: &'static str, value: f64) -> Result<()> {
     if !value.is_finite() {

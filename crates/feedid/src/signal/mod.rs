@@ -34,6 +34,7 @@ mod square;
 mod step;
 
 pub use chirp::{chirp, Chirp, Sweep};
+pub(crate) use common::{check_command, check_rate};
 pub use common::{sample_count, DEFAULT_RATE_HZ, DEFAULT_REST, MAX_SAMPLES};
 pub use contour::{contour, Contour, ContourAxis};
 pub use multisine::{multisine, Multisine};

@@ -46,20 +46,7 @@ impl MemberSpec {
     /// assert_eq!(run.truth.len(), 400);
     /// ```
     pub fn run_plant(&self, command: &[f64], noise_seed: u64) -> Result<PlantRun> {
-        if command.len() < 2 {
-            return Err(Error::TooFewSamples {
-                what: "a command for a zoo plant",
-                needed: 2,
-                actual: command.len(),
-            });
-        }
-        if let Some((index, &value)) = command.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                channel: "command".to_string(),
-                index,
-                value,
-            });
-        }
+        crate::signal::check_command(command, "a command for a zoo plant", 2)?;
         let m = self.decimation();
         let fine: Vec<f64> = (0..(command.len() - 1) * m + 1)
             .map(|j| {

@@ -58,27 +58,8 @@ impl DriveStructure {
         initial_position: f64,
     ) -> Result<StructureRun> {
         self.validate()?;
-        if !(rate_hz.is_finite() && rate_hz > 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "rate",
-                value: rate_hz,
-                reason: "must be finite and > 0",
-            });
-        }
-        if command.len() < 2 {
-            return Err(Error::TooFewSamples {
-                what: "a command for a drive structure",
-                needed: 2,
-                actual: command.len(),
-            });
-        }
-        if let Some((index, &value)) = command.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                channel: "command".to_string(),
-                index,
-                value,
-            });
-        }
+        crate::signal::check_rate(rate_hz)?;
+        crate::signal::check_command(command, "a command for a drive structure", 2)?;
         if !initial_position.is_finite() {
             return Err(Error::InvalidParameter {
                 name: "initial position",

@@ -29,7 +29,7 @@ What it does, in one run (so the ratio holds on a noisy machine):
 5. Checks the QR predictions agree within 1e-6 of the position range and
    prints per-window times and ratios; feedid's simplex both from the
    paper's zeros (default) and with `--simplex-start previous`.
-6. ARX 8,8,1 (issue 19), W = 200, H = 10, hop 10, on the chirp: a NumPy
+6. ARX 8,8,1, W = 200, H = 10, hop 10, on the chirp: a NumPy
    refit per window (`numpy.linalg.lstsq` on [-y lags, u lags, 1], then
    the 10-step prediction driven by the measured command) against
    `feedid identify --method arx --window 200 --horizon 10` (its own ridge,

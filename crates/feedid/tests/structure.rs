@@ -494,3 +494,113 @@ fn a_structure_whose_simulation_would_not_end_is_refused() {
         assert!(e.to_string().contains("mechanics.mass"), "{e}");
     }
 }
+
+/// The EMPS loops on a two-mass axis: 80 kg load, 15 kg motor side, a
+/// transmission of `k` N/m damped by 2000 N·s/m, measured on `side`.
+fn two_mass(k: f64, side: &str) -> DriveStructure {
+    let text = format!(
+        "[position]\nkp = 160.18\n[velocity]\nkp = 243.45\n[drive]\ngain = 35.1507\n\
+         [mechanics]\nmass = 80.0\nmotor_mass = 15.0\nstiffness = {k}\ndamping = 2000.0\nmeasured = \"{side}\"\n\
+         [friction]\nviscous = 203.5034\n"
+    );
+    DriveStructure::from_toml_str(&text, None).unwrap()
+}
+
+#[test]
+fn a_stiff_two_mass_axis_is_the_rigid_one_and_its_mode_is_the_closed_form() {
+    // the free mechanics (c = Fv = 0): Δ = s²·(M_m·M_l·s² + k·(M_m + M_l))
+    let mut free = two_mass(2e7, "load");
+    free.mechanics.damping = 0.0;
+    free.friction.viscous = 0.0;
+    let (_, delta) = free.plant();
+    let roots = feedid::lti::poly_roots(&delta).unwrap();
+    let w = (2e7f64 * (15.0 + 80.0) / (15.0 * 80.0)).sqrt();
+    let mode = roots.iter().map(|r| r.im.abs()).fold(0.0, f64::max);
+    assert!((mode - w).abs() < 1e-9 * w, "{mode} {w}");
+    // a very stiff transmission: the rigid closed loop of the total mass
+    let rigid = DriveStructure {
+        mechanics: feedid::drive::Mechanics {
+            stiffness: None,
+            ..two_mass(1.0, "load").mechanics
+        },
+        ..two_mass(1.0, "load")
+    };
+    assert_eq!(rigid.mechanics.total_mass(), 95.0);
+    let b_rigid = rigid.closed_loop().unwrap().bandwidth_hz.unwrap();
+    for side in ["load", "motor"] {
+        let b = two_mass(1e12, side)
+            .closed_loop()
+            .unwrap()
+            .bandwidth_hz
+            .unwrap();
+        assert!(
+            (b - b_rigid).abs() < 1e-4 * b_rigid,
+            "{side}: {b} {b_rigid}"
+        );
+    }
+}
+
+#[test]
+fn the_two_mass_simulation_follows_its_transfer_function_on_either_side() {
+    for side in ["load", "motor"] {
+        let s = two_mass(3e6, side);
+        assert!(s.closed_loop().unwrap().stable, "{side}");
+        let rate = 2000.0;
+        let n = 2000;
+        let cmd: Vec<f64> = (0..n).map(|k| 0.03 * (k as f64 / rate)).collect();
+        let run = s.simulate(&cmd, rate, 0.0).unwrap();
+        let exact = s
+            .transfer_function()
+            .unwrap()
+            .ramp_response(0.03, 1.0 / rate, n)
+            .unwrap();
+        let worst = run
+            .position
+            .iter()
+            .zip(&exact)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{side}: {worst}");
+    }
+    // the two sides differ by the transmission's deflection
+    let load = two_mass(3e6, "load")
+        .simulate(&vec![1e-3; 500], 2000.0, 0.0)
+        .unwrap();
+    let motor = two_mass(3e6, "motor")
+        .simulate(&vec![1e-3; 500], 2000.0, 0.0)
+        .unwrap();
+    assert!(load
+        .position
+        .iter()
+        .zip(&motor.position)
+        .any(|(a, b)| (a - b).abs() > 1e-7));
+}
+
+#[test]
+fn velocity_feedback_from_the_load_destabilises_a_lightly_damped_transmission() {
+    // non-collocated: measured on the load, the lightly damped mode goes
+    // unstable under the EMPS velocity gain; measured on the motor it does not
+    for k in [1e6, 1e8, 1e10] {
+        let mut load = two_mass(k, "load");
+        load.mechanics.damping = 50.0;
+        let mut motor = two_mass(k, "motor");
+        motor.mechanics.damping = 50.0;
+        assert!(!load.closed_loop().unwrap().stable, "{k}");
+        assert!(motor.closed_loop().unwrap().stable, "{k}");
+    }
+}
+
+#[test]
+fn two_mass_mechanics_need_the_motor_mass_and_are_not_tuned() {
+    let text =
+        "[position]\nkp = 1.0\n[drive]\ngain = 1.0\n[mechanics]\nmass = 1.0\nstiffness = 1e6\n";
+    let e = DriveStructure::from_toml_str(text, None).unwrap_err();
+    assert!(e.to_string().contains("mechanics.motor_mass"), "{e}");
+    let e = two_mass(3e6, "load")
+        .tune(&feedid::drive::TuneTarget {
+            bandwidth_hz: 20.0,
+            damping: 0.7,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("rigid"), "{e}");
+}

@@ -26,7 +26,7 @@ pub use rig::{
 pub use stability::{check_model, require_stable, ModelCheck};
 pub use structure::{
     inverse_dynamics, Controller, Drive, DriveStructure, FeedForward, FrictionLaw, IdimConfig,
-    IdimFit, LoopGains, LoopKind, Mechanics, RunFigures, StructureEstimate, StructureFit,
+    IdimFit, LoopGains, LoopKind, Measured, Mechanics, RunFigures, StructureEstimate, StructureFit,
     StructureParam, StructureRun, StructureSummary, StructureValidation, TuneTarget, Tuned,
     VelocityEstimate,
 };

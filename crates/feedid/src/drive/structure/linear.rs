@@ -1,18 +1,19 @@
 //! The linear closed loop of a drive structure: the friction law reduced to
 //! its viscous term, no saturation, the controller continuous.
 //!
-//! With `P(s) = g / (s·(M·s + Fv))` (force per unit of output to position)
-//! and each controller `C = N/D` as polynomials, the command-to-position
-//! transfer function is, with a velocity loop,
+//! With the mechanics `P(s) = P_n/P_d` from force to the measured position
+//! ([`DriveStructure::plant`]; rigid `1/(s·(M·s + Fv))`) and each controller
+//! `C = N/D` as polynomials, the command-to-position transfer function is,
+//! with a velocity loop,
 //!
 //! ```text
-//! X/X_s = g·N_v·(N_p + kvff·s·D_p) + kaff·M·s²·D_p·D_v
+//! X/X_s = P_n·(g·N_v·(N_p + kvff·s·D_p) + kaff·M·s²·D_p·D_v)
 //!         ─────────────────────────────────────────────────────────
-//!         s·(M·s + Fv)·D_p·D_v + g·N_v·(N_p + s·D_p)
+//!         P_d·D_p·D_v + g·P_n·N_v·(N_p + s·D_p)
 //! ```
 //!
 //! and without one (`N_v = D_v = 1`, no velocity feedback)
-//! `(g·N_p + kaff·M·s²·D_p) / (s·(M·s + Fv)·D_p + g·N_p)`. The following
+//! `P_n·(g·N_p + kaff·M·s²·D_p) / (P_d·D_p + g·P_n·N_p)`. The following
 //! error of a ramp of velocity `v` is `v·lim_{s→0} (D − N)/(s·D)`: with a
 //! velocity loop of kind P on a P position loop, `v·(1 − kvff)/kp + v·Fv/(g·kv·kp)`.
 
@@ -100,28 +101,56 @@ impl DriveStructure {
     pub fn transfer_function(&self) -> Result<TransferFunction> {
         let (np, dp) = controller(&self.position);
         let (nv, dv) = controller(&self.velocity);
-        let (g, m, fv) = (self.drive.gain, self.mechanics.mass, self.friction.viscous);
+        let g = self.drive.gain;
+        let m = self.mechanics.total_mass();
         let (kvff, kaff) = (self.feed_forward.velocity, self.feed_forward.acceleration);
-        let plant_den = vec![m, fv, 0.0]; // s·(M·s + Fv)
+        // force to measured position: P = pn/pd
+        let (pn, pd) = self.plant();
         let s = [1.0, 0.0];
+        // the acceleration feed-forward's force kaff·M·s²·Xs through the plant
+        let accel = scale(&mul(&[m, 0.0, 0.0], &pn), kaff);
         let (num, den) = if self.velocity.kind == LoopKind::None {
-            let num = add(&scale(&np, g), &scale(&mul(&[m, 0.0, 0.0], &dp), kaff));
-            let den = add(&mul(&plant_den, &dp), &scale(&np, g));
+            let num = add(&scale(&mul(&pn, &np), g), &mul(&accel, &dp));
+            let den = add(&mul(&pd, &dp), &scale(&mul(&pn, &np), g));
             (num, den)
         } else {
             let inner = add(&np, &scale(&mul(&s, &dp), kvff));
             let num = add(
-                &scale(&mul(&nv, &inner), g),
-                &scale(&mul(&[m, 0.0, 0.0], &mul(&dp, &dv)), kaff),
+                &scale(&mul(&pn, &mul(&nv, &inner)), g),
+                &mul(&accel, &mul(&dp, &dv)),
             );
             let feedback = add(&np, &mul(&s, &dp));
             let den = add(
-                &mul(&plant_den, &mul(&dp, &dv)),
-                &scale(&mul(&nv, &feedback), g),
+                &mul(&pd, &mul(&dp, &dv)),
+                &scale(&mul(&pn, &mul(&nv, &feedback)), g),
             );
             (num, den)
         };
         TransferFunction::new(trim(num), trim(den))
+    }
+
+    /// The mechanics from force to the measured position, `(numerator,
+    /// denominator)`, viscous friction only: rigid `1/(s·(M·s + Fv))`;
+    /// two-mass, with `K = c·s + k`, `A_m = M_m·s² + K`,
+    /// `A_l = M_l·s² + Fv·s + K` and `Δ = A_m·A_l − K²`, `K/Δ` on the load
+    /// and `A_l/Δ` on the motor.
+    pub fn plant(&self) -> (Vec<f64>, Vec<f64>) {
+        let mech = &self.mechanics;
+        let fv = self.friction.viscous;
+        match (mech.stiffness, mech.motor_mass) {
+            (Some(k), Some(mm)) => {
+                let kk = [mech.damping, k];
+                let am = [mm, mech.damping, k];
+                let al = [mech.mass, fv + mech.damping, k];
+                let delta = add(&mul(&am, &al), &scale(&mul(&kk, &kk), -1.0));
+                let num = match mech.measured {
+                    super::Measured::Load => kk.to_vec(),
+                    super::Measured::Motor => al.to_vec(),
+                };
+                (trim(num), trim(delta))
+            }
+            _ => (vec![1.0], vec![mech.total_mass(), fv, 0.0]),
+        }
     }
 
     /// The linear closed loop in numbers: poles, stability, bandwidth,

@@ -18,7 +18,13 @@
 //! `g` is the drive gain (force per unit of controller output: the EMPS
 //! amplifier's `gtau`, N/V), `F_0` a constant force (gravity, a cable, the
 //! EMPS offset). The mechanics are rigid (one moving mass `M` that includes
-//! the motor's inertia seen at the load). The controller is continuous, or
+//! the motor's inertia seen at the load), or two masses — the motor's `M_m`
+//! (its inertia and the screw's seen at the load), on which the force acts,
+//! and the load's `M_l`, on which the friction acts — joined by the
+//! transmission's stiffness `k` and damping `c`
+//! (`M_m·ẍ_m = F − k(x_m − x_l) − c(ẋ_m − ẋ_l)`,
+//! `M_l·ẍ_l = k(x_m − x_l) + c(ẋ_m − ẋ_l) − Fv·ẋ_l − F_c(ẋ_l) − F_0`),
+//! the position measured on the load or on the motor. The controller is continuous, or
 //! sampled at the recording's interval (`[controller] sample_time`) with the
 //! velocity estimated from the measured position (`velocity_estimate`:
 //! `central`, `(x[k] − x[k−2])/(2·Ts)` as the EMPS controller does, or
@@ -42,7 +48,8 @@
 //! gain = 35.1507               # N per unit of output
 //! limit = 10.0                 # ± output (optional)
 //! [mechanics]
-//! mass = 95.1089               # kg
+//! mass = 95.1089               # kg (two-mass: the load's, with motor_mass,
+//!                              #   stiffness [N/m], damping, measured = "load"/"motor")
 //! [friction]
 //! viscous = 203.5034           # N·s/m
 //! coulomb = 20.3935            # N (coulomb_negative for an asymmetric law)
@@ -155,12 +162,51 @@ pub struct Drive {
     pub limit: Option<f64>,
 }
 
-/// Rigid mechanics.
+/// Which side of a two-mass transmission the position is measured on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Measured {
+    /// The load (a linear encoder on the table); default.
+    #[default]
+    Load,
+    /// The motor (a rotary encoder mapped to the load side).
+    Motor,
+}
+
+/// The mechanics: rigid, or two masses joined by a spring (the screw's
+/// axial stiffness) when `stiffness` is given.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Mechanics {
-    /// Moving mass, the motor's inertia seen at the load included \[kg\].
+    /// Moving mass \[kg\]: rigid, everything that moves (the motor's
+    /// inertia seen at the load included, unless `motor_mass` is given);
+    /// two-mass, the load.
     pub mass: f64,
+    /// The motor's and screw's inertia seen at the load \[kg\] (two-mass:
+    /// required; rigid: added to `mass`).
+    #[serde(default)]
+    pub motor_mass: Option<f64>,
+    /// Stiffness of the transmission \[N/m\]; present: two-mass mechanics.
+    #[serde(default)]
+    pub stiffness: Option<f64>,
+    /// Damping of the transmission \[N·s/m\]; default 0.
+    #[serde(default)]
+    pub damping: f64,
+    /// Side the position is measured on (two-mass); default load.
+    #[serde(default)]
+    pub measured: Measured,
+}
+
+impl Mechanics {
+    /// Everything that moves \[kg\] (`mass` plus `motor_mass`).
+    pub fn total_mass(&self) -> f64 {
+        self.mass + self.motor_mass.unwrap_or(0.0)
+    }
+
+    /// True for two-mass mechanics (a stiffness given).
+    pub fn two_mass(&self) -> bool {
+        self.stiffness.is_some()
+    }
 }
 
 /// The friction law (module doc); every term defaults to 0.
@@ -356,6 +402,27 @@ impl DriveStructure {
                 "feed_forward.velocity",
                 self.feed_forward.velocity,
                 "velocity feed-forward needs a velocity loop",
+            );
+        }
+        let mech = &self.mechanics;
+        for (name, x) in [
+            ("mechanics.motor_mass", mech.motor_mass),
+            ("mechanics.stiffness", mech.stiffness),
+        ] {
+            if let Some(x) = x {
+                if !(x.is_finite() && x > 0.0) {
+                    return bad(name, x, "must be finite and > 0");
+                }
+            }
+        }
+        if !(mech.damping.is_finite() && mech.damping >= 0.0) {
+            return bad("mechanics.damping", mech.damping, "must be finite and >= 0");
+        }
+        if mech.two_mass() && mech.motor_mass.is_none() {
+            return bad(
+                "mechanics.motor_mass",
+                f64::NAN,
+                "two-mass mechanics (a stiffness given) need the motor's mass at the load",
             );
         }
         if !self.friction.offset.is_finite() {

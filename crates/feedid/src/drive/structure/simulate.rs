@@ -11,7 +11,7 @@
 //! controller acts inside the integration on the command interpolated
 //! linearly between samples.
 
-use super::{DriveStructure, LoopKind, VelocityEstimate};
+use super::{DriveStructure, LoopKind, Measured, VelocityEstimate};
 use crate::error::{Error, Result};
 
 /// A command run on a drive structure, one value per sample.
@@ -32,8 +32,9 @@ pub struct StructureRun {
 /// Most RK4 steps of one simulation (substeps × samples).
 const MAX_STEPS: f64 = 1e8;
 
-/// State: position, velocity, position-loop integral, velocity-loop integral.
-type State = [f64; 4];
+/// State: load position and velocity, position-loop integral, velocity-loop
+/// integral, motor position and velocity (rigid: the load's).
+type State = [f64; 6];
 
 impl DriveStructure {
     /// Simulate the structure on `command` sampled at `rate_hz`, from rest at
@@ -94,11 +95,12 @@ impl DriveStructure {
             velocity: vec![0.0; n],
             output: vec![0.0; n],
         };
-        let mut x: State = [initial_position, 0.0, 0.0, 0.0];
+        let mut x: State = [initial_position, 0.0, 0.0, 0.0, initial_position, 0.0];
         let (mut e_prev, mut history) = (command[0] - initial_position, [initial_position; 2]);
         for k in 0..n {
-            run.position[k] = x[0];
-            run.velocity[k] = x[1];
+            let (xm, vm) = self.measured(&x);
+            run.position[k] = xm;
+            run.velocity[k] = vm;
             let next = command[(k + 1).min(n - 1)];
             let prev = command[k.saturating_sub(1)];
             let slope = (next - command[k]) / dt;
@@ -106,10 +108,10 @@ impl DriveStructure {
             if self.controller.sample_time.is_some() {
                 // the sampled controller: measure, estimate, hold
                 let v_hat = match self.controller.velocity_estimate {
-                    VelocityEstimate::Central => (x[0] - history[1]) / (2.0 * dt),
-                    VelocityEstimate::Backward => (x[0] - history[0]) / dt,
+                    VelocityEstimate::Central => (xm - history[1]) / (2.0 * dt),
+                    VelocityEstimate::Backward => (xm - history[0]) / dt,
                 };
-                let e = command[k] - x[0];
+                let e = command[k] - xm;
                 let (kp, ki, kd) = self.position.terms();
                 let vref = kp * (e + ki * x[2] + kd * (e - e_prev) / dt);
                 e_prev = e;
@@ -125,7 +127,7 @@ impl DriveStructure {
                 };
                 let u = self.saturate(raw + self.acceleration_output(accel));
                 run.output[k] = u;
-                history = [x[0], history[0]];
+                history = [xm, history[0]];
                 if k + 1 < n {
                     let force = self.drive.gain * u;
                     for j in 0..substeps {
@@ -156,14 +158,20 @@ impl DriveStructure {
     /// Substeps per sample: the fastest closed-loop pole and friction knee
     /// resolved (`h·λ ≤ 0.3`), at least one.
     fn substeps(&self, dt: f64) -> usize {
-        let m = self.mechanics.mass;
+        let mech = &self.mechanics;
         let f = &self.friction;
         let level = f
             .r#static
             .unwrap_or(0.0)
             .max(f.coulomb)
             .max(f.coulomb_negative.unwrap_or(0.0));
-        let knee = (level / f.smoothing_velocity.unwrap_or(1e-4) + f.viscous) / m;
+        // the friction acts on the load (rigid: on everything)
+        let m = if mech.two_mass() {
+            mech.mass
+        } else {
+            mech.total_mass()
+        };
+        let knee = (level / f.smoothing_velocity.unwrap_or(1e-4) + f.viscous + mech.damping) / m;
         let poles = self
             .closed_loop()
             .map(|s| {
@@ -183,29 +191,56 @@ impl DriveStructure {
         }
     }
 
-    /// `kaff·M/g·ẍ_s`: the output that accelerates the mass with the command.
+    /// `kaff·M/g·ẍ_s`: the output that accelerates every moving mass with the command.
     fn acceleration_output(&self, accel: f64) -> f64 {
-        self.feed_forward.acceleration * self.mechanics.mass / self.drive.gain * accel
+        self.feed_forward.acceleration * self.mechanics.total_mass() / self.drive.gain * accel
     }
 
-    /// The mass under a held force.
+    /// The measured position and velocity in state `s`.
+    fn measured(&self, s: &State) -> (f64, f64) {
+        if self.mechanics.two_mass() && self.mechanics.measured == Measured::Motor {
+            (s[4], s[5])
+        } else {
+            (s[0], s[1])
+        }
+    }
+
+    /// Accelerations of the load and the motor under the drive's `force`.
+    fn accelerations(&self, s: &State, force: f64) -> (f64, f64) {
+        let mech = &self.mechanics;
+        match (mech.stiffness, mech.motor_mass) {
+            (Some(k), Some(mm)) => {
+                let spring = k * (s[4] - s[0]) + mech.damping * (s[5] - s[1]);
+                let load = (spring - self.friction.force(s[1])) / mech.mass;
+                (load, (force - spring) / mm)
+            }
+            _ => {
+                let a = (force - self.friction.force(s[1])) / mech.total_mass();
+                (a, a)
+            }
+        }
+    }
+
+    /// The mechanics under a held force (the sampled controller's integrals
+    /// change only at the samples).
     fn held(&self, s: &State, force: f64) -> State {
-        let a = (force - self.friction.force(s[1])) / self.mechanics.mass;
-        [s[1], a, 0.0, 0.0]
+        let (al, am) = self.accelerations(s, force);
+        [s[1], al, 0.0, 0.0, s[5], am]
     }
 
     /// The continuous controller in state `s` at command `xs` moving at
     /// `slope`, plus the feed-forward output `ff`: its output (saturated)
     /// and the velocity loop's error.
     fn continuous_law(&self, s: &State, xs: f64, slope: f64, ff: f64) -> (f64, f64) {
-        let e = xs - s[0];
+        let (x, v) = self.measured(s);
+        let e = xs - x;
         let (kp, ki, kd) = self.position.terms();
-        let cp = kp * (e + ki * s[2] + kd * (slope - s[1]));
+        let cp = kp * (e + ki * s[2] + kd * (slope - v));
         if self.velocity.kind == LoopKind::None {
             return (self.saturate(cp + ff), 0.0);
         }
         let (kv, kvi, _) = self.velocity.terms();
-        let ev = cp + self.feed_forward.velocity * slope - s[1];
+        let ev = cp + self.feed_forward.velocity * slope - v;
         (self.saturate(kv * (ev + kvi * s[3]) + ff), ev)
     }
 
@@ -217,8 +252,8 @@ impl DriveStructure {
     /// The right-hand side with the continuous controller.
     fn continuous(&self, s: &State, xs: f64, slope: f64, ff: f64) -> State {
         let (u, ev) = self.continuous_law(s, xs, slope, ff);
-        let a = (self.drive.gain * u - self.friction.force(s[1])) / self.mechanics.mass;
-        [s[1], a, xs - s[0], ev]
+        let (al, am) = self.accelerations(s, self.drive.gain * u);
+        [s[1], al, xs - self.measured(s).0, ev, s[5], am]
     }
 }
 
@@ -230,7 +265,7 @@ fn rk4(x: &mut State, t: f64, h: f64, f: impl Fn(f64, &State) -> State) {
     let k2 = f(t + 0.5 * h, &at(x, 0.5 * h, &k1));
     let k3 = f(t + 0.5 * h, &at(x, 0.5 * h, &k2));
     let k4 = f(t + h, &at(x, h, &k3));
-    for j in 0..4 {
+    for j in 0..6 {
         x[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
     }
 }

@@ -78,6 +78,13 @@ impl DriveStructure {
     /// assert!(t.overshoot_percent.1 < 5.0);
     /// ```
     pub fn tune(&self, target: &TuneTarget) -> Result<Tuned> {
+        if self.mechanics.two_mass() {
+            return Err(Error::InvalidParameter {
+                name: "tune",
+                value: f64::NAN,
+                reason: "gains are retuned for rigid mechanics only (a two-mass axis's mode needs more than two gains)",
+            });
+        }
         if self.position.kind != LoopKind::P || self.velocity.kind != LoopKind::P {
             return Err(Error::InvalidParameter {
                 name: "tune",
@@ -103,7 +110,11 @@ impl DriveStructure {
         }
         let ratio = (1.0 - 2.0 * z * z + (4.0 * z.powi(4) - 4.0 * z * z + 2.0).sqrt()).sqrt();
         let wn = 2.0 * std::f64::consts::PI * fb / ratio;
-        let (g, m, fv) = (self.drive.gain, self.mechanics.mass, self.friction.viscous);
+        let (g, m, fv) = (
+            self.drive.gain,
+            self.mechanics.total_mass(),
+            self.friction.viscous,
+        );
         let kv = (2.0 * z * wn * m - fv) / g;
         if kv.is_nan() || kv <= 0.0 {
             return Err(Error::InvalidParameter {

@@ -10,7 +10,7 @@
 //! |---|---|---|
 //! | force pulses | any rig member | a train of table forces of alternating sign ([`ForcePulses`]), 10 … 50 % of the drive's peak force, 1 … 50 ms long (≥ 2 loop samples: impacts at the short end, cuts at the long end), 3 … 8 of them over the recording, the first after 5 … 30 % of it |
 //! | friction | a rig member whose command reverses (sweep, square wave, point-to-point, contour) | Coulomb friction 10 … 25 % of the peak force (the regular members: 0 … 10 %), breakaway 1.1 … 1.6× that; the axis re-planned with it (the motor sized for it) |
-//! | coarse encoder | any member | recorded at 100 Hz … 1 kHz (the source's rate quantile on that range, bounded below by the loop's `Kv/3`), encoder of 30 … 1000 counts over the command's amplitude, no noise (the count is the noise) |
+//! | coarse encoder | a servo member, then a rig member, in turn | recorded at 100 Hz … 1 kHz (the source's rate quantile on that range, bounded below by the loop's `Kv/3`), encoder of 30 … 1000 counts over the command's amplitude, no noise (the count is the noise) |
 //!
 //! The `j`-th member of a kind copies the candidate at the share
 //! `frac(0.05 + 0.3·kind + j·φ)` of its list (φ = 0.618…, the golden-ratio

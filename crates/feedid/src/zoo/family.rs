@@ -200,12 +200,15 @@ impl Zoo {
                     | CommandKind::Contour
             )
         };
+        // coarse encoders alternate between servo and rig axes (servo
+        // actuators are where low rates and coarse counts are common)
+        let servo_turn = (d / 3) % 2 == 0;
         let candidates: Vec<usize> = self
             .regular()
             .filter(|&i| match kind {
                 0 => is_rig(i),
                 1 => is_rig(i) && reverses(i),
-                _ => true,
+                _ => is_rig(i) != servo_turn,
             })
             .collect();
         if candidates.is_empty() {

@@ -506,7 +506,8 @@ pub struct GreyboxArgs {
     #[arg(long, value_name = "rig.toml")]
     pub params: Option<PathBuf>,
     /// Parameters to estimate, comma separated: Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc;
-    /// for a drive structure: M, Fv, Fc, offset, gain, kp, kv.
+    /// for a drive structure: M, Fv, Fc, offset, gain, kp, kv, and Fs (static friction),
+    /// Mm, k, c (two-mass: motor mass, transmission stiffness and damping).
     #[arg(long, value_name = "LIST")]
     pub estimate: String,
     /// Measured motor-current column/variable [A], used as a second output; for a

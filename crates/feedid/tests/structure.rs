@@ -604,3 +604,44 @@ fn two_mass_mechanics_need_the_motor_mass_and_are_not_tuned() {
         .unwrap_err();
     assert!(e.to_string().contains("rigid"), "{e}");
 }
+
+#[test]
+fn a_two_mass_axis_stiffness_and_masses_are_recovered_from_its_run() {
+    use feedid::drive::StructureParam as P;
+    // measured on the motor (collocated), a command rich enough to show the mode
+    let truth = two_mass(3e6, "motor");
+    let rate = 2000.0;
+    let cmd: Vec<f64> = (0..8000)
+        .map(|k| {
+            let t = k as f64 / rate;
+            1e-3 * ((3.0 * t).sin() + 0.3 * (37.0 * t).sin() + 0.1 * (190.0 * t).sin())
+        })
+        .collect();
+    let run = truth.simulate(&cmd, rate, 0.0).unwrap();
+    let mut start = truth.clone();
+    start.mechanics.mass *= 1.3;
+    start.mechanics.motor_mass = Some(15.0 * 0.75);
+    start.mechanics.stiffness = Some(3e6 * 1.4);
+    let fit = start
+        .fit(
+            &cmd,
+            &run.position,
+            rate,
+            &[P::Mass, P::MotorMass, P::Stiffness],
+        )
+        .unwrap();
+    for (p, t) in [(P::Mass, 80.0), (P::MotorMass, 15.0), (P::Stiffness, 3e6)] {
+        let e = fit.estimates.iter().find(|e| e.param == p).unwrap();
+        assert!(
+            ((e.value - t) / t).abs() < 1e-4,
+            "{}: {} vs {t}",
+            p.name(),
+            e.value
+        );
+    }
+    // a rigid structure has no stiffness to estimate
+    let e = emps()
+        .fit(&cmd, &run.position, rate, &[P::Stiffness])
+        .unwrap_err();
+    assert!(e.to_string().contains("two-mass"), "{e}");
+}

@@ -47,6 +47,18 @@ pub enum StructureParam {
     /// Velocity-loop gain (`kv`, `velocity.kp`).
     #[serde(rename = "kv")]
     VelocityKp,
+    /// Motor-side mass of a two-mass axis \[kg\] (`Mm`, `motor_mass`).
+    #[serde(rename = "Mm")]
+    MotorMass,
+    /// Transmission stiffness \[N/m\] (`k`, `stiffness`).
+    #[serde(rename = "k")]
+    Stiffness,
+    /// Transmission damping \[N·s/m\] (`c`, `damping`).
+    #[serde(rename = "c")]
+    Damping,
+    /// Static (breakaway) friction level \[N\] (`Fs`, `static`).
+    #[serde(rename = "Fs")]
+    Static,
 }
 
 impl StructureParam {
@@ -60,14 +72,20 @@ impl StructureParam {
             StructureParam::DriveGain => "gain",
             StructureParam::PositionKp => "kp",
             StructureParam::VelocityKp => "kv",
+            StructureParam::MotorMass => "Mm",
+            StructureParam::Stiffness => "k",
+            StructureParam::Damping => "c",
+            StructureParam::Static => "Fs",
         }
     }
 
     /// Its unit.
     pub fn unit(self) -> &'static str {
         match self {
-            StructureParam::Mass => "kg",
-            StructureParam::Viscous => "N·s/m",
+            StructureParam::Mass | StructureParam::MotorMass => "kg",
+            StructureParam::Viscous | StructureParam::Damping => "N·s/m",
+            StructureParam::Stiffness => "N/m",
+            StructureParam::Static => "N",
             StructureParam::Coulomb | StructureParam::Offset => "N",
             StructureParam::DriveGain => "N/unit",
             StructureParam::PositionKp => "1/s",
@@ -84,6 +102,10 @@ impl StructureParam {
             StructureParam::DriveGain => s.drive.gain,
             StructureParam::PositionKp => s.position.kp,
             StructureParam::VelocityKp => s.velocity.kp,
+            StructureParam::MotorMass => s.mechanics.motor_mass.unwrap_or(0.0),
+            StructureParam::Stiffness => s.mechanics.stiffness.unwrap_or(0.0),
+            StructureParam::Damping => s.mechanics.damping,
+            StructureParam::Static => s.friction.r#static.unwrap_or(s.friction.coulomb),
         }
     }
 
@@ -96,6 +118,10 @@ impl StructureParam {
             StructureParam::DriveGain => s.drive.gain = v,
             StructureParam::PositionKp => s.position.kp = v,
             StructureParam::VelocityKp => s.velocity.kp = v,
+            StructureParam::MotorMass => s.mechanics.motor_mass = Some(v),
+            StructureParam::Stiffness => s.mechanics.stiffness = Some(v),
+            StructureParam::Damping => s.mechanics.damping = v,
+            StructureParam::Static => s.friction.r#static = Some(v),
         }
     }
 
@@ -116,11 +142,15 @@ impl FromStr for StructureParam {
             "gain" | "gtau" => StructureParam::DriveGain,
             "kp" | "position.kp" => StructureParam::PositionKp,
             "kv" | "velocity.kp" => StructureParam::VelocityKp,
+            "Mm" | "motor_mass" => StructureParam::MotorMass,
+            "k" | "stiffness" => StructureParam::Stiffness,
+            "c" | "damping" => StructureParam::Damping,
+            "Fs" | "static" => StructureParam::Static,
             other => {
                 return Err(Error::InvalidChoice {
                     what: "structure parameter",
                     value: other.to_string(),
-                    expected: "M, Fv, Fc, offset, gain, kp, kv",
+                    expected: "M, Fv, Fc, offset, gain, kp, kv, Mm, k, c, Fs",
                 })
             }
         })
@@ -213,6 +243,17 @@ impl DriveStructure {
             }
         };
         for &p in estimate {
+            if matches!(
+                p,
+                StructureParam::MotorMass | StructureParam::Stiffness | StructureParam::Damping
+            ) && !self.mechanics.two_mass()
+            {
+                return Err(Error::InvalidParameter {
+                    name: "estimate",
+                    value: f64::NAN,
+                    reason: "Mm, k and c belong to two-mass mechanics: give stiffness and motor_mass in the file",
+                });
+            }
             let v = p.get(self);
             if p.logarithmic() && (v.is_nan() || v <= 0.0) {
                 return Err(Error::InvalidParameter {

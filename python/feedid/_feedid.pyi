@@ -218,5 +218,7 @@ def structure_fit(
     position: npt.NDArray[np.float64],
     rate: float,
     estimate: List[str],
+    *,
+    restarts: int = 2,
 ) -> Tuple[str, str]: ...
 def structure_tune(path: str, bandwidth: float, damping: float) -> Tuple[str, str]: ...

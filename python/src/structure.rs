@@ -64,8 +64,10 @@ pub fn structure_simulate<'py>(
 }
 
 /// Estimate the named parameters from command and position (`feedid greybox
-/// --params s.toml`); the fit as JSON, the structure's new TOML beside.
+/// --params s.toml`), with `restarts` fits from ±22 % away; the fit as
+/// JSON, the structure's new TOML beside.
 #[pyfunction]
+#[pyo3(signature = (path, command, position, rate, estimate, *, restarts = 2))]
 pub fn structure_fit<'py>(
     py: Python<'py>,
     path: &str,
@@ -73,6 +75,7 @@ pub fn structure_fit<'py>(
     position: PyReadonlyArray1<'py, f64>,
     rate: f64,
     estimate: Vec<String>,
+    restarts: usize,
 ) -> PyResult<(String, String)> {
     let s = load(path)?;
     let names = estimate
@@ -84,7 +87,12 @@ pub fn structure_fit<'py>(
         slice(&command, "command")?.to_vec(),
         slice(&position, "position")?.to_vec(),
     );
-    let fit = py.detach(|| s.fit(&c, &y, rate, &names)).py_err()?;
+    if restarts > 100 {
+        return Err(input(format!("restarts {restarts}: at most 100")));
+    }
+    let fit = py
+        .detach(|| s.fit_with_restarts(&c, &y, rate, &names, restarts))
+        .py_err()?;
     Ok((
         json("fit", serde_json::to_string(&fit))?,
         fit.structure.to_toml_string(),

@@ -645,3 +645,33 @@ fn a_two_mass_axis_stiffness_and_masses_are_recovered_from_its_run() {
         .unwrap_err();
     assert!(e.to_string().contains("two-mass"), "{e}");
 }
+
+#[test]
+fn restarts_flag_what_only_enters_as_a_product() {
+    use feedid::drive::StructureParam as P;
+    // without the output limit, a P/P loop sees the drive gain and the
+    // velocity gain only as their product g·kv: restarts end apart
+    let mut s = emps();
+    s.drive.limit = None;
+    s.controller.sample_time = None;
+    let rate = 1000.0;
+    let cmd: Vec<f64> = (0..6000)
+        .map(|k| 0.01 * (2.0 * (k as f64 / rate)).sin())
+        .collect();
+    let run = s.simulate(&cmd, rate, 0.0).unwrap();
+    let fit = s
+        .fit_with_restarts(&cmd, &run.position, rate, &[P::DriveGain, P::VelocityKp], 2)
+        .unwrap();
+    assert!(fit.estimates.iter().any(|e| !e.identifiable), "{fit}");
+    // the mass and the viscous friction are pinned
+    let fit = s
+        .fit_with_restarts(&cmd, &run.position, rate, &[P::Mass, P::Viscous], 2)
+        .unwrap();
+    assert!(fit.estimates.iter().all(|e| e.identifiable), "{fit}");
+    assert!(
+        fit.estimates
+            .iter()
+            .all(|e| e.restart_spread.unwrap() < 1e-3),
+        "{fit}"
+    );
+}

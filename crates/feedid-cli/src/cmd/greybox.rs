@@ -437,6 +437,12 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
              a drive structure simulates its own friction law"
         );
     }
+    if a.restarts > 100 {
+        bail!(
+            "--restarts {}: at most 100 for a drive structure (each restart is a full fit)",
+            a.restarts
+        );
+    }
     let estimate = a
         .estimate
         .split(',')
@@ -452,7 +458,13 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
         );
     }
     let fit = structure
-        .fit(rec.command(), rec.position(), rec.rate_hz(), &estimate)
+        .fit_with_restarts(
+            rec.command(),
+            rec.position(),
+            rec.rate_hz(),
+            &estimate,
+            a.restarts,
+        )
         .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
     // the controller output beside the position: the inverse-dynamics cross-check
     let idim = match &a.current {

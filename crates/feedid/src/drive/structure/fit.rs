@@ -168,6 +168,12 @@ pub struct StructureEstimate {
     pub value: f64,
     /// Its standard error (white residuals assumed; module doc).
     pub std_error: f64,
+    /// Largest relative difference from this estimate of the fits restarted
+    /// ±22 % away from it (`None` without restarts).
+    pub restart_spread: Option<f64>,
+    /// The restarts ended within `max(10⁻³, 3·std_error/|value|)` of it
+    /// (true without restarts): the data pin it.
+    pub identifiable: bool,
 }
 
 /// The result of [`DriveStructure::fit`].
@@ -333,6 +339,8 @@ impl DriveStructure {
                     value,
                     // d value / d x: value for a logarithm, the scale otherwise
                     std_error: si * if p.logarithmic() { value } else { scale_of(p) },
+                    restart_spread: None,
+                    identifiable: true,
                 }
             })
             .collect();
@@ -356,6 +364,68 @@ impl DriveStructure {
             iterations: report.iterations,
             termination: report.termination,
         })
+    }
+}
+
+impl DriveStructure {
+    /// [`DriveStructure::fit`], then `restarts` fits started from the
+    /// estimate moved ±22 % (parameter `i` of restart `r` up when `i + r` is
+    /// even, down otherwise; the offset by 22 % of its size plus 1 % of the
+    /// drive gain): an estimate whose restarts end farther than
+    /// `max(10⁻³, 3·σ/|value|)` from it is flagged not identifiable — the
+    /// data do not pin it, whatever its standard error says.
+    pub fn fit_with_restarts(
+        &self,
+        command: &[f64],
+        position: &[f64],
+        rate_hz: f64,
+        estimate: &[StructureParam],
+        restarts: usize,
+    ) -> Result<StructureFit> {
+        let mut fit = self.fit(command, position, rate_hz, estimate)?;
+        for r in 0..restarts {
+            let mut moved = fit.structure.clone();
+            for (i, &p) in estimate.iter().enumerate() {
+                let v = p.get(&fit.structure);
+                let up = (i + r) % 2 == 0;
+                let w = if p.logarithmic() {
+                    if up {
+                        v * 1.22
+                    } else {
+                        v / 1.22
+                    }
+                } else {
+                    let step = 0.22 * v.abs() + 0.01 * self.drive.gain;
+                    if up {
+                        v + step
+                    } else {
+                        v - step
+                    }
+                };
+                p.set(&mut moved, w);
+            }
+            let again = match moved.fit(command, position, rate_hz, estimate) {
+                Ok(f) => f,
+                // a restart that cannot be fitted pins nothing
+                Err(_) => {
+                    for e in &mut fit.estimates {
+                        e.restart_spread = Some(f64::INFINITY);
+                        e.identifiable = false;
+                    }
+                    continue;
+                }
+            };
+            for (e, a) in fit.estimates.iter_mut().zip(&again.estimates) {
+                let rel = (a.value - e.value).abs() / e.value.abs().max(f64::MIN_POSITIVE);
+                e.restart_spread = Some(e.restart_spread.map_or(rel, |s| s.max(rel)));
+                let tolerance =
+                    (3.0 * e.std_error / e.value.abs().max(f64::MIN_POSITIVE)).max(1e-3);
+                if rel.is_nan() || rel > tolerance {
+                    e.identifiable = false;
+                }
+            }
+        }
+        Ok(fit)
     }
 }
 
@@ -430,17 +500,23 @@ impl fmt::Display for StructureFit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "{:<8} {:>14} {:>14} {:>12}  unit",
-            "param", "file", "estimate", "std error"
+            "{:<8} {:>14} {:>14} {:>12} {:>14}  unit",
+            "param", "file", "estimate", "std error", "restarts"
         )?;
         for e in &self.estimates {
+            let verdict = match e.restart_spread {
+                None => "–".to_string(),
+                Some(_) if !e.identifiable => "NOT PINNED".to_string(),
+                Some(s) => format!("{:.1e}", s),
+            };
             writeln!(
                 f,
-                "{:<8} {:>14.6} {:>14.6} {:>12.3e}  {}",
+                "{:<8} {:>14.6} {:>14.6} {:>12.3e} {:>14}  {}",
                 e.param.name(),
                 e.start,
                 e.value,
                 e.std_error,
+                verdict,
                 e.param.unit()
             )?;
         }

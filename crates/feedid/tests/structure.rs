@@ -12,6 +12,24 @@ fn emps() -> DriveStructure {
     DriveStructure::from_toml_str(&text, Some(&path)).unwrap()
 }
 
+/// Largest distance between the simulation of `s` on a ramp of `slope`
+/// m/s (n samples at `rate`, from 0) and its transfer function's exact ramp
+/// response.
+fn ramp_gap(s: &DriveStructure, slope: f64, rate: f64, n: usize) -> f64 {
+    let cmd: Vec<f64> = (0..n).map(|k| slope * (k as f64 / rate)).collect();
+    let run = s.simulate(&cmd, rate, 0.0).unwrap();
+    let exact = s
+        .transfer_function()
+        .unwrap()
+        .ramp_response(slope, 1.0 / rate, n)
+        .unwrap();
+    run.position
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+}
+
 #[test]
 fn the_emps_file_reads_with_its_published_values() {
     let s = emps();
@@ -107,18 +125,7 @@ fn the_linear_continuous_simulation_follows_the_transfer_function() {
                 [drive]\ngain = 10.0\n[mechanics]\nmass = 5.0\n[friction]\nviscous = 20.0\n\
                 [feed_forward]\nvelocity = 0.8\n";
     let s = DriveStructure::from_toml_str(text, None).unwrap();
-    let rate = 2000.0;
-    let n = 2000;
-    let cmd: Vec<f64> = (0..n).map(|k| 0.05 * (k as f64 / rate)).collect();
-    let run = s.simulate(&cmd, rate, 0.0).unwrap();
-    let tf = s.transfer_function().unwrap();
-    let exact = tf.ramp_response(0.05, 1.0 / rate, n).unwrap();
-    let worst = run
-        .position
-        .iter()
-        .zip(&exact)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
+    let worst = ramp_gap(&s, 0.05, 2000.0, 2000);
     assert!(worst < 1e-9, "{worst}");
 }
 
@@ -168,21 +175,7 @@ fn a_pid_position_loop_commanding_force_follows_its_transfer_function() {
         "[position]\nkind = \"PID\"\nkp = 2000.0\nki = 20.0\nkd = 0.02\n[drive]\ngain = 1.0\n\
                 [mechanics]\nmass = 1.0\n[friction]\nviscous = 5.0\n";
     let s = DriveStructure::from_toml_str(text, None).unwrap();
-    let rate = 5000.0;
-    let n = 2500;
-    let cmd: Vec<f64> = (0..n).map(|k| 0.02 * (k as f64 / rate)).collect();
-    let run = s.simulate(&cmd, rate, 0.0).unwrap();
-    let exact = s
-        .transfer_function()
-        .unwrap()
-        .ramp_response(0.02, 1.0 / rate, n)
-        .unwrap();
-    let worst = run
-        .position
-        .iter()
-        .zip(&exact)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
+    let worst = ramp_gap(&s, 0.02, 5000.0, 2500);
     assert!(worst < 1e-9, "{worst}");
 }
 
@@ -545,21 +538,7 @@ fn the_two_mass_simulation_follows_its_transfer_function_on_either_side() {
     for side in ["load", "motor"] {
         let s = two_mass(3e6, side);
         assert!(s.closed_loop().unwrap().stable, "{side}");
-        let rate = 2000.0;
-        let n = 2000;
-        let cmd: Vec<f64> = (0..n).map(|k| 0.03 * (k as f64 / rate)).collect();
-        let run = s.simulate(&cmd, rate, 0.0).unwrap();
-        let exact = s
-            .transfer_function()
-            .unwrap()
-            .ramp_response(0.03, 1.0 / rate, n)
-            .unwrap();
-        let worst = run
-            .position
-            .iter()
-            .zip(&exact)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let worst = ramp_gap(&s, 0.03, 2000.0, 2000);
         assert!(worst < 1e-9, "{side}: {worst}");
     }
     // the two sides differ by the transmission's deflection

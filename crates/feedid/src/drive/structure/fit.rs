@@ -22,6 +22,7 @@ use serde::Serialize;
 use super::DriveStructure;
 use crate::error::{Error, Result};
 use crate::solve::{LevenbergMarquardt, LmConfig, Termination};
+use crate::stats::ErrorStats;
 
 /// A parameter of a drive structure that can be estimated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -286,7 +287,6 @@ impl DriveStructure {
             // a parameter set that cannot be simulated is as far as it gets
             Err(_) => r.fill(f64::MAX.sqrt()),
         };
-        let rms_of = |r: &[f64]| (r.iter().map(|v| v * v).sum::<f64>() / m as f64).sqrt();
         let mut r0 = vec![0.0; m];
         residual(
             &estimate
@@ -295,7 +295,7 @@ impl DriveStructure {
                 .collect::<Vec<_>>(),
             &mut r0,
         );
-        let start_rms = rms_of(&r0);
+        let start_rms = crate::stats::rms(&r0);
         if !start_rms.is_finite() || start_rms >= f64::MAX.sqrt() {
             return Err(Error::InvalidModel {
                 reason: "the structure with the file's values cannot be simulated on this command",
@@ -312,7 +312,7 @@ impl DriveStructure {
         };
         let report = lm.minimize(residual, &mut x, &config)?;
         let r = lm.residuals().to_vec();
-        let rms = rms_of(&r);
+        let rms = crate::stats::rms(&r);
         // standard errors: σ²·(JᵀJ)⁻¹ = σ²·R⁻¹R⁻ᵀ from the QR of J, in the
         // varied coordinates, then through the chain rule
         let n = x.len();
@@ -344,23 +344,14 @@ impl DriveStructure {
                 }
             })
             .collect();
-        let mean = position.iter().sum::<f64>() / m as f64;
-        let spread = position
-            .iter()
-            .map(|y| (y - mean).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let err = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        // the simulated position is the measured one plus the residual
+        let simulated = ErrorStats::from_pairs(position.iter().zip(&r).map(|(&y, &e)| (y, y + e)));
         Ok(StructureFit {
             structure,
             estimates,
             start_rms,
             rms,
-            fit_percent: if spread > 0.0 {
-                100.0 * (1.0 - err / spread)
-            } else {
-                f64::NAN
-            },
+            fit_percent: simulated.fit_percent,
             iterations: report.iterations,
             termination: report.termination,
         })
@@ -462,36 +453,16 @@ impl DriveStructure {
         }
         let first = position.first().copied().unwrap_or(0.0);
         let run = self.simulate(command, rate_hz, first)?;
-        let n = position.len();
-        let err: Vec<f64> = run
-            .position
-            .iter()
-            .zip(position)
-            .map(|(s, y)| s - y)
-            .collect();
-        let mean = position.iter().sum::<f64>() / n as f64;
-        let spread = position
-            .iter()
-            .map(|y| (y - mean).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let norm = err.iter().map(|e| e * e).sum::<f64>().sqrt();
+        let simulated =
+            ErrorStats::from_pairs(position.iter().copied().zip(run.position.iter().copied()));
+        let tracking =
+            ErrorStats::from_pairs(position.iter().copied().zip(command.iter().copied()));
         Ok(StructureValidation {
-            samples: n,
-            rms: norm / (n as f64).sqrt(),
-            max: err.iter().fold(0.0, |m, e| m.max(e.abs())),
-            fit_percent: if spread > 0.0 {
-                100.0 * (1.0 - norm / spread)
-            } else {
-                f64::NAN
-            },
-            tracking_rms: (command
-                .iter()
-                .zip(position)
-                .map(|(c, y)| (c - y).powi(2))
-                .sum::<f64>()
-                / n as f64)
-                .sqrt(),
+            samples: simulated.samples,
+            rms: simulated.rms,
+            max: simulated.max_abs,
+            fit_percent: simulated.fit_percent,
+            tracking_rms: tracking.rms,
         })
     }
 }

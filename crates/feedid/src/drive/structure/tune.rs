@@ -19,6 +19,7 @@ use serde::Serialize;
 
 use super::{DriveStructure, LoopKind, StructureSummary};
 use crate::error::{Error, Result};
+use crate::stats::ErrorStats;
 
 /// What the tuned loop should do.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -164,11 +165,8 @@ impl DriveStructure {
         let first = command.first().copied().unwrap_or(0.0);
         let run = self.simulate(command, rate_hz, first)?;
         let n = command.len();
-        let err: Vec<f64> = command
-            .iter()
-            .zip(&run.position)
-            .map(|(c, y)| c - y)
-            .collect();
+        let following =
+            ErrorStats::from_pairs(command.iter().copied().zip(run.position.iter().copied()));
         let last = command[n - 1];
         let travel = command.iter().fold(0.0f64, |m, c| m.max((c - first).abs()));
         let dir = (last - first).signum();
@@ -181,8 +179,8 @@ impl DriveStructure {
             .fold(0.0f64, |m, y| m.max(dir * (y - last)));
         let limit = self.drive.limit;
         Ok(RunFigures {
-            rms_error: (err.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt(),
-            max_error: err.iter().fold(0.0, |m, e| m.max(e.abs())),
+            rms_error: following.rms,
+            max_error: following.max_abs,
             overshoot_percent: if travel > 0.0 {
                 100.0 * beyond / travel
             } else {

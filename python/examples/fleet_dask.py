@@ -1,9 +1,17 @@
 #!/usr/bin/env python3
 """Identify a fleet of recordings on a Dask cluster, one recording per task.
 
-    python python/examples/fleet_dask.py rec1.csv rec2.mat ... --out fleet.csv
+    python python/examples/fleet_dask.py --workers 2          # a demo fleet
+    python python/examples/fleet_dask.py rec1.csv rec2.mat ... --out results/
     python python/examples/fleet_dask.py data/*.csv --out fleet.csv --workers 8
-    python python/examples/fleet_dask.py data/*.csv --out fleet.csv --scheduler tcp://head:8786
+    python python/examples/fleet_dask.py data/*.csv --out results/ --scheduler tcp://head:8786
+
+Everything is written under --out: a directory (created if needed) that
+gets the table as fleet.csv, or a path ending in .csv that is the table
+itself. Without --out a fresh temporary directory is used and printed;
+nothing is written into the current directory. Without recordings the
+script first simulates a demo fleet there (axis1.csv … axis4.csv: PRBS on
+the virtual rig, seeds 1 to 4) and identifies it.
 
 Without --scheduler a LocalCluster with N worker processes (one thread
 each) runs on this machine; with it the same tasks go to an existing
@@ -29,9 +37,11 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
 import sys
+import tempfile
 import time
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Tuple
 
 COLUMNS = [
     "recording",
@@ -118,10 +128,51 @@ def run_fleet(
             cluster.close()
 
 
+def output_paths(out: Optional[str]) -> Tuple[str, str]:
+    """The directory the outputs go to and the table's path: `out` as a
+    directory (created), a path ending in .csv as the table, or a fresh
+    temporary directory."""
+    if out is None:
+        directory = tempfile.mkdtemp(prefix="feedid-fleet-")
+        return directory, os.path.join(directory, "fleet.csv")
+    if out.lower().endswith(".csv") and not os.path.isdir(out):
+        directory = os.path.dirname(os.path.abspath(out))
+        os.makedirs(directory, exist_ok=True)
+        return directory, out
+    os.makedirs(out, exist_ok=True)
+    return out, os.path.join(out, "fleet.csv")
+
+
+def demo_fleet(directory: str, axes: int = 4) -> List[str]:
+    """Simulate `axes` PRBS recordings on the virtual rig into `directory`
+    (axis1.csv …, seeds 1 …) and return their paths."""
+    import numpy as np
+
+    import feedid
+
+    paths = []
+    for seed in range(1, axes + 1):
+        rec = feedid.simulate("prbs", seed=seed)
+        path = os.path.join(directory, f"axis{seed}.csv")
+        np.savetxt(
+            path,
+            np.column_stack([rec.time, rec.command, rec.position]),
+            delimiter=",",
+            header="time_s,command_m,position_m",
+            comments="",
+            fmt="%.17g",
+        )
+        paths.append(path)
+    return paths
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("recordings", nargs="+", metavar="RECORDING", help="CSV or MAT recordings")
-    p.add_argument("--out", required=True, metavar="TABLE.csv", help="the fleet table to write")
+    p.add_argument("recordings", nargs="*", metavar="RECORDING",
+                   help="CSV or MAT recordings (none: simulate a demo fleet of 4 under --out)")
+    p.add_argument("--out", metavar="DIR|TABLE.csv",
+                   help="output directory (the table is DIR/fleet.csv) or the table's path; "
+                        "default: a fresh temporary directory, printed")
     p.add_argument("--workers", type=int, default=2, metavar="N",
                    help="worker processes of the LocalCluster (default 2)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -136,16 +187,20 @@ def main(argv: Optional[List[str]] = None) -> int:
         p.error("--workers must be at least 1")
     read_options = {k: v for k, v in
                     (("time", a.time), ("command", a.command), ("position", a.position)) if v}
+    directory, table = output_paths(a.out)
+    if a.out is None:
+        print(f"writing into {directory}")
+    recordings = a.recordings or demo_fleet(directory)
     start = time.perf_counter()
-    rows = run_fleet(a.recordings, a.method, a.workers, a.scheduler, read_options)
-    with open(a.out, "w", newline="") as f:
+    rows = run_fleet(recordings, a.method, a.workers, a.scheduler, read_options)
+    with open(table, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(COLUMNS)
         for r in rows:
             w.writerow([cell(r[c]) for c in COLUMNS])
     failed = sum(1 for r in rows if r["error"])
     print(
-        f"{a.out}: {len(rows)} recordings, {failed} failed, "
+        f"{table}: {len(rows)} recordings, {failed} failed, "
         f"{time.perf_counter() - start:.1f} s wall "
         f"({'scheduler ' + a.scheduler if a.scheduler else f'{a.workers} local workers'})"
     )

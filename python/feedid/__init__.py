@@ -617,7 +617,7 @@ class OnlineCompensator:
 
 def simulate(
     scenario: str,
-    seed: int = 1,
+    seed: int = 0,
     duration: Optional[float] = None,
     rate: float = 5000.0,
     params: Params = None,
@@ -633,8 +633,8 @@ def simulate(
     scenario : str
         ``ramp``, ``step``, ``scurve``, ``chirp``, ``prbs``, ``multisine``.
     seed : int
-        Random seed of the command and the measurement noise (default 1;
-        ``feedid simulate``'s is 0: give it to compare).
+        Random seed of the command and the measurement noise (default 0,
+        as ``feedid simulate --seed``).
     duration : float, optional
         Duration [s]; default the scenario's own.
     rate : float

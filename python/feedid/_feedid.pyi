@@ -152,7 +152,7 @@ def identify(
 def simulate(
     scenario: str,
     *,
-    seed: int = 1,
+    seed: int = 0,
     duration: Optional[float] = None,
     rate: float = 5000.0,
     params_path: Optional[str] = None,

@@ -19,7 +19,7 @@ use crate::recording::{slice, PyRecording};
 
 /// Simulate a scenario on the virtual rig (`feedid simulate`).
 #[pyfunction]
-#[pyo3(signature = (scenario, *, seed = 1, duration = None, rate = 5000.0, params_path = None,
+#[pyo3(signature = (scenario, *, seed = 0, duration = None, rate = 5000.0, params_path = None,
     params_json = None, linear = false, effects = None, allow_unstable = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(

@@ -66,6 +66,17 @@ def test_simulate_equals_the_cli(cli, tmp_path):
         np.testing.assert_array_equal(r.velocity, c["velocity_m_per_s"])
 
 
+def test_simulate_defaults_equal_the_cli_defaults(cli, tmp_path):
+    # no seed given on either side: the same default seed (0)
+    p = tmp_path / "prbs.csv"
+    cli("simulate", "--scenario", "prbs", "--duration", 0.2, "-o", p)
+    c = read_csv(p)
+    r = feedid.simulate("prbs", duration=0.2)
+    np.testing.assert_array_equal(r.command, c["command_m"])
+    np.testing.assert_array_equal(r.position, c["position_m"])
+    assert not np.array_equal(feedid.simulate("prbs", seed=1, duration=0.2).position, r.position)
+
+
 def test_options_reach_the_method_as_on_the_command_line(cli, tmp_path):
     rec_path = tmp_path / "chirp.csv"
     cli("simulate", "--scenario", "chirp", "--seed", 2, "-o", rec_path)

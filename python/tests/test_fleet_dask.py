@@ -66,3 +66,31 @@ def test_fleet_rows_equal_the_cli_summaries(cli, tmp_path):
     # the fleet is not trivial: most recordings have a global model and a score
     assert sum(1 for r in by_name.values() if r["global_model"]) >= 10
     assert sum(1 for r in by_name.values() if r["global_fit_percent"]) >= 10
+
+
+def test_demo_fleet_writes_into_a_fresh_directory_not_the_current_one(tmp_path):
+    cwd = tmp_path / "cwd"
+    cwd.mkdir()
+    r = subprocess.run(
+        [sys.executable, str(SCRIPT), "--workers", "2"],
+        capture_output=True, text=True, timeout=600, cwd=cwd,
+    )
+    assert r.returncode == 0, r.stderr
+    assert list(cwd.iterdir()) == []  # nothing in the current directory
+    first = r.stdout.splitlines()[0]
+    assert first.startswith("writing into "), r.stdout
+    out = Path(first[len("writing into "):])
+    assert sorted(p.name for p in out.iterdir()) == [
+        "axis1.csv", "axis2.csv", "axis3.csv", "axis4.csv", "fleet.csv"]
+    with open(out / "fleet.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [Path(row["recording"]).name for row in rows] == [f"axis{i}.csv" for i in range(1, 5)]
+    assert all(row["error"] == "" and float(row["rms_m"]) > 0 for row in rows)
+    # a given directory gets the table as fleet.csv
+    given = tmp_path / "results"
+    r = subprocess.run(
+        [sys.executable, str(SCRIPT), str(out / "axis1.csv"), "--out", str(given), "--workers", "1"],
+        capture_output=True, text=True, timeout=600, cwd=cwd,
+    )
+    assert r.returncode == 0, r.stderr
+    assert (given / "fleet.csv").is_file() and list(cwd.iterdir()) == []

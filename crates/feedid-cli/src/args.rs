@@ -156,7 +156,7 @@ pub struct SimulateArgs {
     /// (sampled, continuous, interpolated), backlash (backlash_width), dead_time and
     /// [pulses] (force, width, period, first); missing keys keep the default: all on
     /// but backlash, dead time and pulses.
-    #[arg(long, value_name = "effects.toml", conflicts_with = "linear")]
+    #[arg(long, value_name = "effects.toml", conflicts_with = "linear", long_help = crate::cmd::simulate::effects_long_help())]
     pub effects: Option<PathBuf>,
     /// Seed of the measurement noise (and of the PRBS).
     #[arg(long, default_value_t = 0)]

@@ -555,7 +555,8 @@ fn reproduce_on_a_real_axis_puts_the_papers_figures_beside_ours_with_a_verdict()
         "{md}"
     );
     assert!(
-        md.contains("Verdict (the measured axis is off the nominal model"),
+        md.contains("Verdict: over the whole ramp")
+            && md.contains("The measured axis here is off the nominal model"),
         "{md}"
     );
     // the default axis says the simulation model starts with an advantage
@@ -1174,4 +1175,36 @@ fn a_run_that_predicts_nothing_reports_no_error_warns_and_writes_its_outputs() {
     let (h, rows) = read_csv(&pred);
     assert_eq!(rows.len(), 400);
     assert!(column(&h, &rows, "predicted_m").iter().all(Option::is_none));
+}
+
+#[test]
+fn simulate_help_lists_every_effects_key_with_its_unit_and_default() {
+    let o = feedid(&["simulate", "--help"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let help = String::from_utf8_lossy(&o.stdout).to_string();
+    for key in [
+        "friction = true",
+        "[motor_friction]",
+        "[table_friction]",
+        "stribeck_velocity = 0.5",
+        "current_limit = 10",
+        "resolution = 1e-7",
+        "noise_std = 2e-7",
+        "position_loop = \"sampled\"",
+        "backlash_width = 5e-6",
+        "dead_time = 0",
+        "[pulses]",
+        "period = 0.5",
+    ] {
+        assert!(help.contains(key), "{key} in\n{help}");
+    }
+    assert!(
+        help.contains("[samples]") && help.contains("[N·m]"),
+        "{help}"
+    );
+    assert!(!help.contains("see `feedid simulate --help`"), "{help}");
+    // the short help stays short
+    let o = feedid(&["simulate", "-h"]);
+    let short = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(!short.contains("stribeck_velocity"), "{short}");
 }

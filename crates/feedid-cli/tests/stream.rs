@@ -731,3 +731,55 @@ fn a_stream_that_loses_to_holding_says_so_with_figures_cause_and_options() {
         .unwrap();
     assert_eq!(rows(&out).len(), 2 * predicted, "{line}");
 }
+
+#[test]
+fn stream_numbers_and_summary_read_like_identify() {
+    let rec = rig_recording(Scenario::Ramp, 0.2);
+    let text = csv(&rec, true);
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("r.csv");
+    std::fs::write(&input, &text).unwrap();
+    let predictions = dir.path().join("p.csv");
+    let o = Command::new(BIN)
+        .args(["identify", input.to_str().unwrap(), "--method", "arx", "-o"])
+        .arg(&predictions)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let identify_summary = String::from_utf8_lossy(&o.stdout).to_string();
+    let (out, err) = stream(&["--method", "arx"], &text);
+    // numbers: the formatter of identify's CSV, the shortest text that reads
+    // back as the same f64 (and an empty cell, never NaN, for no number)
+    let identify_csv = std::fs::read_to_string(&predictions).unwrap();
+    for (what, table) in [("stream", &out), ("identify", &identify_csv)] {
+        let mut cells = 0;
+        for line in table.lines().skip(1) {
+            for cell in line.split(',').filter(|c| !c.is_empty()) {
+                let v: f64 = cell.parse().unwrap();
+                assert_eq!(cell, format!("{v}"), "{what}: {line}");
+                cells += 1;
+            }
+        }
+        assert!(cells > 1000, "{what}: {cells}");
+    }
+    assert!(!out.contains("NaN") && !out.contains("inf"));
+    // errors in µm, worded as identify's summary
+    assert!(
+        identify_summary.contains("prediction error: rms "),
+        "{identify_summary}"
+    );
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("scored "))
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!(line.contains("; prediction error: rms "), "{line}");
+    for part in line.split("rms ").skip(1) {
+        let (value, rest) = part.split_once(' ').unwrap();
+        assert!(
+            value.parse::<f64>().is_ok() && !value.contains('e'),
+            "{line}"
+        );
+        assert!(rest.starts_with("µm"), "{line}");
+    }
+    assert!(!line.contains(" m;") && !line.contains(" m,"), "{line}");
+}

@@ -1,9 +1,12 @@
 //! A self-contained HTML page built from sections: inline SVG figures,
-//! tables and paragraphs, a header with facts, a table of contents, and an
-//! inline print-friendly style sheet. No scripts, no external resources: the
+//! tables and paragraphs, a header with facts, a compact table of contents
+//! (one line, the full list one click away) after the leading sections that
+//! hold the answer, and an inline print-friendly style sheet. No scripts, no external resources: the
 //! file opens offline and prints as it looks.
 //!
-//! Every piece of text is HTML-escaped when written ([`escape_html`]); only
+//! Every piece of text is HTML-escaped when written ([`escape_html`]); in
+//! paragraphs, list items and answers a span between backticks is shown as
+//! code (`<code>`). Only
 //! the figures' SVG (produced by [`crate::plot`]) is inserted as markup, with
 //! its `xmlns` attribute dropped (HTML puts inline `<svg>` in the SVG
 //! namespace by itself) and its size made responsive.
@@ -84,6 +87,14 @@ pub struct Table {
 pub enum Block {
     /// A paragraph of plain text.
     Paragraph(String),
+    /// The answer the page gives: a paragraph set apart, with an element id
+    /// (checks find it; it should be on the first screen).
+    Answer {
+        /// Element id.
+        id: String,
+        /// Plain text.
+        text: String,
+    },
     /// A bulleted list of plain-text items.
     List(Vec<String>),
     /// A full-width figure.
@@ -156,10 +167,13 @@ pub struct HtmlReport {
     pub title: String,
     /// Key facts shown under the title (label, value).
     pub facts: Vec<(String, String)>,
-    /// Paragraphs before the table of contents.
+    /// Paragraphs under the header, before the sections.
     pub intro: Vec<String>,
     /// The sections.
     pub sections: Vec<Section>,
+    /// How many sections come before the table of contents (those holding
+    /// the answer, so that it is on the first screen); default 0.
+    pub lead_sections: usize,
 }
 
 const STYLE: &str = r#"
@@ -174,11 +188,11 @@ header { border-bottom: 1px solid var(--rule); padding-bottom: 12px; }
 dl.facts { display: grid; grid-template-columns: max-content 1fr; gap: 2px 18px; margin: 10px 0 0; }
 dl.facts dt { color: var(--muted); }
 dl.facts dd { margin: 0; font-variant-numeric: tabular-nums; }
-nav.toc { background: #f6f7f9; border: 1px solid var(--rule); padding: 10px 18px; margin: 18px 0; }
-nav.toc h2 { border: none; margin: 4px 0; font-size: 17px; }
+nav.toc { background: #f6f7f9; border: 1px solid var(--rule); padding: 6px 14px; margin: 18px 0; font-size: 14px; }
+nav.toc > details > summary { color: var(--ink); margin: 0; }
 nav.toc ol { margin: 4px 0; padding-left: 22px; }
-nav.toc > ol { columns: 2; column-gap: 28px; }
-nav.toc > ol > li { break-inside: avoid; }
+nav.toc > details > ol { columns: 2; column-gap: 28px; }
+nav.toc > details > ol > li { break-inside: avoid; }
 nav.toc li { margin: 1px 0; }
 nav.toc ol ol { font-size: 13.5px; color: var(--muted); }
 a { color: var(--accent); text-decoration: none; }
@@ -188,6 +202,8 @@ figcaption { font-size: 13.5px; color: #333; margin-top: 6px; }
 figcaption b { color: var(--ink); }
 .grid { display: grid; grid-template-columns: 1fr 1fr; gap: 0 20px; }
 details > summary { cursor: pointer; color: var(--accent); margin: 0.5em 0; }
+p.answer { border-left: 4px solid var(--accent); background: #f2f7fb; padding: 8px 12px; font-size: 16px; }
+code { font-family: "DejaVu Sans Mono", Menlo, Consolas, monospace; font-size: 0.92em; background: #eef0f3; padding: 0 3px; border-radius: 3px; }
 table { border-collapse: collapse; margin: 8px 0 18px; font-size: 14px; font-variant-numeric: tabular-nums; break-inside: avoid; }
 caption { text-align: left; color: var(--muted); font-size: 13.5px; padding-bottom: 4px; }
 th, td { padding: 4px 10px; border-bottom: 1px solid var(--rule); }
@@ -198,13 +214,31 @@ footer { margin-top: 40px; color: var(--muted); font-size: 12.5px; border-top: 1
 @media (max-width: 820px) { .grid { grid-template-columns: 1fr; } body { padding: 12px; } }
 @media print {
   body { max-width: none; padding: 0; font-size: 11pt; }
-  nav.toc { break-after: page; }
   h2 { break-before: page; }
-  nav.toc h2 { break-before: auto; }
+  section:first-of-type > h2 { break-before: auto; }
   a { color: inherit; }
   figure svg { border: none; }
 }
 "#;
+
+/// Escaped text with each span between a pair of backticks shown as code;
+/// an unpaired backtick stays as it is.
+pub(crate) fn inline_text(s: &str) -> String {
+    let parts: Vec<&str> = s.split('`').collect();
+    let mut out = String::with_capacity(s.len() + 16);
+    for (i, part) in parts.iter().enumerate() {
+        if i % 2 == 1 && i + 1 < parts.len() {
+            let _ = write!(out, "<code>{}</code>", escape_html(part));
+        } else {
+            if i % 2 == 1 {
+                // the last backtick has no partner
+                out.push('`');
+            }
+            out.push_str(&escape_html(part));
+        }
+    }
+    out
+}
 
 /// Whether a cell reads as a number (right-aligned).
 fn numeric(s: &str) -> bool {
@@ -256,6 +290,7 @@ impl HtmlReport {
             facts: Vec::new(),
             intro: Vec::new(),
             sections: Vec::new(),
+            lead_sections: 0,
         }
     }
 
@@ -293,14 +328,36 @@ impl HtmlReport {
         }
         h.push_str("</header>\n");
         for p in &self.intro {
-            let _ = writeln!(h, "<p>{}</p>", escape_html(p));
+            let _ = writeln!(h, "<p>{}</p>", inline_text(p));
         }
-        h.push_str("<nav class=\"toc\">\n<h2>Contents</h2>\n<ol>\n");
+        let lead = self.lead_sections.min(self.sections.len());
+        h.push_str("<main>\n");
+        for s in &self.sections[..lead] {
+            write_section(&mut h, s, 2, &number);
+        }
+        // the contents in one line (the sections), every figure one click away
+        let _ = write!(
+            h,
+            "<nav class=\"toc\" id=\"contents\">\n<details class=\"toc-list\"><summary><b>Contents</b> ({} figure{}, \
+             click for the full list):",
+            figs.len(),
+            if figs.len() == 1 { "" } else { "s" }
+        );
+        for (i, s) in self.sections.iter().enumerate() {
+            let _ = write!(
+                h,
+                "{} <a href=\"#{}\">{}</a>",
+                if i == 0 { "" } else { " ·" },
+                escape_html(&s.id),
+                escape_html(&s.title)
+            );
+        }
+        h.push_str("</summary>\n<ol>\n");
         for s in &self.sections {
             toc_entry(&mut h, s, &number);
         }
-        h.push_str("</ol>\n</nav>\n<main>\n");
-        for s in &self.sections {
+        h.push_str("</ol>\n</details>\n</nav>\n");
+        for s in &self.sections[lead..] {
             write_section(&mut h, s, 2, &number);
         }
         let _ = write!(
@@ -388,12 +445,20 @@ fn write_section(h: &mut String, s: &Section, level: usize, number: &dyn Fn(&str
     for b in &s.blocks {
         match b {
             Block::Paragraph(p) => {
-                let _ = writeln!(h, "<p>{}</p>", escape_html(p));
+                let _ = writeln!(h, "<p>{}</p>", inline_text(p));
+            }
+            Block::Answer { id, text } => {
+                let _ = writeln!(
+                    h,
+                    "<p class=\"answer\" id=\"{}\">{}</p>",
+                    escape_html(id),
+                    inline_text(text)
+                );
             }
             Block::List(items) => {
                 h.push_str("<ul>\n");
                 for i in items {
-                    let _ = writeln!(h, "<li>{}</li>", escape_html(i));
+                    let _ = writeln!(h, "<li>{}</li>", inline_text(i));
                 }
                 h.push_str("</ul>\n");
             }
@@ -505,6 +570,50 @@ mod tests {
         assert!(!html.contains("http://") && !html.contains("https://"));
         assert!(html.contains("<h3>Sub</h3>"));
         assert!(html.contains("<div class=\"grid\">"));
+    }
+
+    #[test]
+    fn backtick_spans_are_code_and_escaped() {
+        assert_eq!(
+            inline_text("run `a <b>` now"),
+            "run <code>a &lt;b&gt;</code> now"
+        );
+        assert_eq!(
+            inline_text("`x` and `y`"),
+            "<code>x</code> and <code>y</code>"
+        );
+        assert_eq!(inline_text("one ` left"), "one ` left");
+        assert_eq!(inline_text("`a` b ` c"), "<code>a</code> b ` c");
+        let mut p = page();
+        p.sections[0].blocks.push(Block::Answer {
+            id: "the-answer".into(),
+            text: "use `feedid x`".into(),
+        });
+        let html = p.to_html();
+        assert!(
+            html.contains("<p class=\"answer\" id=\"the-answer\">use <code>feedid x</code></p>")
+        );
+    }
+
+    #[test]
+    fn lead_sections_come_before_the_one_line_contents() {
+        let mut p = page();
+        p.sections.push(Section::new("sec-c", "Later"));
+        let html = p.to_html();
+        let toc = html.find("<nav class=\"toc\" id=\"contents\">").unwrap();
+        assert!(toc < html.find("<section id=\"sec-a\">").unwrap());
+        p.lead_sections = 1;
+        let html = p.to_html();
+        let toc = html.find("<nav class=\"toc\" id=\"contents\">").unwrap();
+        assert!(html.find("<section id=\"sec-a\">").unwrap() < toc);
+        assert!(toc < html.find("<section id=\"sec-c\">").unwrap());
+        // one line of section links; the figures one click away
+        assert!(html.contains(
+            "<summary><b>Contents</b> (3 figures, click for the full list): \
+             <a href=\"#sec-a\">Section &lt;A&gt;</a> · <a href=\"#sec-c\">Later</a></summary>"
+        ));
+        // every section once in the page
+        assert_eq!(html.matches("<section id=\"sec-a\">").count(), 1);
     }
 
     #[test]

@@ -138,7 +138,10 @@ pub fn paper_report(
     }
     let mut comparison = Section::new("paper-sec", "Answer: the paper's question on this axis");
     if let Some(v) = paper_verdict(results, cfg) {
-        comparison.blocks.push(Block::Paragraph(v));
+        comparison.blocks.push(Block::Answer {
+            id: "paper-verdict".into(),
+            text: v,
+        });
     }
     let axis_note = match cfg.axis {
         Axis::Nominal => {
@@ -180,6 +183,8 @@ pub fn paper_report(
             axis_note.into(),
         ]));
     page.sections.push(comparison);
+    // the verdict and its table before the contents: on the first screen
+    page.lead_sections = 1;
 
     for r in results {
         let analysis = RecordingAnalysis::run(
@@ -238,7 +243,26 @@ mod tests {
         assert!(html.contains("<td>ramp</td><td>paper LSM, QR</td>"));
         assert!(!html.contains("http://") && !html.contains("<script"));
         // the answer before any figure: the verdict on the paper's question
-        let answer = html.find("Verdict (").unwrap();
+        let answer = html
+            .find("<p class=\"answer\" id=\"paper-verdict\">Verdict: ")
+            .unwrap();
+        assert!(answer < html.find("id=\"contents\"").unwrap());
+        let verdict = &html[answer..answer + html[answer..].find("</p>").unwrap()];
+        // plain sentences: code as code, no literal backticks, no nested parentheses
+        assert!(!verdict.contains('`'), "{verdict}");
+        assert!(
+            verdict.contains("<code>feedid reproduce --axis real</code>"),
+            "{verdict}"
+        );
+        let mut depth = 0;
+        for c in verdict.chars() {
+            match c {
+                '(' => depth += 1,
+                ')' => depth -= 1,
+                _ => {}
+            }
+            assert!(depth <= 1, "nested parentheses: {verdict}");
+        }
         assert!(answer < html.find("<figure").unwrap());
         assert!(html.find("paper-table").unwrap() < html.find("<figure").unwrap());
         // the diagnostics of both experiments are folded, one click away

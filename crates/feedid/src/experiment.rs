@@ -433,28 +433,30 @@ pub fn paper_verdict(results: &[ExperimentResult], cfg: &PaperExperimentConfig) 
     let after = lsm.after.samples > 0 && lsm.after.rms < sim.after.rms;
     let axis = match cfg.axis {
         Axis::Nominal => {
-            "the measured axis is the nominal model itself (plus its effects), so the \
-             simulation model starts with an advantage no real axis gives it (`--axis real` \
-             moves the rig off it)"
+            "The measured axis here is the nominal model itself plus its effects, so the \
+             simulation model starts with an advantage no real axis gives it; \
+             `feedid reproduce --axis real` moves the rig off the nominal model."
         }
         Axis::Real(_) => {
-            "the measured axis is off the nominal model as a real axis is off its data sheet"
+            "The measured axis here is off the nominal model, as a real axis is off its data \
+             sheet."
         }
     };
+    let better = |yes: bool| if yes { "better" } else { "worse" };
     Some(format!(
-        "Verdict ({axis}): over the whole ramp the paper's identified model is {} than \
-         the simulation model ({} vs {} µm rms){}; once the motion has settled (after \
-         {z:.0} ms) it is {} ({} vs {} µm rms). The paper's finding — the identified model \
-         nearer the measurement than the simulation model — {}.",
-        if whole { "better" } else { "worse" },
+        "Verdict: over the whole ramp, the paper's identified model is {} than the \
+         simulation model: {} µm rms against {} µm.{} Once the motion has settled, after \
+         {z:.0} ms, it is {}: {} µm rms against {} µm. The paper's finding, that the \
+         identified model is nearer the measurement than the simulation model, {}. {axis}",
+        better(whole),
         um(lsm.whole.rms),
         um(sim.whole.rms),
         if whole {
             ""
         } else {
-            ", because of its blow-ups in the first windows after the motion start"
+            " Its blow-ups in the first windows after the motion start make it so."
         },
-        if after { "better" } else { "worse" },
+        better(after),
         um(lsm.after.rms),
         um(sim.after.rms),
         match (whole, after) {

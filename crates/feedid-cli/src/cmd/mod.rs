@@ -8,7 +8,7 @@ mod order;
 mod progress;
 mod recording;
 mod reproduce;
-mod simulate;
+pub(crate) mod simulate;
 
 mod stream;
 mod stream_compensate;

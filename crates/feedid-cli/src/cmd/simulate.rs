@@ -196,3 +196,240 @@ fn simulate_structure(a: &SimulateArgs, s: &feedid::drive::DriveStructure) -> Re
     );
     Ok(())
 }
+
+/// A TOML value as the help shows it: plain decimals, exponents for the
+/// very small and very large (`1e-7`, not `0.0000001`).
+fn toml_number(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// The long help of `--effects`: every table and key of the effects file
+/// with its unit and its default, the defaults read from
+/// [`RigEffects::default`] (the effect structs of `feedid::drive`).
+pub fn effects_long_help() -> String {
+    let d = RigEffects::default();
+    let on = |b: bool| if b { "true" } else { "false" };
+    let position_loop = serde_json::to_string(&d.position_loop).unwrap_or_default();
+    let friction = |f: &feedid::drive::Friction, force: &str, speed: &str| {
+        [
+            (
+                "coulomb",
+                toml_number(f.coulomb),
+                format!("Coulomb level [{force}]"),
+            ),
+            (
+                "breakaway",
+                toml_number(f.breakaway),
+                format!("breakaway (static) level at zero speed, ≥ coulomb [{force}]"),
+            ),
+            (
+                "stribeck_velocity",
+                toml_number(f.stribeck_velocity),
+                format!("Stribeck speed, > 0 [{speed}]"),
+            ),
+            (
+                "smoothing_velocity",
+                toml_number(f.smoothing_velocity),
+                format!("regularisation speed of the tanh, > 0 [{speed}]"),
+            ),
+        ]
+    };
+    let mut rows: Vec<(String, String)> = Vec::new();
+    let mut key =
+        |k: &str, v: String, what: &str| rows.push((format!("{k} = {v}"), what.to_string()));
+    key(
+        "friction",
+        on(d.friction).into(),
+        "Coulomb + Stribeck friction at motor and table (the two tables below)",
+    );
+    key(
+        "variable_stiffness",
+        on(d.variable_stiffness).into(),
+        "screw stiffness depending on the nut position",
+    );
+    key(
+        "limits",
+        on(d.limits).into(),
+        "current and voltage limits with anti-windup",
+    );
+    key(
+        "current_limit",
+        toml_number(d.current_limit),
+        "current limit [A]",
+    );
+    key(
+        "voltage_limit",
+        toml_number(d.voltage_limit),
+        "voltage limit [V]",
+    );
+    key(
+        "quantisation",
+        on(d.quantisation).into(),
+        "linear-encoder quantisation",
+    );
+    key(
+        "resolution",
+        toml_number(d.resolution),
+        "encoder resolution [m]",
+    );
+    key(
+        "noise",
+        on(d.noise).into(),
+        "Gaussian noise on the recorded position",
+    );
+    key(
+        "noise_std",
+        toml_number(d.noise_std),
+        "noise standard deviation [m]",
+    );
+    key(
+        "position_loop",
+        position_loop,
+        "the P position loop: \"sampled\" (at the sample rate), \"continuous\" (command held between samples) or \"interpolated\" (command interpolated)",
+    );
+    key(
+        "backlash",
+        on(d.backlash).into(),
+        "dead band in the screw–table connection",
+    );
+    key(
+        "backlash_width",
+        toml_number(d.backlash_width),
+        "total play of the backlash [m]",
+    );
+    key(
+        "dead_time",
+        d.dead_time.to_string(),
+        "dead time between the recorded set-point and the drive [samples]",
+    );
+    // (table, what it is, its keys)
+    type KeyRows = Vec<(String, String)>;
+    let mut tables: Vec<(&str, &str, KeyRows)> = Vec::new();
+    for (name, what, f, force, speed) in [
+        (
+            "motor_friction",
+            "motor friction law",
+            &d.motor_friction,
+            "N·m",
+            "rad/s",
+        ),
+        (
+            "table_friction",
+            "table friction law",
+            &d.table_friction,
+            "N",
+            "m/s",
+        ),
+    ] {
+        tables.push((
+            name,
+            what,
+            friction(f, force, speed)
+                .into_iter()
+                .map(|(k, v, w)| (format!("{k} = {v}"), w))
+                .collect(),
+        ));
+    }
+    let p = &d.pulses;
+    tables.push((
+        "pulses",
+        "force pulses on the table (cutting, impacts); off while force = 0",
+        vec![
+            (
+                format!("force = {}", toml_number(p.force)),
+                "height of each pulse, its sign alternating [N]".into(),
+            ),
+            (
+                format!("width = {}", toml_number(p.width)),
+                "length of each pulse [s]".into(),
+            ),
+            (
+                format!("period = {}", toml_number(p.period)),
+                "from one pulse's start to the next's [s]".into(),
+            ),
+            (
+                format!("first = {}", toml_number(p.first)),
+                "start of the first pulse after sample 0 [s]".into(),
+            ),
+        ],
+    ));
+    // the explanations in one column: keys indented by 2, table keys by 4
+    let column = rows
+        .iter()
+        .map(|(k, _)| 2 + k.chars().count())
+        .chain(
+            tables
+                .iter()
+                .flat_map(|t| t.2.iter())
+                .map(|(k, _)| 4 + k.chars().count()),
+        )
+        .max()
+        .unwrap_or(0)
+        + 2;
+    let mut o = String::from(
+        "Nonlinear effects of the virtual rig: a TOML file of any of the keys below \
+         (shown with their defaults; a missing key keeps its default, an unknown key is an \
+         error; the plain keys come before the [tables]). Default: all on but backlash, \
+         dead time and pulses; --linear switches every effect off.\n\n",
+    );
+    for (k, w) in &rows {
+        o += &format!("  {k:<width$}{w}\n", width = column - 2);
+    }
+    for (name, what, keys) in &tables {
+        o += &format!("  [{name}]  {what}\n");
+        for (k, w) in keys {
+            o += &format!("    {k:<width$}{w}\n", width = column - 4);
+        }
+    }
+    o.trim_end().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_effects_help_lists_every_key_with_its_default_and_parses_as_toml() {
+        let help = effects_long_help();
+        let d = serde_json::to_value(RigEffects::default()).unwrap();
+        for (k, v) in d.as_object().unwrap() {
+            match v.as_object() {
+                Some(table) => {
+                    assert!(help.contains(&format!("[{k}]")), "[{k}] in\n{help}");
+                    for sub in table.keys() {
+                        assert!(
+                            help.contains(&format!("    {sub} = ")),
+                            "{k}.{sub} in\n{help}"
+                        );
+                    }
+                }
+                None => assert!(help.contains(&format!("  {k} = ")), "{k} in\n{help}"),
+            }
+        }
+        assert!(
+            help.contains("resolution = 1e-7") && help.contains("[m]"),
+            "{help}"
+        );
+        assert!(help.contains("stribeck_velocity = 0.5"), "{help}");
+        assert!(!help.contains("simulate --help"), "{help}");
+        // the keys with their defaults, as listed, make a valid effects file
+        // equal to the defaults
+        let mut toml = String::new();
+        for line in help.lines() {
+            let t = line.trim_start();
+            if let Some(end) = t
+                .find("  ")
+                .filter(|_| t.contains(" = ") || t.starts_with('['))
+            {
+                toml += &t[..end];
+                toml.push('\n');
+            }
+        }
+        let parsed: RigEffects = toml::from_str(&toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
+        assert_eq!(parsed, RigEffects::default(), "{toml}");
+    }
+}

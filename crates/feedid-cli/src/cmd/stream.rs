@@ -421,14 +421,14 @@ fn summary(
     }
     if st.scored.samples > 0 {
         o += &format!(
-            "scored {} of {} samples ({}): rms error {:.4e} m, max {:.4e} m; \
-             holding each window's last position on the same samples: rms {:.4e} m\n",
+            "scored {} of {} samples ({}); prediction error: rms {:.3} µm, max {:.3} µm; \
+             holding each window's last position on the same samples: rms {:.3} µm\n",
             st.scored.samples,
             st.samples,
             percent(st.scored.samples, st.samples),
-            st.scored.rms,
-            st.scored.max_abs,
-            st.hold.rms
+            1e6 * st.scored.rms,
+            1e6 * st.scored.max_abs,
+            1e6 * st.hold.rms
         );
         o += &format!(
             "inside the {} % prediction interval: {} of the scored samples ({}); isolated outliers not fitted: {}\n",

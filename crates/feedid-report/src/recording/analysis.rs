@@ -22,6 +22,10 @@ pub(super) const MEASUREMENT: usize = 0;
 pub(super) const SIMULATION: usize = 5;
 pub(super) const COMMAND: usize = 8;
 
+/// Fewest samples the zoom after the motion start shows (see
+/// [`RecordingAnalysis::zoom_s`]).
+pub const MIN_ZOOM_SAMPLES: usize = 30;
+
 pub(super) fn method_color(i: usize) -> usize {
     METHOD_COLORS[i % METHOD_COLORS.len()]
 }
@@ -35,7 +39,9 @@ pub struct ReportOptions {
     pub params: RigParams,
     /// Where the parameters came from (shown in the header); default "the built-in default rig".
     pub params_source: String,
-    /// Zoom after the motion start \[s\]; default 0.06 (the paper's figures 5 and 7).
+    /// Zoom after the motion start \[s\]; default 0.06 (the paper's figures
+    /// 5 and 7). Widened on a coarse or slow-starting recording so that the
+    /// zoom shows data (see [`RecordingAnalysis::zoom_s`]).
     pub zoom_s: f64,
     /// Points per curve after min/max decimation; default 3000 (coefficient
     /// curves, up to 16 per figure, get a fifth of it).
@@ -112,6 +118,13 @@ pub struct RecordingAnalysis {
     pub notes: Vec<String>,
     /// Motion start \[s\].
     pub motion_start: f64,
+    /// The zoom after the motion start shown in the figures and the
+    /// summary \[s\]: [`ReportOptions::zoom_s`], widened (to 1, 2 or 5 ×
+    /// 10ⁿ s, at most to the recording's end) when it would hold fewer than
+    /// [`MIN_ZOOM_SAMPLES`] samples or miss a method's first predicted
+    /// horizon after the motion start (at 100 Hz, 60 ms are 6 samples and
+    /// lie inside the first window).
+    pub zoom_s: f64,
     /// Options used.
     pub options: ReportOptions,
 }
@@ -161,7 +174,6 @@ impl RecordingAnalysis {
         let motion_start = recording.motion_start_time();
         let t = recording.time();
         let y = recording.position();
-        let in_zoom = |k: usize| t[k] >= motion_start && t[k] <= motion_start + opts.zoom_s;
 
         let runs: Vec<feedid::Result<Identification>> = opts
             .methods
@@ -179,9 +191,11 @@ impl RecordingAnalysis {
                 p.run(&recording)
             })
             .collect();
+        let runs = runs.into_iter().collect::<feedid::Result<Vec<_>>>()?;
+        let zoom_s = zoom_span(&recording, motion_start, opts.zoom_s, &runs);
+        let in_zoom = |k: usize| t[k] >= motion_start && t[k] <= motion_start + zoom_s;
         let mut out_runs = Vec::with_capacity(runs.len());
-        for (i, r) in runs.into_iter().enumerate() {
-            let identification = r?;
+        for (i, identification) in runs.into_iter().enumerate() {
             let s = &identification.sliding;
             let zoom_stats = ErrorStats::from_pairs(
                 (0..y.len())
@@ -255,6 +269,7 @@ impl RecordingAnalysis {
             global,
             notes,
             motion_start,
+            zoom_s,
             options: opts.clone(),
         })
     }
@@ -379,9 +394,7 @@ impl RecordingAnalysis {
     pub(super) fn zoom_indices(&self) -> Vec<usize> {
         let t = self.recording.time();
         (0..t.len())
-            .filter(|&k| {
-                t[k] >= self.motion_start && t[k] <= self.motion_start + self.options.zoom_s
-            })
+            .filter(|&k| t[k] >= self.motion_start && t[k] <= self.motion_start + self.zoom_s)
             .collect()
     }
 
@@ -407,7 +420,27 @@ impl RecordingAnalysis {
     }
 
     pub(super) fn zoom_ms(&self) -> f64 {
-        1e3 * self.options.zoom_s
+        1e3 * self.zoom_s
+    }
+
+    /// The zoom span as text: "60 ms", "1 s", "2.5 s".
+    pub(super) fn zoom_text(&self) -> String {
+        span_text(self.zoom_s)
+    }
+
+    /// A sentence saying that and why the zoom was widened; empty when it was not.
+    pub(super) fn zoom_note(&self) -> String {
+        if self.zoom_s > self.options.zoom_s {
+            format!(
+                " The zoom is widened from the requested {} to {}: at {:.0} Hz the requested span \
+                 holds too few samples or no method's prediction yet.",
+                span_text(self.options.zoom_s),
+                self.zoom_text(),
+                self.recording.rate_hz()
+            )
+        } else {
+            String::new()
+        }
     }
 
     pub(super) fn figure(
@@ -418,6 +451,63 @@ impl RecordingAnalysis {
     ) -> Result<Figure> {
         Ok(Figure::new(&id, title, &chart.to_svg()?, caption))
     }
+}
+
+/// A time span as text: whole ms below a second ("60 ms"), else seconds
+/// to three significant digits ("1 s", "2.5 s"); sub-ms spans to three digits.
+pub(super) fn span_text(s: f64) -> String {
+    let sig3 = |v: f64| {
+        format!("{v:.2e}")
+            .parse::<f64>()
+            .map_or_else(|_| v.to_string(), |x| x.to_string())
+    };
+    let ms = 1e3 * s;
+    if ms >= 999.5 {
+        format!("{} s", sig3(s))
+    } else if ms >= 1.0 {
+        format!("{ms:.0} ms")
+    } else {
+        format!("{} ms", sig3(ms))
+    }
+}
+
+/// The zoom after the motion start actually shown \[s\] (see
+/// [`RecordingAnalysis::zoom_s`]): `requested`, unless it holds fewer than
+/// [`MIN_ZOOM_SAMPLES`] samples or ends before some method's first full
+/// horizon of predictions after the motion start; then the smallest 1, 2 or
+/// 5 × 10ⁿ s that holds them, at most up to the recording's last sample.
+fn zoom_span(
+    recording: &Recording,
+    motion_start: f64,
+    requested: f64,
+    runs: &[Identification],
+) -> f64 {
+    let t = recording.time();
+    let n = t.len();
+    let Some(first) = t.iter().position(|&v| v >= motion_start) else {
+        return requested;
+    };
+    let last = t[n - 1] - motion_start;
+    let at = |k: usize| t[k.min(n - 1)] - motion_start;
+    let mut need = at(first + MIN_ZOOM_SAMPLES - 1);
+    for run in runs {
+        let s = &run.sliding;
+        let h = run.config.horizon.max(1);
+        if let Some(k) = (first..n).find(|&k| s.has_prediction.get(k) == Some(&true)) {
+            need = need.max(at(k + h - 1));
+        }
+    }
+    if need <= requested || !need.is_finite() || last <= requested {
+        return requested;
+    }
+    // the next 1, 2 or 5 × 10ⁿ at or above what is needed
+    let decade = 10f64.powf(need.log10().floor());
+    let nice = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * decade)
+        .find(|&v| v >= need * (1.0 - 1e-12))
+        .unwrap_or(10.0 * decade);
+    nice.min(last)
 }
 
 /// The global models of the Bode figure, through the library's one
@@ -494,13 +584,17 @@ pub fn recording_report(a: &RecordingAnalysis) -> Result<HtmlReport> {
     let mut page = HtmlReport::new(&format!("feedid report — {}", a.name));
     page.facts = a.facts();
     page.intro.push(
-        "How to read this report: the recording is identified in short sliding windows by each method; every \
-         window's model predicts the next H samples, which are compared with what was then measured. The \
-         figures go from the raw data to the predictions, their errors, the identified coefficients, the \
-         whiteness of the errors, and the frequency response; the summary table at the end has the numbers. \
-         Units: time in ms (s for long recordings), positions in µm or mm as labelled on each axis."
+        "How to read this report: the answer comes first. The summary below names the method that predicts \
+         best and has every method's numbers; the one-line contents follow it. The recording is identified in \
+         short sliding windows by each method; every window's model predicts the next H samples, which are \
+         compared with what was then measured. After the summary, the figures go from the raw data to the \
+         predictions and their errors; the identified coefficients, the whiteness of the errors and the \
+         frequency response are folded at the end, one click away. Units: time in ms, or s for long \
+         recordings; positions in µm or mm as labelled on each axis."
             .into(),
     );
     page.sections = a.sections("rec")?;
+    // the summary with the answer before the contents: on the first screen
+    page.lead_sections = 1;
     Ok(page)
 }

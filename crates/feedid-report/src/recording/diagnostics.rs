@@ -320,7 +320,7 @@ impl RecordingAnalysis {
                 "–".into()
             }
         };
-        let z = self.zoom_ms();
+        let z = self.zoom_text();
         let mut rows = Vec::new();
         for m in &self.runs {
             let s = m.identification.summary();
@@ -357,11 +357,13 @@ impl RecordingAnalysis {
         ]);
         let table = Table {
             id: format!("{p}-summary"),
-            caption:
+            caption: format!(
                 "k-step-ahead prediction errors (measurement − prediction) over every predicted sample; the \
-                 simulation model over all samples. Fit = NRMSE fit (100 % is perfect). Time = identification and \
-                 prediction per window, methods run in parallel."
-                .into(),
+                 simulation model over all samples. Fit = NRMSE fit (100 % is perfect). The rms over the first {z} \
+                 after the motion start is that of the zoomed figures.{} Time = identification and prediction per \
+                 window, methods run in parallel.",
+                self.zoom_note()
+            ),
             header: vec![
                 "method".into(),
                 "W".into(),
@@ -372,13 +374,16 @@ impl RecordingAnalysis {
                 "rms [µm]".into(),
                 "max [µm]".into(),
                 "fit [%]".into(),
-                format!("rms first {z:.0} ms [µm]"),
+                format!("rms first {z} [µm]"),
                 "time per window [µs]".into(),
             ],
             rows,
         };
         let mut sec = Section::new(&format!("{p}-summary-sec"), "Summary")
-            .with(Block::Paragraph(self.verdict()))
+            .with(Block::Answer {
+                id: format!("{p}-answer"),
+                text: self.verdict(),
+            })
             .with(Block::Table(table))
             .with(Block::Table(self.interval_table(p)));
         if !self.global.is_empty() {

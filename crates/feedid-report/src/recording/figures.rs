@@ -68,7 +68,10 @@ impl RecordingAnalysis {
             )?)))
     }
 
-    pub(super) fn response_section(&self, p: &str) -> Result<Section> {
+    /// The two charts of the response section (the whole recording and the
+    /// zoom after the motion start), each with the sentence naming the curves
+    /// cut at its frame (empty when none is).
+    pub(super) fn response_charts(&self) -> ((LineChart, String), (LineChart, String)) {
         let (sc, unit) = self.position_unit();
         let (_, tl) = self.time_axis();
         let r = &self.recording;
@@ -87,7 +90,7 @@ impl RecordingAnalysis {
         )
         .with_legend(LegendPosition::Below);
         let mut zoom = LineChart::new(
-            &format!("First {:.0} ms after the motion start", self.zoom_ms()),
+            &format!("First {} after the motion start", self.zoom_text()),
             "time since motion start [ms]",
             "position from rest [µm]",
         )
@@ -129,20 +132,54 @@ impl RecordingAnalysis {
             self.zoomed("measurement", &|k| Some(r.position()[k] - y0), 1e6)
                 .with_color(MEASUREMENT),
         );
-        // Keep the zoom readable when a method blows up: the y range covers
-        // the measurement and the command with a margin; lines leaving it are cut.
-        let idx = self.zoom_indices();
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for &k in &idx {
-            for v in [r.position()[k] - y0, r.command()[k] - y0] {
-                lo = lo.min(1e6 * v);
-                hi = hi.max(1e6 * v);
+        // Keep both readable when a method blows up: the y range covers the
+        // measurement and the command with a margin; lines leaving it are
+        // cut at the frame, and the caption names them and how far they go.
+        let references = ["command", "measurement"];
+        let whole_range =
+            value_range((0..r.len()).flat_map(|k| [sc * r.position()[k], sc * r.command()[k]]));
+        let mut full_note = String::new();
+        if let Some(frame) = whole_range.map(|(lo, hi)| with_margin(lo, hi, 0.1)) {
+            let off = off_frame(&full, frame, unit, tl, &references);
+            if !off.is_empty() {
+                // only then: a chart nothing leaves keeps its own data range
+                full.y_range = Some(frame);
+                full.pin_to_edges = true;
+                full_note = format!(
+                    " The y axis follows the measurement and the command ({} … {} {unit} with a 10 % \
+                     margin); curves beyond it run along the frame: {}.",
+                    num3(frame.0),
+                    num3(frame.1),
+                    off.join("; ")
+                );
             }
         }
-        if lo.is_finite() && hi > lo {
-            let m = 0.15 * (hi - lo);
-            zoom.y_range = Some((lo - m, hi + m));
+        let idx = self.zoom_indices();
+        let zoom_range = value_range(
+            idx.iter()
+                .flat_map(|&k| [1e6 * (r.position()[k] - y0), 1e6 * (r.command()[k] - y0)]),
+        );
+        let mut zoom_note = String::new();
+        if let Some((lo, hi)) = zoom_range.filter(|(lo, hi)| hi > lo) {
+            let frame = with_margin(lo, hi, 0.15);
+            zoom.y_range = Some(frame);
+            let off = off_frame(
+                &zoom,
+                frame,
+                "µm",
+                "time since motion start [ms]",
+                &references,
+            );
+            if !off.is_empty() {
+                zoom_note = format!(" Cut at the frame: {}.", off.join("; "));
+            }
         }
+        ((full, full_note), (zoom, zoom_note))
+    }
+
+    pub(super) fn response_section(&self, p: &str) -> Result<Section> {
+        let r = &self.recording;
+        let ((full, full_note), (zoom, zoom_note)) = self.response_charts();
         let h = self
             .runs
             .first()
@@ -151,23 +188,29 @@ impl RecordingAnalysis {
             .with(Block::Paragraph(format!(
                 "Each method fits a model to the last W samples and predicts the next H = {h} samples ({:.1} ms) \
                  from it and the known command; the window then moves on by H. The simulation model is the nominal \
-                 physical model of the rig parameters driven by the measured command from the start (no data used).",
-                1e3 * h as f64 * r.dt()
+                 physical model of the rig parameters driven by the measured command from the start (no data used).{}",
+                1e3 * h as f64 * r.dt(),
+                self.zoom_note()
             )))
             .with(Block::Figure(Self::figure(
                 format!("{p}-response"),
                 "Whole recording",
                 &full,
-                "The black measurement is drawn on top; at this scale all curves should lie under it, and a \
-                 coloured curve that leaves it shows where a method blows up. Gaps are samples without a prediction (before the first window, or a failed window).",
+                &format!(
+                    "The black measurement is drawn on top; at this scale all curves should lie under it, and a \
+                     coloured curve that leaves it shows where a method blows up. Gaps are samples without a \
+                     prediction (before the first window, or a failed window).{full_note}"
+                ),
             )?))
             .with(Block::Figure(Self::figure(
                 format!("{p}-response-zoom"),
-                &format!("Zoom on the first {:.0} ms of the motion (as the paper's figures 5 and 7)", self.zoom_ms()),
+                &format!("Zoom on the first {} of the motion (as the paper's figures 5 and 7)", self.zoom_text()),
                 &zoom,
-                "Positions relative to the rest position at the motion start. This is where identification is \
-                 hardest: the window still contains the standstill. Lines leaving the plot are cut at its edge; \
-                 the error figures below show by how much.",
+                &format!(
+                    "Positions relative to the rest position at the motion start. This is where identification is \
+                     hardest: the window still contains the standstill. Lines leaving the plot are cut at its edge; \
+                     the error figures below show by how much.{zoom_note}"
+                ),
             )?)))
     }
 
@@ -204,8 +247,8 @@ impl RecordingAnalysis {
         );
         let mut zoom = LineChart::new(
             &format!(
-                "Error in the first {:.0} ms (as the paper's figures 6 and 8)",
-                self.zoom_ms()
+                "Error in the first {} (as the paper's figures 6 and 8)",
+                self.zoom_text()
             ),
             "time since motion start [ms]",
             "measurement − model [µm]",
@@ -249,8 +292,8 @@ impl RecordingAnalysis {
         // the same, with the y axis at the simulation model's error scale
         let mut detail = zoom.clone();
         detail.title = format!(
-            "Error in the first {:.0} ms, detail at the simulation model's scale",
-            self.zoom_ms()
+            "Error in the first {}, detail at the simulation model's scale",
+            self.zoom_text()
         );
         let lim = 1.3 * (1e6 * self.simulation_zoom.max_abs).max(1.0);
         detail.y_range = Some((-lim, lim));
@@ -265,13 +308,13 @@ impl RecordingAnalysis {
             )?))
             .with(Block::Figure(Self::figure(
                 format!("{p}-error-zoom"),
-                &format!("Error in the first {:.0} ms of the motion", self.zoom_ms()),
+                &format!("Error in the first {} of the motion", self.zoom_text()),
                 &zoom,
                 "Measurement − model, sample by sample, in µm, at full scale: the largest errors of any method.",
             )?))
             .with(Block::Figure(Self::figure(
                 format!("{p}-error-zoom-detail"),
-                &format!("Error in the first {:.0} ms, detail", self.zoom_ms()),
+                &format!("Error in the first {}, detail", self.zoom_text()),
                 &detail,
                 &format!(
                     "The same errors with the y axis limited to ±{lim:.1} µm (1.3 × the simulation model's largest \
@@ -431,4 +474,75 @@ impl RecordingAnalysis {
         }
         Ok(sec)
     }
+}
+
+/// The smallest and largest finite value, if any.
+fn value_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// `lo … hi` widened by `share` of its span on each side (by 5 % of the
+/// magnitude, or 1, for a flat range).
+fn with_margin(lo: f64, hi: f64, share: f64) -> (f64, f64) {
+    let m = if hi > lo {
+        share * (hi - lo)
+    } else if hi.abs() > 0.0 {
+        0.05 * hi.abs()
+    } else {
+        1.0
+    };
+    (lo - m, hi + m)
+}
+
+/// A number to three significant digits, plainly written ("1090", "0.0123").
+fn num3(v: f64) -> String {
+    format!("{v:.2e}")
+        .parse::<f64>()
+        .map_or_else(|_| v.to_string(), |x| x.to_string())
+}
+
+/// The curves of `chart` (but those labelled in `skip`) that leave the y
+/// range `frame`, one phrase each: the curve, its farthest value (in
+/// `unit`), where it is (x as in `x_label`) and how far beyond the frame.
+fn off_frame(
+    chart: &LineChart,
+    frame: (f64, f64),
+    unit: &str,
+    x_label: &str,
+    skip: &[&str],
+) -> Vec<String> {
+    let (lo, hi) = frame;
+    let x_unit = x_label
+        .rsplit_once('[')
+        .map_or("", |(_, u)| u.trim_end_matches(']'));
+    let mut out = Vec::new();
+    for s in chart
+        .series
+        .iter()
+        .filter(|s| !skip.contains(&s.label.as_str()))
+    {
+        let far =
+            s.x.iter()
+                .zip(&s.y)
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .filter(|(x, _)| chart.x_range.map_or(true, |(a, b)| **x >= a && **x <= b))
+                .map(|(&x, &y)| (x, y, (y - hi).max(lo - y)))
+                .filter(|&(_, _, beyond)| beyond > 0.0)
+                .max_by(|a, b| a.2.total_cmp(&b.2));
+        if let Some((x, y, beyond)) = far {
+            out.push(format!(
+                "{} reaches {} {unit} at {} {x_unit}, {} {unit} beyond it",
+                s.label,
+                num3(y),
+                num3(x),
+                num3(beyond)
+            ));
+        }
+    }
+    out
 }

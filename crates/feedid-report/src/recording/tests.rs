@@ -1,5 +1,6 @@
 //! Tests of the recording report.
 
+use super::analysis::MIN_ZOOM_SAMPLES;
 use super::analysis::*;
 use super::diagnostics::*;
 use crate::html::Block;
@@ -142,12 +143,10 @@ fn report_opens_with_the_answer_and_folds_the_diagnostics() {
     let secs = a.sections("rec").unwrap();
     // the summary (answer) comes first, with the verdict before its table
     assert_eq!(secs[0].id, "rec-summary-sec");
-    let Block::Paragraph(verdict) = &secs[0].blocks[0] else {
-        panic!(
-            "the summary opens with a paragraph: {:?}",
-            secs[0].blocks[0]
-        );
+    let Block::Answer { id, text: verdict } = &secs[0].blocks[0] else {
+        panic!("the summary opens with the answer: {:?}", secs[0].blocks[0]);
     };
+    assert_eq!(id, "rec-answer");
     assert!(verdict.starts_with("Answer: "), "{verdict}");
     // the best method named is the one with the lowest rms among those with
     // (nearly) full coverage; its rms is the summary's
@@ -176,9 +175,132 @@ fn report_opens_with_the_answer_and_folds_the_diagnostics() {
     }
     let html = recording_report(&a).unwrap().to_html();
     assert!(html.contains("<details><summary>"));
-    let answer = html.find("Answer: ").unwrap();
+    let answer = html
+        .find("<p class=\"answer\" id=\"rec-answer\">Answer: ")
+        .unwrap();
     let first_figure = html.find("<figure").unwrap();
     assert!(answer < first_figure);
+    // the answer comes before the (one-line) contents, and the intro says so
+    let contents = html.find("<nav class=\"toc\" id=\"contents\">").unwrap();
+    assert!(answer < contents && contents < first_figure);
+    let intro = &html[html.find("How to read this report").unwrap()..];
+    assert!(intro.starts_with("How to read this report: the answer comes first."));
+    assert!(!html.contains("summary table at the end"));
+}
+
+/// A recording at `rate` Hz: the ramp scenario over `duration` s.
+fn ramp_at(rate: f64, duration: f64) -> Recording {
+    let cmd = Scenario::Ramp.command(rate, duration, 1).unwrap();
+    let out = VirtualRig::new(RigParams::default())
+        .with_seed(1)
+        .simulate(&cmd, rate)
+        .unwrap();
+    Recording::new(out.time, out.command, out.position).unwrap()
+}
+
+#[test]
+fn a_100_hz_report_has_method_data_in_every_zoom_figure_and_a_named_zoom_column() {
+    let mut o = opts();
+    o.methods = ["paper", "arx", "auto"]
+        .iter()
+        .map(|n| {
+            let spec: Method = n.parse().unwrap();
+            let cfg = EngineConfig {
+                window: spec.default_window(),
+                ..EngineConfig::default()
+            };
+            (spec, cfg)
+        })
+        .collect();
+    let a = RecordingAnalysis::run("ramp100.csv", ramp_at(100.0, 5.0), &o).unwrap();
+    // 60 ms are 6 samples inside the first window: the zoom is widened to a
+    // round span that holds every method's first predictions
+    assert!(a.zoom_s > 0.06, "{}", a.zoom_s);
+    assert!(a.zoom_indices().len() >= MIN_ZOOM_SAMPLES);
+    let label = super::analysis::span_text(a.zoom_s);
+    // every method has predictions in the zoomed figures
+    let ((full, _), (zoom, _)) = a.response_charts();
+    for m in &a.runs {
+        for chart in [&full, &zoom] {
+            let s = chart.series.iter().find(|s| s.label == m.label).unwrap();
+            assert!(
+                s.y.iter().filter(|v| v.is_finite()).count() >= 3,
+                "{}: {} in {}",
+                a.zoom_s,
+                m.label,
+                chart.title
+            );
+        }
+        assert!(m.zoom_stats.samples > 0, "{}", m.label);
+    }
+    // the summary names the span and has no all-"–" column
+    let sec = a.summary_section("rec");
+    let Block::Table(t) = &sec.blocks[1] else {
+        panic!("table expected")
+    };
+    assert!(
+        t.header.contains(&format!("rms first {label} [µm]")),
+        "{:?}",
+        t.header
+    );
+    assert!(!t.header.iter().any(|h| h.contains("60 ms")));
+    for j in 1..t.header.len() {
+        assert!(
+            t.rows.iter().any(|r| r[j] != "–"),
+            "column {} is all –",
+            t.header[j]
+        );
+    }
+    let html = recording_report(&a).unwrap().to_html();
+    assert!(html.contains(&format!("Zoom on the first {label} of the motion")));
+    assert!(html.contains("The zoom is widened from the requested 60 ms"));
+    // at 5 kHz the requested 60 ms stay
+    let b = RecordingAnalysis::run("ramp.csv", ramp(), &opts()).unwrap();
+    assert_eq!(b.zoom_s, 0.06);
+    assert!(!recording_report(&b).unwrap().to_html().contains("widened"));
+}
+
+#[test]
+fn a_method_that_blows_up_is_cut_at_the_frame_of_the_measurement_and_named() {
+    let mut a = RecordingAnalysis::run("ramp.csv", ramp(), &opts()).unwrap();
+    // nothing leaves the whole figure: its own data range, no note
+    let ((full, note), _) = a.response_charts();
+    assert!(full.y_range.is_none() && note.is_empty(), "{note}");
+    // one method blows up to 1.09 m on one stretch of predictions
+    let label = a.runs[1].label.clone();
+    let s = &mut a.runs[1].identification.sliding;
+    let k = (500..s.has_prediction.len())
+        .find(|&k| s.has_prediction[k])
+        .unwrap();
+    for v in &mut s.predicted[k..k + 5] {
+        *v = 1.09;
+    }
+    let ((full, note), _) = a.response_charts();
+    let r = &a.recording;
+    let (lo, hi) = r
+        .position()
+        .iter()
+        .chain(r.command())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    // the y range follows the measurement and the command (in mm), with a margin
+    let (y0, y1) = full.y_range.unwrap();
+    let span = 1e3 * (hi - lo);
+    assert!((y0 - (1e3 * lo - 0.1 * span)).abs() < 1e-9 * span, "{y0}");
+    assert!((y1 - (1e3 * hi + 0.1 * span)).abs() < 1e-9 * span, "{y1}");
+    // the caption names the method and how far it went
+    assert!(
+        note.contains(&format!("{label} reaches 1090 mm at ")),
+        "{note}"
+    );
+    assert!(note.contains("beyond it"), "{note}");
+    assert!(!note.contains("measurement reaches"), "{note}");
+    let html = a.response_section("rec").unwrap();
+    let Block::Figure(f) = &html.blocks[1] else {
+        panic!("figure expected")
+    };
+    assert!(f.caption.contains(&format!("{label} reaches 1090 mm")));
 }
 
 #[test]

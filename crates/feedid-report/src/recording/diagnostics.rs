@@ -291,6 +291,33 @@ impl RecordingAnalysis {
                 .map(|r| format!("{} [%] (samples)", r.label())),
         );
         header.push("cut back as runaways".into());
+        // a regime no method predicted a sample in is left out (a column of "–")
+        let absent: Vec<String> = Regime::ALL
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| rows.iter().all(|r| r[3 + i] == "–"))
+            .map(|(_, r)| r.label().to_string())
+            .collect();
+        let keep: Vec<bool> = (0..header.len())
+            .map(|j| !(3..3 + Regime::ALL.len()).contains(&j) || rows.iter().any(|r| r[j] != "–"))
+            .collect();
+        let pick = |v: Vec<String>| -> Vec<String> {
+            v.into_iter()
+                .zip(&keep)
+                .filter(|(_, k)| **k)
+                .map(|(c, _)| c)
+                .collect()
+        };
+        let header = pick(header);
+        let rows: Vec<Vec<String>> = rows.into_iter().map(pick).collect();
+        let left_out = if absent.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " No method predicted a sample in: {} (not shown).",
+                absent.join(", ")
+            )
+        };
         Table {
             id: format!("{p}-intervals"),
             caption: format!(
@@ -298,7 +325,7 @@ impl RecordingAnalysis {
                  their interval, in all and by the command's regime at the sample (calibrated per \
                  step ahead and per regime from the method's own recent errors), their median \
                  width, and the windows whose prediction left the motion the axis has shown and \
-                 was cut back (their interval spans the hold)."
+                 was cut back (their interval spans the hold).{left_out}"
             ),
             header,
             rows,

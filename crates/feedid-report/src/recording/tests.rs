@@ -251,6 +251,26 @@ fn a_100_hz_report_has_method_data_in_every_zoom_figure_and_a_named_zoom_column(
             t.header[j]
         );
     }
+    // nor has any other table: a regime without samples is left out, and said so
+    for b in &sec.blocks {
+        let Block::Table(t) = b else { continue };
+        for j in 1..t.header.len() {
+            assert!(
+                t.rows.iter().any(|r| r[j] != "–"),
+                "{}: column {} is all –",
+                t.id,
+                t.header[j]
+            );
+        }
+    }
+    let Block::Table(intervals) = &sec.blocks[2] else {
+        panic!("interval table expected")
+    };
+    assert!(
+        intervals.caption.contains("(not shown)"),
+        "{}",
+        intervals.caption
+    );
     let html = recording_report(&a).unwrap().to_html();
     assert!(html.contains(&format!("Zoom on the first {label} of the motion")));
     assert!(html.contains("The zoom is widened from the requested 60 ms"));

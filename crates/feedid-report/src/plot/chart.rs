@@ -219,6 +219,22 @@ impl LineChart {
             .y_range
             .map_or((f64::NEG_INFINITY, f64::INFINITY), |(a, b)| (fy(a), fy(b)));
         let inside = |x: f64, y: f64| x >= xa && x <= xb && y >= ya && y <= yb;
+        // Points far outside (up to ±f64::MAX: a diverging simulation) would
+        // overflow the differences below; they are first brought into a box a
+        // million times the range around it (the line's crossing of the frame
+        // moves by far less than a pixel).
+        let near = |v: f64, a: f64, b: f64| {
+            if a.is_finite() && b.is_finite() {
+                let m = (1e6 * (b - a).abs()).clamp(f64::MIN_POSITIVE, 1e300);
+                v.clamp(a - m, b + m)
+            } else {
+                v
+            }
+        };
+        let seg: Vec<(f64, f64)> = seg
+            .into_iter()
+            .map(|(x, y)| (gx(near(fx(x), xa, xb)), gy(near(fy(y), ya, yb))))
+            .collect();
         let mut out = Vec::new();
         let mut cur: Vec<(f64, f64)> = Vec::new();
         if seg.len() == 1 {
@@ -757,5 +773,27 @@ mod tests {
     fn empty_chart_renders() {
         let c = LineChart::new("empty", "x", "y");
         assert!(c.to_svg().unwrap().contains("</svg>"));
+    }
+
+    #[test]
+    fn points_near_the_float_limits_are_clipped_to_the_frame() {
+        let mut c = LineChart::new("t", "x", "y");
+        c.y_range = Some((0.0, 1.0));
+        for pin in [false, true] {
+            c.pin_to_edges = pin;
+            let seg = vec![
+                (0.0, 0.5),
+                (1.0, -1e308),
+                (2.0, 1e308),
+                (3.0, f64::MAX),
+                (4.0, 0.5),
+            ];
+            let parts = c.clip(seg);
+            assert!(!parts.is_empty());
+            for (x, y) in parts.iter().flatten() {
+                assert!((0.0..=4.0).contains(x), "{x}");
+                assert!((-1e-9..=1.0 + 1e-9).contains(y), "{pin}: {y}");
+            }
+        }
     }
 }

@@ -80,6 +80,38 @@ pub enum Error {
         applies_to: &'static str,
     },
 
+    /// A method option was given for a method that does not have it (it is
+    /// refused, never silently ignored).
+    #[error("option `{key}` does not apply to method {method} (only to {applies_to})")]
+    OptionNotApplicable {
+        /// The option's key (`"lambda"`).
+        key: &'static str,
+        /// The method it was given for.
+        method: &'static str,
+        /// The methods that have it (`"rls"`).
+        applies_to: String,
+    },
+
+    /// A method option's value does not parse or lies outside its range.
+    #[error("invalid {key} `{value}`: {expected}")]
+    InvalidOption {
+        /// The option's key (`"lambda"`).
+        key: &'static str,
+        /// The value as given.
+        value: String,
+        /// What is accepted (`"expected a number in (0, 1]"`).
+        expected: String,
+    },
+
+    /// No method has an option of this key.
+    #[error("unknown method option `{key}`; the options are: {known}")]
+    UnknownOption {
+        /// The key given.
+        key: String,
+        /// The keys of all method options, comma separated.
+        known: String,
+    },
+
     /// A rig parameter file could not be parsed (unknown key, wrong type, ...).
     #[error("{}: {message}", display_path(path))]
     ParamsFile {
@@ -365,6 +397,43 @@ pub enum Error {
         /// `1 / min` \[Hz\].
         max_rate: f64,
     },
+}
+
+/// The syntax in which a message names a setting: each front end phrases
+/// the library's settings as its users type them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Syntax {
+    /// Neutral: `unit = mm`.
+    Library,
+    /// Command line: `--unit mm`.
+    Cli,
+    /// Python keyword: `unit="mm"` (numbers unquoted: `max_smoothing=0.05`).
+    Python,
+}
+
+impl Syntax {
+    /// The setting `key` = `value` in this syntax.
+    ///
+    /// ```
+    /// use feedid::error::Syntax;
+    /// assert_eq!(Syntax::Cli.setting("time_origin", "window"), "--time-origin window");
+    /// assert_eq!(Syntax::Python.setting("unit", "mm"), "unit=\"mm\"");
+    /// assert_eq!(Syntax::Python.setting("max_smoothing", "0.05"), "max_smoothing=0.05");
+    /// assert_eq!(Syntax::Library.setting("unit", "mm"), "unit = mm");
+    /// ```
+    pub fn setting(self, key: &str, value: &str) -> String {
+        match self {
+            Syntax::Library => format!("{key} = {value}"),
+            Syntax::Cli => format!("--{} {value}", key.replace('_', "-")),
+            Syntax::Python => {
+                if value.parse::<f64>().is_ok() {
+                    format!("{key}={value}")
+                } else {
+                    format!("{key}={value:?}")
+                }
+            }
+        }
+    }
 }
 
 impl Error {

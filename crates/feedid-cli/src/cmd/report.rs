@@ -34,10 +34,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         .into_iter()
         .map(|m| {
             let cfg = EngineConfig {
-                window: match a.windows.window {
-                    Some(w) => w.samples(rate, "window")?,
-                    None => m.default_window(),
-                },
+                window: m.window_for(a.windows.window, rate)?,
                 horizon: a.windows.horizon.samples(rate, "horizon")?,
                 hop: a.windows.hop.map(|h| h.samples(rate, "hop")).transpose()?,
                 warm_up: 0,

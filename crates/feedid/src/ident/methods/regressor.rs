@@ -19,6 +19,21 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::ident::{LinearModel, Signals};
 
+/// Option `order` of the methods with an ARX regressor: its [`ArxOrders`]
+/// (`auto` as a value — choose them from the recording — is the front
+/// ends' to handle, before [`crate::ident::Method::set_option`]).
+pub(crate) const ORDER_OPTION: crate::ident::OptionSpec = crate::ident::OptionSpec {
+    key: "order",
+    python: None,
+    value_name: "NA,NB,NK|auto",
+    kind: crate::ident::OptionKind::Orders,
+    range: None,
+    unit: None,
+    help: "ARX orders `na,nb,nk` (poles, input terms, input delay in samples), or `auto` \
+           (chosen from the recording by BIC; identify only)",
+    requires: None,
+};
+
 /// Largest accepted `na` and `nb` (guards against absurd allocations).
 pub const MAX_ARX_ORDER: usize = 64;
 

@@ -315,7 +315,7 @@ pub enum Error {
     // --- compensate
     /// No smoothing allowed brings the compensated command within a limit,
     /// and the plain trajectory exceeds it too.
-    #[error("the command {quantity} cannot be brought within the limit {limit} {unit}: with the most smoothing allowed (σ up to {smoothing_ms:.3} ms) the compensated command still peaks at {achievable:.4} {unit} at t = {time:.4} s, and the desired trajectory itself at {plain:.4} {unit}; raise the limit or --max-smoothing, or slow the trajectory")]
+    #[error("{}", self.message(Syntax::Library))]
     LimitUnreachable {
         /// `"velocity"` or `"acceleration"`.
         quantity: &'static str,
@@ -346,7 +346,7 @@ pub enum Error {
     },
 
     /// A computed command violates a velocity or acceleration limit.
-    #[error("command {quantity} {value:.4} {unit} at t = {time:.4} s exceeds the limit {limit} {unit}; {hint}")]
+    #[error("{}", self.message(Syntax::Library))]
     LimitExceeded {
         /// `"velocity"` or `"acceleration"`.
         quantity: &'static str,
@@ -358,8 +358,8 @@ pub enum Error {
         unit: &'static str,
         /// Time of the peak \[s\].
         time: f64,
-        /// What to change.
-        hint: &'static str,
+        /// The settings that would allow the command (`smooth = auto`, `max_smoothing`).
+        hints: &'static [Hint],
     },
 
     // --- harden
@@ -436,7 +436,118 @@ impl Syntax {
     }
 }
 
+/// A setting a message suggests, kept apart from the text so that each
+/// front end phrases it in its own syntax ([`Error::message`]): `--unit mm`
+/// on the command line, `unit="mm"` in Python, `unit = mm` in the library's
+/// own text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hint {
+    /// Set option `key` to `value` (`--smooth auto`).
+    SetOption {
+        /// The option's key, snake_case (`"smooth"`).
+        key: &'static str,
+        /// The value (`"auto"`).
+        value: &'static str,
+    },
+    /// Change option `key` (`--max-smoothing`).
+    Option {
+        /// The option's key, snake_case (`"max_smoothing"`).
+        key: &'static str,
+    },
+}
+
+impl Hint {
+    /// The hint in `syntax`: `--smooth auto` / `smooth="auto"` / `smooth = auto`,
+    /// or the option alone: `--max-smoothing` / `max_smoothing`.
+    pub fn phrase(&self, syntax: Syntax) -> String {
+        match *self {
+            Hint::SetOption { key, value } => syntax.setting(key, value),
+            Hint::Option { key } => match syntax {
+                Syntax::Cli => format!("--{}", key.replace('_', "-")),
+                Syntax::Library | Syntax::Python => key.to_string(),
+            },
+        }
+    }
+}
+
+/// The hint of [`Error::LimitUnreachable`]: more smoothing.
+const MAX_SMOOTHING: Hint = Hint::Option {
+    key: "max_smoothing",
+};
+
+/// The hints of [`Error::LimitExceeded`]: smoothing.
+pub const SMOOTHING_HINTS: &[Hint] = &[
+    Hint::SetOption {
+        key: "smooth",
+        value: "auto",
+    },
+    MAX_SMOOTHING,
+];
+
+/// Hints joined by `, `.
+fn phrase_all(hints: &[Hint], syntax: Syntax) -> String {
+    hints
+        .iter()
+        .map(|h| h.phrase(syntax))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 impl Error {
+    /// The settings the message suggests (empty for most errors; those of
+    /// the wrapped error for [`Error::InFile`] and [`Error::Stage`]).
+    pub fn hints(&self) -> Vec<Hint> {
+        match self {
+            Error::LimitExceeded { hints, .. } => hints.to_vec(),
+            Error::LimitUnreachable { .. } => vec![MAX_SMOOTHING],
+            Error::InFile { source, .. } | Error::Stage { source, .. } => source.hints(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The message with its hints in a front end's syntax (`Display` is
+    /// [`Syntax::Library`]'s): the CLI names `--max-smoothing`, Python
+    /// `max_smoothing`.
+    pub fn message(&self, syntax: Syntax) -> String {
+        match self {
+            Error::LimitUnreachable {
+                quantity,
+                achievable,
+                time,
+                limit,
+                plain,
+                unit,
+                smoothing_ms,
+            } => format!(
+                "the command {quantity} cannot be brought within the limit {limit} {unit}: with \
+                 the most smoothing allowed (σ up to {smoothing_ms:.3} ms) the compensated \
+                 command still peaks at {achievable:.4} {unit} at t = {time:.4} s, and the \
+                 desired trajectory itself at {plain:.4} {unit}; raise the limit or {}, or slow \
+                 the trajectory",
+                MAX_SMOOTHING.phrase(syntax)
+            ),
+            Error::LimitExceeded {
+                quantity,
+                value,
+                limit,
+                unit,
+                time,
+                hints,
+            } => format!(
+                "command {quantity} {value:.4} {unit} at t = {time:.4} s exceeds the limit \
+                 {limit} {unit}; allow smoothing ({}) or raise the limit",
+                phrase_all(hints, syntax)
+            ),
+            Error::InFile {
+                path,
+                location,
+                source,
+            } => display_in_file_text(path, location, &source.message(syntax)),
+            Error::Stage { stage, source } => format!("{stage}: {}", source.message(syntax)),
+            other => other.to_string(),
+        }
+    }
+
     /// The innermost error: the wrapped one for [`Error::InFile`] and
     /// [`Error::Stage`], else `self`.
     pub fn root(&self) -> &Error {
@@ -448,6 +559,11 @@ impl Error {
 }
 
 fn display_in_file(path: &std::path::Path, location: &str, source: &Error) -> String {
+    display_in_file_text(path, location, &source.to_string())
+}
+
+/// [`Error::InFile`]'s text around the wrapped error's text.
+fn display_in_file_text(path: &std::path::Path, location: &str, source: &str) -> String {
     if location.is_empty() {
         format!("{}: {source}", path.display())
     } else {
@@ -509,5 +625,47 @@ mod tests {
             e.to_string(),
             "invalid value for `duration`: 1e300 (too long)"
         );
+    }
+
+    #[test]
+    fn hints_are_phrased_in_each_front_ends_syntax() {
+        let e = Error::LimitExceeded {
+            quantity: "velocity",
+            value: 2.0,
+            limit: 1.0,
+            unit: "m/s",
+            time: 0.5,
+            hints: SMOOTHING_HINTS,
+        };
+        let wrapped = Error::Stage {
+            stage: "compensation",
+            source: Box::new(e),
+        };
+        assert!(wrapped
+            .to_string()
+            .ends_with("allow smoothing (smooth = auto, max_smoothing) or raise the limit"));
+        assert!(wrapped
+            .message(Syntax::Cli)
+            .ends_with("allow smoothing (--smooth auto, --max-smoothing) or raise the limit"));
+        assert!(wrapped
+            .message(Syntax::Python)
+            .ends_with("allow smoothing (smooth=\"auto\", max_smoothing) or raise the limit"));
+        assert_eq!(wrapped.hints(), SMOOTHING_HINTS);
+        let e = Error::LimitUnreachable {
+            quantity: "velocity",
+            achievable: 2.0,
+            time: 0.5,
+            limit: 1.0,
+            plain: 1.5,
+            unit: "m/s",
+            smoothing_ms: 20.0,
+        };
+        assert!(e.to_string().contains("raise the limit or max_smoothing,"));
+        assert!(e
+            .message(Syntax::Cli)
+            .contains("raise the limit or --max-smoothing,"));
+        assert_eq!(e.to_string(), e.message(Syntax::Library));
+        // no flag of the command line in the library's own text
+        assert!(!e.to_string().contains("--"));
     }
 }

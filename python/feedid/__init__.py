@@ -381,9 +381,10 @@ def identify(
         not copied (others are converted first); do not change them while
         ``identify`` runs.
     method : str
-        ``auto`` (default), ``arx``, ``rls``, ``oe``, ``paper``.
+        {method_names}
     window : int, optional
-        Window length W [samples]; default: the method's own (as the CLI).
+        Window length W [samples]; default: the method's own (as the CLI:
+        {method_windows}).
     horizon : int
         Prediction horizon H [samples]; default 10 (2 ms at 5 kHz).
     order : str or (na, nb, nk), optional
@@ -480,9 +481,9 @@ class Streamer:
         Sampling rate [Hz]; with it the intervals are exact (a skipped line
         is a gap). Default: the running mean interval.
     method : str
-        ``auto`` (default), ``arx``, ``rls``, ``oe``, ``paper``.
+        {method_names}
     window : int, optional
-        Window length W [samples]; default the method's own.
+        Window length W [samples]; default the method's own ({method_windows}).
     horizon : int
         Prediction horizon H [samples]; default 10.
     hop : int, optional
@@ -575,8 +576,23 @@ class Streamer:
         return self._s.dt
 
 
-identify.__doc__ = (identify.__doc__ or "").replace("{method_options}", _options_doc(" " * 8))
-Streamer.__doc__ = (Streamer.__doc__ or "").replace("{method_options}", _options_doc(" " * 8))
+def _fill_doc(doc: Optional[str]) -> str:
+    """A docstring with the library's methods and options filled in."""
+    methods = _feedid.methods()
+    names = ", ".join(
+        f"``{m['name']}``" + (" (default)" if i == 0 else "") for i, m in enumerate(methods)
+    )
+    windows = ", ".join(f"{m['name']} {m['default_window']}" for m in methods)
+    return (
+        (doc or "")
+        .replace("{method_names}", names + ".")
+        .replace("{method_windows}", windows)
+        .replace("{method_options}", _options_doc(" " * 8))
+    )
+
+
+identify.__doc__ = _fill_doc(identify.__doc__)
+Streamer.__doc__ = _fill_doc(Streamer.__doc__)
 
 
 class OnlineCompensator:

@@ -42,7 +42,9 @@ def test_the_stubs_have_every_option_with_its_type_and_default():
 
 def test_the_docstrings_name_every_option_with_its_help():
     for doc in (feedid.identify.__doc__, feedid.Streamer.__doc__):
-        assert "{method_options}" not in doc
+        assert "{method_" not in doc
+        for m in _feedid.methods():
+            assert f"``{m['name']}``" in doc and f"{m['name']} {m['default_window']}" in doc
         flat = re.sub(r"\s+", " ", doc)
         for s in _feedid.method_options():
             assert re.search(rf"\b{s['key']}\b", flat), s["key"]

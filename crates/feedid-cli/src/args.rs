@@ -264,6 +264,20 @@ fn window_help() -> String {
     )
 }
 
+/// The methods `feedid report` compares by default.
+pub const REPORT_METHODS: &str = "paper,arx,rls,oe,auto";
+
+/// The methods `feedid sweep` compares by default.
+pub const SWEEP_METHODS: &str = "paper,arx";
+
+/// `--methods`' help, with every method's name and the default list.
+fn methods_help(default: &str) -> String {
+    format!(
+        "Methods, comma-separated: {} [default: {default}]",
+        feedid::ident::METHOD_NAMES
+    )
+}
+
 /// `--method`'s help, with every method's name.
 fn method_help() -> String {
     format!(
@@ -461,8 +475,8 @@ pub struct ReportArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: paper,arx,rls,oe,auto].
-    #[arg(long, value_name = "LIST")]
+    /// Methods, comma-separated [default: paper,arx,rls,oe,auto].
+    #[arg(long, value_name = "LIST", help = methods_help(REPORT_METHODS))]
     pub methods: Option<String>,
     /// Options of the methods (each goes to the methods that have it).
     #[command(flatten)]
@@ -492,8 +506,8 @@ pub struct SweepArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: paper,arx].
-    #[arg(long, value_name = "LIST")]
+    /// Methods, comma-separated [default: paper,arx].
+    #[arg(long, value_name = "LIST", help = methods_help(SWEEP_METHODS))]
     pub methods: Option<String>,
     /// Options of the methods (each goes to the methods that have it).
     #[command(flatten)]

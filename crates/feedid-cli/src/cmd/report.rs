@@ -16,7 +16,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     }
     let methods = a
         .options
-        .methods(a.methods.as_deref(), "paper,arx,rls,oe,auto")?;
+        .methods(a.methods.as_deref(), crate::args::REPORT_METHODS)?;
     if !(a.zoom.is_finite() && a.zoom > 0.0) {
         bail!(
             "invalid --zoom {}: must be a positive number of milliseconds",

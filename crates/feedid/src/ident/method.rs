@@ -16,17 +16,32 @@
 //! 8,8,0); its other candidates stay as they are. Setting
 //! orders on a method without an ARX regressor is an error, not ignored.
 //!
+//! # Options
+//!
+//! Each option is described once, as an [`OptionSpec`] (key, Python
+//! keyword, value type, range, unit, help) next to the method that has it;
+//! a method lists its options ([`MethodOption`]) in its settings' `impl
+//! MethodSettings`, which also reads and sets them. [`Method::options`]
+//! gathers every option with the methods that have it and their defaults;
+//! [`Method::set_option`] parses, range-checks and sets one. The CLI's
+//! flags and help, Python's keywords, docstrings and stubs come from these
+//! descriptions.
+//!
 //! # Adding a method
 //!
 //! 1. a module under `ident/methods/` with its settings (`Default`,
-//!    `validate`, `build`) and its [`Estimator`];
-//! 2. its `mod` and `pub use` lines in `ident/methods/mod.rs` (and the
-//!    `pub use` in `ident/mod.rs`);
-//! 3. a variant of [`Method`] here and its name in [`Method::all`]; the
-//!    compiler then lists every `match` below that needs an arm.
+//!    `validate`, `build`), its [`Estimator`], the [`OptionSpec`] of each
+//!    option of its own and `impl MethodSettings` for the settings;
+//! 2. its `mod` and `pub use` lines in `ident/methods/mod.rs`;
+//! 3. a variant of [`Method`] here, its entry in [`Method::all`] and
+//!    [`METHOD_NAMES`]; the compiler then lists every `match` below that
+//!    needs an arm.
 //!
-//! The pipeline, the CLI (`--method NAME`), the streamer, sweeps and reports
-//! take the method from here and need no change.
+//! The pipeline, the CLI (`--method NAME` and one flag per option), the
+//! streamer, sweeps, reports and the Python package take the method and its
+//! options from here and need no change; the Python stubs' option lines are
+//! regenerated (`FEEDID_UPDATE_STUBS=1 cargo test -p feedid-cli --test
+//! options`).
 //!
 //! ```
 //! use feedid::ident::{ArxOrders, Method};

@@ -3,7 +3,7 @@
 //! (report, sweep) with the shared [`MethodOptions`].
 
 use anyhow::{bail, Context, Result};
-use feedid::error::Syntax;
+use feedid::error::{Hint, Syntax};
 use feedid::ident::{ArxOrders, Method};
 
 use crate::args::MethodOptions;
@@ -43,7 +43,7 @@ impl MethodOptions {
     pub fn apply(&self, method: &mut Method) -> Result<Vec<String>> {
         let mut missing = Vec::new();
         for (key, value) in &self.values {
-            let flag = || Syntax::Cli.setting(key, "").trim_end().to_string();
+            let flag = || Hint::Option { key }.phrase(Syntax::Cli);
             if *key == "order" && is_select(value) {
                 if !method.has_option(key) {
                     missing.push(flag());

@@ -34,6 +34,20 @@ pub(crate) const ORDER_OPTION: crate::ident::OptionSpec = crate::ident::OptionSp
     requires: None,
 };
 
+/// Option `ridge` of the least-squares fits on the ARX regressor: `arx`
+/// ([`crate::ident::ArxConfig::ridge`]) and `auto`'s windowed candidates.
+pub(crate) const RIDGE_OPTION: crate::ident::OptionSpec = crate::ident::OptionSpec {
+    key: "ridge",
+    python: None,
+    value_name: "R",
+    kind: crate::ident::OptionKind::Float,
+    range: Some(crate::ident::OptionRange::at_least(0.0)),
+    unit: None,
+    help: "ridge of the least squares, relative to the regressors' scale (arx: on the \
+           column-normalised coefficients; 0 = none)",
+    requires: None,
+};
+
 /// Largest accepted `na` and `nb` (guards against absurd allocations).
 pub const MAX_ARX_ORDER: usize = 64;
 

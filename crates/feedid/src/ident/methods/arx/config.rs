@@ -6,21 +6,8 @@
 use super::estimator::ArxEstimator;
 use crate::error::{Error, Result};
 use crate::ident::method::MethodSettings;
-use crate::ident::methods::regressor::{ArxOrders, ORDER_OPTION};
-use crate::ident::{MethodOption, OptionKind, OptionRange, OptionSpec, OptionValue};
-
-/// Option `ridge` of `arx` and of `auto`'s windowed candidates ([`ArxConfig::ridge`]).
-pub(crate) const RIDGE_OPTION: OptionSpec = OptionSpec {
-    key: "ridge",
-    python: None,
-    value_name: "R",
-    kind: OptionKind::Float,
-    range: Some(OptionRange::at_least(0.0)),
-    unit: None,
-    help: "ridge of the least squares, relative to the regressors' scale (arx: on the \
-           column-normalised coefficients; 0 = none)",
-    requires: None,
-};
+use crate::ident::methods::regressor::{ArxOrders, ORDER_OPTION, RIDGE_OPTION};
+use crate::ident::{MethodOption, OptionValue};
 
 impl MethodSettings for ArxConfig {
     fn options(&self) -> &'static [MethodOption] {

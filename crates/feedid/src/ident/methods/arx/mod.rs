@@ -110,7 +110,6 @@ mod fit;
 mod tests;
 
 pub use config::ArxConfig;
-pub(crate) use config::RIDGE_OPTION;
 pub use estimator::{ArxDiagnostics, ArxEstimator};
 pub(crate) use fit::fit_arx_rows;
 pub use fit::{fit_arx, fit_arx_segments, ArxFit};

@@ -7,8 +7,7 @@ use super::candidate::Candidate;
 use super::estimator::AutoEstimator;
 use crate::error::{Error, Result};
 use crate::ident::method::MethodSettings;
-use crate::ident::methods::arx::RIDGE_OPTION;
-use crate::ident::methods::regressor::ORDER_OPTION;
+use crate::ident::methods::regressor::{ORDER_OPTION, RIDGE_OPTION};
 use crate::ident::{ArxOrders, MethodOption, OptionValue};
 
 impl MethodSettings for AutoConfig {

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import os
+import textwrap
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -88,7 +89,39 @@ def _array(x: Any, name: str) -> np.ndarray:
     return a
 
 
-_METHOD_OPTIONS = ("solver", "time_origin", "prediction", "simplex_start", "lambda", "lambda_", "ridge")
+# The method options as the library describes them (``_feedid.method_options()``:
+# key, Python keyword, type, range, help, the methods that have it and their
+# defaults); ``order`` is a parameter of its own.
+_OPTION_SPECS: List[Dict[str, Any]] = [
+    s for s in _feedid.method_options() if s["key"] != "order"
+]
+
+# Accepted keywords of the method options → the native keyword: the
+# library's key (``lambda``) and its Python keyword (``lambda_``).
+_METHOD_OPTIONS: Dict[str, str] = {
+    **{s["key"]: s["python"] for s in _OPTION_SPECS},
+    **{s["python"]: s["python"] for s in _OPTION_SPECS},
+}
+
+
+def _options_doc(indent: str) -> str:
+    """The method options' entries for a docstring, from the library's descriptions."""
+    lines = []
+    for s in _OPTION_SPECS:
+        name = f"``{s['key']}``"
+        if s["python"] != s["key"]:
+            name += f" or ``{s['python']}``"
+        kind = {"float": "float", "int": "int"}.get(s["kind"], "str")
+        lines.append(
+            textwrap.fill(
+                f"{name} ({kind}): {s['help']}.",
+                width=76,
+                initial_indent=indent,
+                subsequent_indent=indent + "    ",
+                break_on_hyphens=False,
+            )
+        )
+    return "\n".join(lines)
 
 
 def _method_options(order: Any, options: Mapping[str, Any]) -> Dict[str, Any]:
@@ -96,12 +129,9 @@ def _method_options(order: Any, options: Mapping[str, Any]) -> Dict[str, Any]:
     out: Dict[str, Any] = {}
     for key, value in options.items():
         if key not in _METHOD_OPTIONS:
-            raise TypeError(
-                f"unknown option {key!r}; method options are: "
-                "solver, time_origin, prediction, simplex_start (paper), lambda (rls), "
-                "ridge (arx, auto)"
-            )
-        out["lambda_" if key == "lambda" else key] = value
+            known = "; ".join(f"{s['key']} ({s['applies_to']})" for s in _OPTION_SPECS)
+            raise TypeError(f"unknown option {key!r}; method options are: {known}")
+        out[_METHOD_OPTIONS[key]] = value
     if order is not None:
         if isinstance(order, str):
             out["order"] = order
@@ -351,9 +381,10 @@ def identify(
         not copied (others are converted first); do not change them while
         ``identify`` runs.
     method : str
-        ``auto`` (default), ``arx``, ``rls``, ``oe``, ``paper``.
+        {method_names}
     window : int, optional
-        Window length W [samples]; default: the method's own (as the CLI).
+        Window length W [samples]; default: the method's own (as the CLI:
+        {method_windows}).
     horizon : int
         Prediction horizon H [samples]; default 10 (2 ms at 5 kHz).
     order : str or (na, nb, nk), optional
@@ -391,9 +422,10 @@ def identify(
         summary counts ``runaway_windows``, ``runaway_samples``); None keeps
         every prediction as the method made it.
     **options
-        Method options: ``solver``, ``time_origin``, ``prediction``,
-        ``simplex_start`` (paper), ``lambda`` (rls forgetting factor),
-        ``ridge`` (arx, auto: ridge of the least squares).
+        Method options (each given to a method that does not have it is an
+        :class:`InputError`):
+
+{method_options}
 
     Returns
     -------
@@ -449,9 +481,9 @@ class Streamer:
         Sampling rate [Hz]; with it the intervals are exact (a skipped line
         is a gap). Default: the running mean interval.
     method : str
-        ``auto`` (default), ``arx``, ``rls``, ``oe``, ``paper``.
+        {method_names}
     window : int, optional
-        Window length W [samples]; default the method's own.
+        Window length W [samples]; default the method's own ({method_windows}).
     horizon : int
         Prediction horizon H [samples]; default 10.
     hop : int, optional
@@ -472,7 +504,9 @@ class Streamer:
     runaway : float or None
         The runaway cut as for :func:`identify` (default 1.5; None: off).
     **options
-        Method options as for :func:`identify`.
+        Method options as for :func:`identify`:
+
+{method_options}
 
     ``push`` and ``finish`` return lists of ``(time [s], predicted [m],
     lower [m], upper [m])``.
@@ -540,6 +574,25 @@ class Streamer:
     def dt(self) -> Optional[float]:
         """The sampling interval in use [s] (None before two samples)."""
         return self._s.dt
+
+
+def _fill_doc(doc: Optional[str]) -> str:
+    """A docstring with the library's methods and options filled in."""
+    methods = _feedid.methods()
+    names = ", ".join(
+        f"``{m['name']}``" + (" (default)" if i == 0 else "") for i, m in enumerate(methods)
+    )
+    windows = ", ".join(f"{m['name']} {m['default_window']}" for m in methods)
+    return (
+        (doc or "")
+        .replace("{method_names}", names + ".")
+        .replace("{method_windows}", windows)
+        .replace("{method_options}", _options_doc(" " * 8))
+    )
+
+
+identify.__doc__ = _fill_doc(identify.__doc__)
+Streamer.__doc__ = _fill_doc(Streamer.__doc__)
 
 
 class OnlineCompensator:

@@ -84,15 +84,17 @@ class Streamer:
         command_lead: int = 0,
         extrapolate: Optional[str] = None,
         jitter_tol: float = 0.01,
-        order: Optional[str] = None,
+        interval: float = 95.0,
+        runaway: Optional[float] = 1.5,
+        # method options: generated from the library's option descriptions (FEEDID_UPDATE_STUBS=1 cargo test -p feedid-cli --test options)
         solver: Optional[str] = None,
         time_origin: Optional[str] = None,
         prediction: Optional[str] = None,
         simplex_start: Optional[str] = None,
-        lambda_: Optional[float] = None,
+        order: Optional[str] = None,
         ridge: Optional[float] = None,
-        interval: float = 95.0,
-        runaway: Optional[float] = 1.5,
+        lambda_: Optional[float] = None,
+        # end of method options
     ) -> None: ...
     def push(self, t: float, u: float, y: float) -> List[_Row]: ...
     def push_many(
@@ -106,6 +108,9 @@ class Streamer:
     def stats(self) -> Dict[str, Any]: ...
     @property
     def dt(self) -> Optional[float]: ...
+
+def method_options() -> List[Dict[str, Any]]: ...
+def methods() -> List[Dict[str, Any]]: ...
 
 def read(
     path: str,
@@ -133,13 +138,6 @@ def identify(
     window: Optional[int] = None,
     horizon: int = 10,
     hop: Optional[int] = None,
-    order: Optional[str] = None,
-    solver: Optional[str] = None,
-    time_origin: Optional[str] = None,
-    prediction: Optional[str] = None,
-    simplex_start: Optional[str] = None,
-    lambda_: Optional[float] = None,
-    ridge: Optional[float] = None,
     interval: float = 95.0,
     runaway: Optional[float] = 1.5,
     params_path: Optional[str] = None,
@@ -148,6 +146,15 @@ def identify(
     nominal: bool = True,
     global_model: bool = True,
     residuals: bool = True,
+    # method options: generated from the library's option descriptions (FEEDID_UPDATE_STUBS=1 cargo test -p feedid-cli --test options)
+    solver: Optional[str] = None,
+    time_origin: Optional[str] = None,
+    prediction: Optional[str] = None,
+    simplex_start: Optional[str] = None,
+    order: Optional[str] = None,
+    ridge: Optional[float] = None,
+    lambda_: Optional[float] = None,
+    # end of method options
 ) -> Dict[str, Any]: ...
 def simulate(
     scenario: str,

@@ -1,7 +1,8 @@
 //! Library errors as Python exceptions: `feedid.FileError` (an `OSError`)
 //! for files that cannot be opened or read, `feedid.InputError` (a
 //! `ValueError`) for everything else; both are `feedid.Error`. The message
-//! is the library's, as the command-line tool prints it.
+//! is the library's, its hints phrased as Python keywords (`max_smoothing`
+//! where the command-line tool says `--max-smoothing`).
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -23,11 +24,13 @@ fn raise(class: &str, message: String) -> PyErr {
 
 /// A library error as `feedid.FileError` or `feedid.InputError`.
 pub fn to_py(e: feedid::Error) -> PyErr {
+    // the library's hints as Python keywords (`max_smoothing`)
+    let message = e.message(feedid::error::Syntax::Python);
     match e {
         feedid::Error::Io { .. } | feedid::Error::InputTooLarge { .. } => {
-            raise("FileError", e.to_string())
+            raise("FileError", message)
         }
-        _ => raise("InputError", e.to_string()),
+        _ => raise("InputError", message),
     }
 }
 

@@ -23,13 +23,13 @@ use crate::recording::{slice, PyRecording};
 /// (`predicted`, `lower`, `upper` with NaN where nothing was predicted,
 /// `coefficients` windows × names, `coefficient_names`, `window_start`,
 /// `window_end`, `window_outcome`, `simulated`, `summary_json`,
-/// `model_json`, `warnings`).
+/// `model_json`, `warnings`). The method options are keyword arguments
+/// (`order`, `lambda_`, ...: [`feedid::ident::Method::options`]).
 #[pyfunction]
 #[pyo3(signature = (recording = None, *, time = None, command = None, position = None,
     jitter_tol = 0.01, method = "auto", window = None, horizon = 10, hop = None,
-    order = None, solver = None, time_origin = None, prediction = None, simplex_start = None, lambda_ = None,
-    ridge = None, interval = 95.0, runaway = Some(1.5), params_path = None, params_json = None, allow_unstable = false,
-    nominal = true, global_model = true, residuals = true))]
+    interval = 95.0, runaway = Some(1.5), params_path = None, params_json = None, allow_unstable = false,
+    nominal = true, global_model = true, residuals = true, **options))]
 #[allow(clippy::too_many_arguments)]
 pub fn identify<'py>(
     py: Python<'py>,
@@ -42,13 +42,6 @@ pub fn identify<'py>(
     window: Option<usize>,
     horizon: usize,
     hop: Option<usize>,
-    order: Option<String>,
-    solver: Option<String>,
-    time_origin: Option<String>,
-    prediction: Option<String>,
-    simplex_start: Option<String>,
-    lambda_: Option<f64>,
-    ridge: Option<f64>,
     interval: f64,
     runaway: Option<f64>,
     params_path: Option<String>,
@@ -57,16 +50,9 @@ pub fn identify<'py>(
     nominal: bool,
     global_model: bool,
     residuals: bool,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let options = MethodOptions {
-        order,
-        solver,
-        time_origin,
-        prediction,
-        simplex_start,
-        lambda: lambda_,
-        ridge,
-    };
+    let options = MethodOptions::from_kwargs(options)?;
     let method = options.method(method)?;
     let interval = crate::method::interval(interval)?;
     let runaway = crate::method::runaway(runaway)?;

@@ -27,6 +27,8 @@ fn _feedid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<online::PyOnlineCompensator>()?;
     m.add_function(wrap_pyfunction!(recording::read, m)?)?;
     m.add_function(wrap_pyfunction!(identify::identify, m)?)?;
+    m.add_function(wrap_pyfunction!(method::method_options, m)?)?;
+    m.add_function(wrap_pyfunction!(method::methods, m)?)?;
     m.add_function(wrap_pyfunction!(rig::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(rig::model, m)?)?;
     m.add_function(wrap_pyfunction!(rig::compensate, m)?)?;

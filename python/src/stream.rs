@@ -3,7 +3,7 @@
 //! the predictions that became due.
 
 use feedid::ident::stream::{CommandExtrapolation, StreamOptions, StreamStats};
-use feedid::ident::{EngineConfig, Estimator, GuardConfig, Regime, Streamer};
+use feedid::ident::{EngineConfig, Estimator, GuardConfig, Regime, Span, Streamer};
 use std::sync::{Mutex, MutexGuard};
 
 use numpy::PyReadonlyArray1;
@@ -96,9 +96,8 @@ fn stats_dict<'py>(py: Python<'py>, s: &StreamStats) -> PyResult<Bound<'py, PyDi
 impl PyStreamer {
     #[new]
     #[pyo3(signature = (*, rate = None, method = "auto", window = None, horizon = 10, hop = None,
-        command_lead = 0, extrapolate = None, jitter_tol = 0.01, order = None, solver = None,
-        time_origin = None, prediction = None, simplex_start = None, lambda_ = None, ridge = None,
-        interval = 95.0, runaway = Some(1.5)))]
+        command_lead = 0, extrapolate = None, jitter_tol = 0.01,
+        interval = 95.0, runaway = Some(1.5), **options))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         rate: Option<f64>,
@@ -109,25 +108,11 @@ impl PyStreamer {
         command_lead: usize,
         extrapolate: Option<String>,
         jitter_tol: f64,
-        order: Option<String>,
-        solver: Option<String>,
-        time_origin: Option<String>,
-        prediction: Option<String>,
-        simplex_start: Option<String>,
-        lambda_: Option<f64>,
-        ridge: Option<f64>,
         interval: f64,
         runaway: Option<f64>,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let options = MethodOptions {
-            order,
-            solver,
-            time_origin,
-            prediction,
-            simplex_start,
-            lambda: lambda_,
-            ridge,
-        };
+        let options = MethodOptions::from_kwargs(options)?;
         if matches!(options.order_option()?, Some(OrderOption::Select)) {
             return Err(input(
                 "order='auto' chooses the orders from a whole recording; a stream needs them given (na,nb,nk; `feedid order` chooses them)",
@@ -144,7 +129,9 @@ impl PyStreamer {
             }
         }
         let config = EngineConfig {
-            window: window.unwrap_or_else(|| method.default_window()),
+            window: method
+                .window_for(window.map(Span::Samples), f64::NAN)
+                .py_err()?,
             horizon,
             hop,
             warm_up: 0,

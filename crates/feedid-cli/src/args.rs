@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use feedid::ident::Span;
+use feedid::error::Syntax;
+use feedid::ident::{OptionKind, Span};
 
 /// Identify feed-drive dynamics in short sliding windows and predict the next milliseconds.
 #[derive(Debug, Parser)]
@@ -179,37 +180,62 @@ pub struct SimulateArgs {
 }
 
 /// The per-method options of every subcommand that takes a method
-/// (identify, stream, report, sweep), flattened into each; turned into
-/// [`feedid::ident::Method`]s by `cmd::method`. An option given for a method
-/// that does not have it is refused, never ignored.
-#[derive(Debug, Clone, Args)]
+/// (identify, stream, report, sweep), flattened into each: one flag per
+/// library option description ([`feedid::ident::Method::options`]: flag,
+/// value name, help with the methods that have it and their defaults),
+/// turned into [`feedid::ident::Method`]s by `cmd::method`. An option given
+/// for a method that does not have it is refused, never ignored.
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct MethodOptions {
-    /// paper: solver, qr (exact least squares) or simplex (Nelder–Mead, as in the paper) [default: qr].
-    #[arg(long, value_name = "NAME")]
-    pub solver: Option<String>,
-    /// paper: time origin, motion (start of motion) or window (each window's first sample; accurate coefficients, but it cannot predict a moving axis) [default: motion].
-    #[arg(long, value_name = "NAME")]
-    pub time_origin: Option<String>,
-    /// paper: prediction, polynomial (fitted output continued) or tf (identified Tf on the next command) [default: polynomial].
-    #[arg(long, value_name = "NAME")]
-    pub prediction: Option<String>,
-    /// paper with --solver simplex: start of each window's simplex, zeros (every window on its own, the default) or previous (the previous window's fit: fewer iterations, about 2.5× faster) [default: zeros].
-    #[arg(long, value_name = "NAME")]
-    pub simplex_start: Option<String>,
-    /// arx, rls, auto (its long-memory candidate): ARX orders `na,nb,nk`
-    /// (poles, input terms, input delay in samples), or `auto` (chosen from
-    /// the recording by BIC; identify only) [default: arx 3,3,0; rls 8,8,0;
-    /// auto 8,8,0].
-    #[arg(long, value_name = "NA,NB,NK|auto")]
-    pub order: Option<String>,
-    /// rls: forgetting factor λ (memory ≈ 1/(1−λ) samples) [default: 0.999].
-    #[arg(long, value_name = "LAMBDA")]
-    pub lambda: Option<f64>,
-    /// arx, auto (its windowed candidates): ridge of the least squares,
-    /// relative to the regressors' scale (arx: on the column-normalised
-    /// coefficients), ≥ 0, 0 = none [default: arx 1e-10; auto 0].
-    #[arg(long, value_name = "R")]
-    pub ridge: Option<f64>,
+    /// The options given: key (`"lambda"`) and value as text, in the order of
+    /// [`feedid::ident::Method::options`].
+    pub values: Vec<(&'static str, String)>,
+}
+
+impl clap::FromArgMatches for MethodOptions {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut values = Vec::new();
+        for o in feedid::ident::Method::options() {
+            let key = o.spec.key;
+            let v = match o.spec.kind {
+                OptionKind::Float => m.get_one::<f64>(key).map(f64::to_string),
+                OptionKind::Int => m.get_one::<usize>(key).map(usize::to_string),
+                OptionKind::Choice(_) | OptionKind::Orders => m.get_one::<String>(key).cloned(),
+            };
+            if let Some(v) = v {
+                values.push((key, v));
+            }
+        }
+        Ok(Self { values })
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+impl Args for MethodOptions {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        feedid::ident::Method::options()
+            .into_iter()
+            .fold(cmd, |cmd, o| {
+                let arg = clap::Arg::new(o.spec.key)
+                    .long(o.spec.flag().trim_start_matches('-').to_string())
+                    .value_name(o.spec.value_name)
+                    .help(o.help(Syntax::Cli))
+                    .action(clap::ArgAction::Set);
+                cmd.arg(match o.spec.kind {
+                    OptionKind::Float => arg.value_parser(clap::value_parser!(f64)),
+                    OptionKind::Int => arg.value_parser(clap::value_parser!(usize)),
+                    OptionKind::Choice(_) | OptionKind::Orders => arg,
+                })
+            })
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
 }
 
 /// Sliding-window options.
@@ -235,6 +261,20 @@ fn window_help() -> String {
     format!(
         "Window length W: samples, or a time with its unit (20ms, at the recording's rate); default: the method's, in samples ({})",
         defaults.join(", ")
+    )
+}
+
+/// The methods `feedid report` compares by default.
+pub const REPORT_METHODS: &str = "paper,arx,rls,oe,auto";
+
+/// The methods `feedid sweep` compares by default.
+pub const SWEEP_METHODS: &str = "paper,arx";
+
+/// `--methods`' help, with every method's name and the default list.
+fn methods_help(default: &str) -> String {
+    format!(
+        "Methods, comma-separated: {} [default: {default}]",
+        feedid::ident::METHOD_NAMES
     )
 }
 
@@ -435,8 +475,8 @@ pub struct ReportArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: paper,arx,rls,oe,auto].
-    #[arg(long, value_name = "LIST")]
+    /// Methods, comma-separated [default: paper,arx,rls,oe,auto].
+    #[arg(long, value_name = "LIST", help = methods_help(REPORT_METHODS))]
     pub methods: Option<String>,
     /// Options of the methods (each goes to the methods that have it).
     #[command(flatten)]
@@ -466,8 +506,8 @@ pub struct SweepArgs {
     /// How to read it.
     #[command(flatten)]
     pub recording: RecordingArgs,
-    /// Methods, comma-separated: auto, paper, arx, rls, oe [default: paper,arx].
-    #[arg(long, value_name = "LIST")]
+    /// Methods, comma-separated [default: paper,arx].
+    #[arg(long, value_name = "LIST", help = methods_help(SWEEP_METHODS))]
     pub methods: Option<String>,
     /// Options of the methods (each goes to the methods that have it).
     #[command(flatten)]

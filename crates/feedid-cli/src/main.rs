@@ -119,7 +119,12 @@ fn one_line(e: &anyhow::Error) -> String {
     let mut out = String::new();
     let mut previous = String::new();
     for cause in e.chain() {
-        let text = cause.to_string().replace(['\n', '\r'], " ");
+        // the library's hints in the command line's syntax (`--max-smoothing`)
+        let text = match cause.downcast_ref::<feedid::Error>() {
+            Some(e) => e.message(feedid::error::Syntax::Cli),
+            None => cause.to_string(),
+        };
+        let text = text.replace(['\n', '\r'], " ");
         if !out.is_empty() && previous.contains(&text) {
             previous = text;
             continue;

@@ -80,6 +80,38 @@ pub enum Error {
         applies_to: &'static str,
     },
 
+    /// A method option was given for a method that does not have it (it is
+    /// refused, never silently ignored).
+    #[error("option `{key}` does not apply to method {method} (only to {applies_to})")]
+    OptionNotApplicable {
+        /// The option's key (`"lambda"`).
+        key: &'static str,
+        /// The method it was given for.
+        method: &'static str,
+        /// The methods that have it (`"rls"`).
+        applies_to: String,
+    },
+
+    /// A method option's value does not parse or lies outside its range.
+    #[error("invalid {key} `{value}`: {expected}")]
+    InvalidOption {
+        /// The option's key (`"lambda"`).
+        key: &'static str,
+        /// The value as given.
+        value: String,
+        /// What is accepted (`"expected a number in (0, 1]"`).
+        expected: String,
+    },
+
+    /// No method has an option of this key.
+    #[error("unknown method option `{key}`; the options are: {known}")]
+    UnknownOption {
+        /// The key given.
+        key: String,
+        /// The keys of all method options, comma separated.
+        known: String,
+    },
+
     /// A rig parameter file could not be parsed (unknown key, wrong type, ...).
     #[error("{}: {message}", display_path(path))]
     ParamsFile {
@@ -283,7 +315,7 @@ pub enum Error {
     // --- compensate
     /// No smoothing allowed brings the compensated command within a limit,
     /// and the plain trajectory exceeds it too.
-    #[error("the command {quantity} cannot be brought within the limit {limit} {unit}: with the most smoothing allowed (σ up to {smoothing_ms:.3} ms) the compensated command still peaks at {achievable:.4} {unit} at t = {time:.4} s, and the desired trajectory itself at {plain:.4} {unit}; raise the limit or --max-smoothing, or slow the trajectory")]
+    #[error("{}", self.message(Syntax::Library))]
     LimitUnreachable {
         /// `"velocity"` or `"acceleration"`.
         quantity: &'static str,
@@ -314,7 +346,7 @@ pub enum Error {
     },
 
     /// A computed command violates a velocity or acceleration limit.
-    #[error("command {quantity} {value:.4} {unit} at t = {time:.4} s exceeds the limit {limit} {unit}; {hint}")]
+    #[error("{}", self.message(Syntax::Library))]
     LimitExceeded {
         /// `"velocity"` or `"acceleration"`.
         quantity: &'static str,
@@ -326,8 +358,8 @@ pub enum Error {
         unit: &'static str,
         /// Time of the peak \[s\].
         time: f64,
-        /// What to change.
-        hint: &'static str,
+        /// The settings that would allow the command (`smooth = auto`, `max_smoothing`).
+        hints: &'static [Hint],
     },
 
     // --- harden
@@ -367,7 +399,155 @@ pub enum Error {
     },
 }
 
+/// The syntax in which a message names a setting: each front end phrases
+/// the library's settings as its users type them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Syntax {
+    /// Neutral: `unit = mm`.
+    Library,
+    /// Command line: `--unit mm`.
+    Cli,
+    /// Python keyword: `unit="mm"` (numbers unquoted: `max_smoothing=0.05`).
+    Python,
+}
+
+impl Syntax {
+    /// The setting `key` = `value` in this syntax.
+    ///
+    /// ```
+    /// use feedid::error::Syntax;
+    /// assert_eq!(Syntax::Cli.setting("time_origin", "window"), "--time-origin window");
+    /// assert_eq!(Syntax::Python.setting("unit", "mm"), "unit=\"mm\"");
+    /// assert_eq!(Syntax::Python.setting("max_smoothing", "0.05"), "max_smoothing=0.05");
+    /// assert_eq!(Syntax::Library.setting("unit", "mm"), "unit = mm");
+    /// ```
+    pub fn setting(self, key: &str, value: &str) -> String {
+        match self {
+            Syntax::Library => format!("{key} = {value}"),
+            Syntax::Cli => format!("--{} {value}", key.replace('_', "-")),
+            Syntax::Python => {
+                if value.parse::<f64>().is_ok() {
+                    format!("{key}={value}")
+                } else {
+                    format!("{key}={value:?}")
+                }
+            }
+        }
+    }
+}
+
+/// A setting a message suggests, kept apart from the text so that each
+/// front end phrases it in its own syntax ([`Error::message`]): `--unit mm`
+/// on the command line, `unit="mm"` in Python, `unit = mm` in the library's
+/// own text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hint {
+    /// Set option `key` to `value` (`--smooth auto`).
+    SetOption {
+        /// The option's key, snake_case (`"smooth"`).
+        key: &'static str,
+        /// The value (`"auto"`).
+        value: &'static str,
+    },
+    /// Change option `key` (`--max-smoothing`).
+    Option {
+        /// The option's key, snake_case (`"max_smoothing"`).
+        key: &'static str,
+    },
+}
+
+impl Hint {
+    /// The hint in `syntax`: `--smooth auto` / `smooth="auto"` / `smooth = auto`,
+    /// or the option alone: `--max-smoothing` / `max_smoothing`.
+    pub fn phrase(&self, syntax: Syntax) -> String {
+        match *self {
+            Hint::SetOption { key, value } => syntax.setting(key, value),
+            Hint::Option { key } => match syntax {
+                Syntax::Cli => format!("--{}", key.replace('_', "-")),
+                Syntax::Library | Syntax::Python => key.to_string(),
+            },
+        }
+    }
+}
+
+/// The hint of [`Error::LimitUnreachable`]: more smoothing.
+const MAX_SMOOTHING: Hint = Hint::Option {
+    key: "max_smoothing",
+};
+
+/// The hints of [`Error::LimitExceeded`]: smoothing.
+pub const SMOOTHING_HINTS: &[Hint] = &[
+    Hint::SetOption {
+        key: "smooth",
+        value: "auto",
+    },
+    MAX_SMOOTHING,
+];
+
+/// Hints joined by `, `.
+fn phrase_all(hints: &[Hint], syntax: Syntax) -> String {
+    hints
+        .iter()
+        .map(|h| h.phrase(syntax))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 impl Error {
+    /// The settings the message suggests (empty for most errors; those of
+    /// the wrapped error for [`Error::InFile`] and [`Error::Stage`]).
+    pub fn hints(&self) -> Vec<Hint> {
+        match self {
+            Error::LimitExceeded { hints, .. } => hints.to_vec(),
+            Error::LimitUnreachable { .. } => vec![MAX_SMOOTHING],
+            Error::InFile { source, .. } | Error::Stage { source, .. } => source.hints(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The message with its hints in a front end's syntax (`Display` is
+    /// [`Syntax::Library`]'s): the CLI names `--max-smoothing`, Python
+    /// `max_smoothing`.
+    pub fn message(&self, syntax: Syntax) -> String {
+        match self {
+            Error::LimitUnreachable {
+                quantity,
+                achievable,
+                time,
+                limit,
+                plain,
+                unit,
+                smoothing_ms,
+            } => format!(
+                "the command {quantity} cannot be brought within the limit {limit} {unit}: with \
+                 the most smoothing allowed (σ up to {smoothing_ms:.3} ms) the compensated \
+                 command still peaks at {achievable:.4} {unit} at t = {time:.4} s, and the \
+                 desired trajectory itself at {plain:.4} {unit}; raise the limit or {}, or slow \
+                 the trajectory",
+                MAX_SMOOTHING.phrase(syntax)
+            ),
+            Error::LimitExceeded {
+                quantity,
+                value,
+                limit,
+                unit,
+                time,
+                hints,
+            } => format!(
+                "command {quantity} {value:.4} {unit} at t = {time:.4} s exceeds the limit \
+                 {limit} {unit}; allow smoothing ({}) or raise the limit",
+                phrase_all(hints, syntax)
+            ),
+            Error::InFile {
+                path,
+                location,
+                source,
+            } => display_in_file_text(path, location, &source.message(syntax)),
+            Error::Stage { stage, source } => format!("{stage}: {}", source.message(syntax)),
+            other => other.to_string(),
+        }
+    }
+
     /// The innermost error: the wrapped one for [`Error::InFile`] and
     /// [`Error::Stage`], else `self`.
     pub fn root(&self) -> &Error {
@@ -379,6 +559,11 @@ impl Error {
 }
 
 fn display_in_file(path: &std::path::Path, location: &str, source: &Error) -> String {
+    display_in_file_text(path, location, &source.to_string())
+}
+
+/// [`Error::InFile`]'s text around the wrapped error's text.
+fn display_in_file_text(path: &std::path::Path, location: &str, source: &str) -> String {
     if location.is_empty() {
         format!("{}: {source}", path.display())
     } else {
@@ -440,5 +625,47 @@ mod tests {
             e.to_string(),
             "invalid value for `duration`: 1e300 (too long)"
         );
+    }
+
+    #[test]
+    fn hints_are_phrased_in_each_front_ends_syntax() {
+        let e = Error::LimitExceeded {
+            quantity: "velocity",
+            value: 2.0,
+            limit: 1.0,
+            unit: "m/s",
+            time: 0.5,
+            hints: SMOOTHING_HINTS,
+        };
+        let wrapped = Error::Stage {
+            stage: "compensation",
+            source: Box::new(e),
+        };
+        assert!(wrapped
+            .to_string()
+            .ends_with("allow smoothing (smooth = auto, max_smoothing) or raise the limit"));
+        assert!(wrapped
+            .message(Syntax::Cli)
+            .ends_with("allow smoothing (--smooth auto, --max-smoothing) or raise the limit"));
+        assert!(wrapped
+            .message(Syntax::Python)
+            .ends_with("allow smoothing (smooth=\"auto\", max_smoothing) or raise the limit"));
+        assert_eq!(wrapped.hints(), SMOOTHING_HINTS);
+        let e = Error::LimitUnreachable {
+            quantity: "velocity",
+            achievable: 2.0,
+            time: 0.5,
+            limit: 1.0,
+            plain: 1.5,
+            unit: "m/s",
+            smoothing_ms: 20.0,
+        };
+        assert!(e.to_string().contains("raise the limit or max_smoothing,"));
+        assert!(e
+            .message(Syntax::Cli)
+            .contains("raise the limit or --max-smoothing,"));
+        assert_eq!(e.to_string(), e.message(Syntax::Library));
+        // no flag of the command line in the library's own text
+        assert!(!e.to_string().contains("--"));
     }
 }

@@ -3,6 +3,7 @@
 //! (report, sweep) with the shared [`MethodOptions`].
 
 use anyhow::{bail, Context, Result};
+use feedid::error::{Hint, Syntax};
 use feedid::ident::{ArxOrders, Method};
 
 use crate::args::MethodOptions;
@@ -17,12 +18,20 @@ pub enum OrderOption {
 }
 
 impl MethodOptions {
+    /// These options, each given as `(key, value)` (as the flags would give them).
+    #[cfg(test)]
+    pub fn given(values: &[(&'static str, &str)]) -> Self {
+        Self {
+            values: values.iter().map(|&(k, v)| (k, v.to_string())).collect(),
+        }
+    }
+
     /// `--order`, parsed.
     pub fn order_option(&self) -> Result<Option<OrderOption>> {
-        let Some(o) = self.order.as_deref() else {
+        let Some((_, o)) = self.values.iter().find(|(k, _)| *k == "order") else {
             return Ok(None);
         };
-        if o.trim().eq_ignore_ascii_case("auto") {
+        if is_select(o) {
             return Ok(Some(OrderOption::Select));
         }
         Ok(Some(OrderOption::Orders(parse_orders(o)?)))
@@ -31,60 +40,23 @@ impl MethodOptions {
     /// Set every given option that `method` has; returns the flags of the
     /// given options it does not have (`--order auto` is left to the
     /// caller: see [`MethodOptions::order_option`]).
-    pub fn apply(&self, method: &mut Method) -> Result<Vec<&'static str>> {
+    pub fn apply(&self, method: &mut Method) -> Result<Vec<String>> {
         let mut missing = Vec::new();
-        if let Some(s) = &self.solver {
-            let v = s.parse()?;
-            match method {
-                Method::Paper(c) => c.solver = v,
-                _ => missing.push("--solver"),
-            }
-        }
-        if let Some(s) = &self.time_origin {
-            let v = s.parse()?;
-            match method {
-                Method::Paper(c) => c.time_origin = v,
-                _ => missing.push("--time-origin"),
-            }
-        }
-        if let Some(s) = &self.prediction {
-            let v = s.parse()?;
-            match method {
-                Method::Paper(c) => c.prediction = v,
-                _ => missing.push("--prediction"),
-            }
-        }
-        if let Some(s) = &self.simplex_start {
-            let v = s.parse()?;
-            match method {
-                Method::Paper(c) => c.simplex_start = v,
-                _ => missing.push("--simplex-start"),
-            }
-        }
-        match self.order_option()? {
-            Some(OrderOption::Orders(o)) => match method.set_orders(o) {
-                Ok(()) => {}
-                Err(feedid::Error::NotApplicable { .. }) => missing.push("--order"),
-                Err(e) => {
-                    return Err(e).with_context(|| {
-                        format!("--order {}", self.order.as_deref().unwrap_or_default())
-                    })
+        for (key, value) in &self.values {
+            let flag = || Hint::Option { key }.phrase(Syntax::Cli);
+            if *key == "order" && is_select(value) {
+                if !method.has_option(key) {
+                    missing.push(flag());
                 }
-            },
-            Some(OrderOption::Select) if method.orders().is_none() => missing.push("--order"),
-            _ => {}
-        }
-        if let Some(l) = self.lambda {
-            match method {
-                Method::Rls(c) => c.lambda = l,
-                _ => missing.push("--lambda"),
+                continue;
             }
-        }
-        if let Some(r) = self.ridge {
-            match method {
-                Method::Arx(c) => c.ridge = r,
-                Method::Auto(c) => c.set_ridge(r),
-                _ => missing.push("--ridge"),
+            match method.set_option(key, value) {
+                Ok(()) => {}
+                Err(feedid::Error::OptionNotApplicable { .. }) => missing.push(flag()),
+                Err(
+                    e @ (feedid::Error::InvalidOption { .. } | feedid::Error::InvalidChoice { .. }),
+                ) => return Err(e.into()),
+                Err(e) => return Err(e).with_context(|| format!("{} {value}", flag())),
             }
         }
         Ok(missing)
@@ -112,7 +84,7 @@ impl MethodOptions {
     pub fn methods(&self, list: Option<&str>, default: &str) -> Result<Vec<Method>> {
         let list = list.unwrap_or(default);
         let mut out = Vec::new();
-        let mut missing_everywhere: Option<Vec<&'static str>> = None;
+        let mut missing_everywhere: Option<Vec<String>> = None;
         for name in list.split(',').map(str::trim) {
             if name.is_empty() {
                 bail!("invalid --methods `{list}`: empty method name");
@@ -136,16 +108,18 @@ impl MethodOptions {
     }
 }
 
-/// The methods an option applies to, for messages.
-fn applies_to(flag: &str) -> &'static str {
-    match flag {
-        "--solver" | "--time-origin" | "--prediction" => "paper",
-        "--simplex-start" => "paper (with --solver simplex)",
-        "--order" => "arx, rls, auto",
-        "--lambda" => "rls",
-        "--ridge" => "arx, auto",
-        _ => "some methods",
-    }
+/// `--order auto`: choose the orders from the recording.
+fn is_select(value: &str) -> bool {
+    value.trim().eq_ignore_ascii_case("auto")
+}
+
+/// The methods the option of `flag` applies to, for messages (from the
+/// library's option descriptions).
+fn applies_to(flag: &str) -> String {
+    Method::options()
+        .into_iter()
+        .find(|o| o.spec.flag() == flag)
+        .map_or_else(|| "some methods".to_string(), |o| o.applies_to(Syntax::Cli))
 }
 
 /// `na,nb,nk` → orders.
@@ -165,24 +139,9 @@ pub fn parse_orders(s: &str) -> Result<ArxOrders> {
 mod tests {
     use super::*;
 
-    fn options() -> MethodOptions {
-        MethodOptions {
-            solver: None,
-            time_origin: None,
-            prediction: None,
-            simplex_start: None,
-            order: None,
-            lambda: None,
-            ridge: None,
-        }
-    }
-
     #[test]
     fn options_go_to_the_methods_that_have_them_and_are_refused_elsewhere() {
-        let o = MethodOptions {
-            order: Some("2,2,1".into()),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("order", "2,2,1")]);
         for name in ["arx", "rls", "auto"] {
             let m = o.method(name).unwrap();
             assert_eq!(m.orders(), Some(ArxOrders::new(2, 2, 1)), "{name}");
@@ -191,10 +150,7 @@ mod tests {
             let e = o.method(name).unwrap_err().to_string();
             assert!(e.contains("--order") && e.contains(name), "{e}");
         }
-        let o = MethodOptions {
-            solver: Some("simplex".into()),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("solver", "simplex")]);
         assert!(o.method("arx").is_err());
         let Method::Paper(c) = o.method("paper").unwrap() else {
             unreachable!()
@@ -206,38 +162,21 @@ mod tests {
         let e = o.methods(Some("arx,rls"), "").unwrap_err().to_string();
         assert!(e.contains("--solver") && e.contains("arx,rls"), "{e}");
         // the simplex start: with the simplex only
-        let o = MethodOptions {
-            solver: Some("simplex".into()),
-            simplex_start: Some("previous".into()),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("solver", "simplex"), ("simplex_start", "previous")]);
         let Method::Paper(c) = o.method("paper").unwrap() else {
             unreachable!()
         };
         assert_eq!(c.simplex_start, feedid::ident::SimplexStart::Previous);
-        let o = MethodOptions {
-            simplex_start: Some("previous".into()),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("simplex_start", "previous")]);
         let e = format!("{:#}", o.method("paper").unwrap_err());
         assert!(e.contains("simplex"), "{e}");
         assert!(o.method("arx").is_err());
-        let o = MethodOptions {
-            solver: Some("simplex".into()),
-            simplex_start: Some("last".into()),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("solver", "simplex"), ("simplex_start", "last")]);
         assert!(o.method("paper").unwrap_err().to_string().contains("last"));
         // bad values are named
-        let o = MethodOptions {
-            order: Some("2,2".into()),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("order", "2,2")]);
         assert!(o.method("arx").unwrap_err().to_string().contains("`2,2`"));
-        let o = MethodOptions {
-            ridge: Some(0.0),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("ridge", "0")]);
         let Method::Arx(c) = o.method("arx").unwrap() else {
             unreachable!()
         };
@@ -250,10 +189,7 @@ mod tests {
             _ => true,
         }));
         assert!(o.method("rls").unwrap_err().to_string().contains("--ridge"));
-        let o = MethodOptions {
-            ridge: Some(-1.0),
-            ..options()
-        };
+        let o = MethodOptions::given(&[("ridge", "-1")]);
         assert!(o.method("arx").is_err() && o.method("auto").is_err());
     }
 }

@@ -16,7 +16,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     }
     let methods = a
         .options
-        .methods(a.methods.as_deref(), "paper,arx,rls,oe,auto")?;
+        .methods(a.methods.as_deref(), crate::args::REPORT_METHODS)?;
     if !(a.zoom.is_finite() && a.zoom > 0.0) {
         bail!(
             "invalid --zoom {}: must be a positive number of milliseconds",
@@ -34,10 +34,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         .into_iter()
         .map(|m| {
             let cfg = EngineConfig {
-                window: match a.windows.window {
-                    Some(w) => w.samples(rate, "window")?,
-                    None => m.default_window(),
-                },
+                window: m.window_for(a.windows.window, rate)?,
                 horizon: a.windows.horizon.samples(rate, "horizon")?,
                 hop: a.windows.hop.map(|h| h.samples(rate, "hop")).transpose()?,
                 warm_up: 0,

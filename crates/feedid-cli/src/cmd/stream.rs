@@ -79,10 +79,7 @@ fn streamer(a: &StreamArgs, rate: Option<f64>) -> Result<Streamer<Box<dyn Estima
         None => f64::NAN,
     };
     let config = EngineConfig {
-        window: match a.windows.window {
-            Some(w) => w.samples(rate_hz, "window")?,
-            None => method.default_window(),
-        },
+        window: method.window_for(a.windows.window, rate_hz)?,
         horizon: a.windows.horizon.samples(rate_hz, "horizon")?,
         hop: a
             .windows

@@ -71,7 +71,9 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     if a.options.order_option()? == Some(OrderOption::Select) {
         bail!("--order auto is for `feedid identify`; sweep orders with --orders (na,nb,nk …)");
     }
-    let methods = a.options.methods(a.methods.as_deref(), "paper,arx")?;
+    let methods = a
+        .options
+        .methods(a.methods.as_deref(), crate::args::SWEEP_METHODS)?;
     let windows = parse_counts("--windows", &a.windows)?;
     let horizons = parse_counts("--horizons", &a.horizons)?;
     let orders = a

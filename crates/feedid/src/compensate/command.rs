@@ -691,7 +691,7 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
                 limit: cfg.max_velocity,
                 unit: "m/s",
                 time: pk.velocity_at as f64 * dt,
-                hint: LIMIT_HINT,
+                hints: LIMIT_HINT,
             });
         }
         if over(pk.acceleration, cfg.max_acceleration) {
@@ -701,7 +701,7 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
                 limit: cfg.max_acceleration,
                 unit: "m/s²",
                 time: pk.acceleration_at as f64 * dt,
-                hint: LIMIT_HINT,
+                hints: LIMIT_HINT,
             });
         }
         return Ok(Search::Met(c, sigma, zero, 0.0));
@@ -1005,7 +1005,7 @@ fn rms_error(e: &[f64], y: &[f64], scale: f64) -> f64 {
     (s / e.len() as f64).sqrt()
 }
 
-const LIMIT_HINT: &str = "allow smoothing (--smooth auto, --max-smoothing) or raise the limit";
+const LIMIT_HINT: &[crate::error::Hint] = crate::error::SMOOTHING_HINTS;
 
 #[cfg(test)]
 mod tests {

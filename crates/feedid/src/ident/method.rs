@@ -16,17 +16,32 @@
 //! 8,8,0); its other candidates stay as they are. Setting
 //! orders on a method without an ARX regressor is an error, not ignored.
 //!
+//! # Options
+//!
+//! Each option is described once, as an [`OptionSpec`] (key, Python
+//! keyword, value type, range, unit, help) next to the method that has it;
+//! a method lists its options ([`MethodOption`]) in its settings' `impl
+//! MethodSettings`, which also reads and sets them. [`Method::options`]
+//! gathers every option with the methods that have it and their defaults;
+//! [`Method::set_option`] parses, range-checks and sets one. The CLI's
+//! flags and help, Python's keywords, docstrings and stubs come from these
+//! descriptions.
+//!
 //! # Adding a method
 //!
 //! 1. a module under `ident/methods/` with its settings (`Default`,
-//!    `validate`, `build`) and its [`Estimator`];
-//! 2. its `mod` and `pub use` lines in `ident/methods/mod.rs` (and the
-//!    `pub use` in `ident/mod.rs`);
-//! 3. a variant of [`Method`] here and its name in [`Method::all`]; the
-//!    compiler then lists every `match` below that needs an arm.
+//!    `validate`, `build`), its [`Estimator`], the [`OptionSpec`] of each
+//!    option of its own and `impl MethodSettings` for the settings;
+//! 2. its `mod` and `pub use` lines in `ident/methods/mod.rs`;
+//! 3. a variant of [`Method`] here, its entry in [`Method::all`] and
+//!    [`METHOD_NAMES`]; the compiler then lists every `match` below that
+//!    needs an arm.
 //!
-//! The pipeline, the CLI (`--method NAME`), the streamer, sweeps and reports
-//! take the method from here and need no change.
+//! The pipeline, the CLI (`--method NAME` and one flag per option), the
+//! streamer, sweeps, reports and the Python package take the method and its
+//! options from here and need no change; the Python stubs' option lines are
+//! regenerated (`FEEDID_UPDATE_STUBS=1 cargo test -p feedid-cli --test
+//! options`).
 //!
 //! ```
 //! use feedid::ident::{ArxOrders, Method};
@@ -42,9 +57,10 @@
 use std::fmt;
 use std::str::FromStr;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Syntax};
 use crate::ident::{
     ArxConfig, ArxOrders, AutoConfig, Estimator, GlobalModelKind, OeConfig, PaperConfig, RlsConfig,
+    Span,
 };
 
 /// Accepted method names, for messages.
@@ -207,6 +223,478 @@ impl Method {
             Method::Auto(c) => Box::new(c.build()?),
         })
     }
+
+    /// The window in samples: `window` converted at `rate_hz` (a time needs
+    /// the rate), or the method's [`Method::default_window`] when `None` —
+    /// the one place every front end takes its default window from.
+    ///
+    /// ```
+    /// use feedid::ident::{Method, Span};
+    /// let m = Method::default();
+    /// assert_eq!(m.window_for(None, f64::NAN).unwrap(), 50);
+    /// assert_eq!(m.window_for(Some(Span::Seconds(0.01)), 5000.0).unwrap(), 50);
+    /// ```
+    pub fn window_for(&self, window: Option<Span>, rate_hz: f64) -> Result<usize> {
+        match window {
+            Some(w) => w.samples(rate_hz, "window"),
+            None => Ok(self.default_window()),
+        }
+    }
+
+    /// One line on what the method does, for help texts.
+    pub fn help(&self) -> &'static str {
+        match self {
+            Method::Paper(_) => "the paper's windowed polynomial least squares",
+            Method::Arx(_) => "windowed ARX with exact sliding update",
+            Method::Rls(_) => "recursive least squares with forgetting",
+            Method::Oe(_) => "continuous-time output error over sliding windows",
+            Method::Auto(_) => "validated choice of model, order and memory (the default)",
+        }
+    }
+
+    /// The method's description: name, label, help, default window, options.
+    pub fn describe(&self) -> MethodInfo {
+        MethodInfo {
+            name: self.name(),
+            label: self.label(),
+            help: self.help(),
+            default_window: self.default_window(),
+            takes_orders: self.orders().is_some(),
+            options: self.settings().options(),
+        }
+    }
+
+    /// The method's settings as the option interface.
+    fn settings(&self) -> &dyn MethodSettings {
+        match self {
+            Method::Paper(c) => c,
+            Method::Arx(c) => c,
+            Method::Rls(c) => c,
+            Method::Oe(c) => c,
+            Method::Auto(c) => c,
+        }
+    }
+
+    /// The method's settings as the option interface, to change.
+    fn settings_mut(&mut self) -> &mut dyn MethodSettings {
+        match self {
+            Method::Paper(c) => c,
+            Method::Arx(c) => c,
+            Method::Rls(c) => c,
+            Method::Oe(c) => c,
+            Method::Auto(c) => c,
+        }
+    }
+
+    /// Whether the method has the option `key`.
+    pub fn has_option(&self, key: &str) -> bool {
+        self.settings().options().iter().any(|o| o.spec.key == key)
+    }
+
+    /// The current value of option `key`, as text (`None`: the method has no such option).
+    pub fn option(&self, key: &str) -> Option<String> {
+        self.has_option(key)
+            .then(|| self.settings().option(key))
+            .flatten()
+            .map(|v| v.to_string())
+    }
+
+    /// Set option `key` (e.g. `"lambda"`) from its text `value`: parsed and
+    /// range-checked against its [`OptionSpec`].
+    ///
+    /// Errors: [`Error::UnknownOption`] for a key no method has;
+    /// [`Error::OptionNotApplicable`] for an option of other methods (it is
+    /// refused, never ignored); [`Error::InvalidOption`] or
+    /// [`Error::InvalidChoice`] for a value that does not parse or lies
+    /// outside the range; the method's own checks (e.g. invalid orders).
+    /// Nothing changes on error.
+    ///
+    /// ```
+    /// use feedid::ident::Method;
+    /// let mut m: Method = "rls".parse().unwrap();
+    /// m.set_option("lambda", "0.99").unwrap();
+    /// assert_eq!(m.option("lambda").as_deref(), Some("0.99"));
+    /// assert!(m.set_option("lambda", "2").is_err()); // outside (0, 1]
+    /// assert!(m.set_option("solver", "qr").is_err()); // paper's
+    /// ```
+    pub fn set_option(&mut self, key: &str, value: &str) -> Result<()> {
+        let Some(info) = Method::options().into_iter().find(|o| o.spec.key == key) else {
+            return Err(Error::UnknownOption {
+                key: key.to_string(),
+                known: Method::options()
+                    .iter()
+                    .map(|o| o.spec.key)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        };
+        if !self.has_option(key) {
+            return Err(Error::OptionNotApplicable {
+                key: info.spec.key,
+                method: self.name(),
+                applies_to: info.applies_to(Syntax::Library),
+            });
+        }
+        let v = info.spec.parse(value)?;
+        let mut changed = self.clone();
+        changed.settings_mut().set_option(info.spec.key, &v)?;
+        *self = changed;
+        Ok(())
+    }
+
+    /// Every method option, each once, with the methods that have it and
+    /// their defaults (in the order of [`Method::by_specificity`]).
+    pub fn options() -> Vec<OptionInfo> {
+        let mut out: Vec<OptionInfo> = Vec::new();
+        for m in Method::by_specificity() {
+            for o in m.settings().options() {
+                let default = m
+                    .settings()
+                    .option(o.spec.key)
+                    .map(|v| v.to_string())
+                    .unwrap_or_default();
+                let used = OptionUse {
+                    method: m.name(),
+                    note: o.note,
+                    default,
+                };
+                match out.iter_mut().find(|i| i.spec.key == o.spec.key) {
+                    Some(i) => i.methods.push(used),
+                    None => out.push(OptionInfo {
+                        spec: o.spec,
+                        methods: vec![used],
+                    }),
+                }
+            }
+        }
+        out
+    }
+
+    /// Every method with its default settings, `auto` last (it combines the
+    /// others, and its options go to its candidates): the order in which
+    /// option help lists the methods.
+    pub fn by_specificity() -> Vec<Method> {
+        let mut all = Method::all().to_vec();
+        all.sort_by_key(|m| matches!(m, Method::Auto(_)));
+        all
+    }
+}
+
+// ------------------------------------------------------------ descriptions
+
+/// A method's description, for help texts and bindings ([`Method::describe`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MethodInfo {
+    /// Name as on the command line (`"arx"`).
+    pub name: &'static str,
+    /// Label with the default settings (`"ARX 3,3,0"`).
+    pub label: String,
+    /// One line on what it does.
+    pub help: &'static str,
+    /// Default window \[samples\].
+    pub default_window: usize,
+    /// Whether it takes ARX orders (`order`).
+    pub takes_orders: bool,
+    /// Its options.
+    pub options: &'static [MethodOption],
+}
+
+/// The type of an option's value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OptionKind {
+    /// A real number.
+    Float,
+    /// A whole number ≥ 0.
+    Int,
+    /// One of these names (aliases may be accepted too).
+    Choice(&'static [&'static str]),
+    /// ARX orders `na,nb,nk`.
+    Orders,
+}
+
+/// The valid range of a numeric option (always finite values).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OptionRange {
+    /// Lower bound.
+    pub min: f64,
+    /// Whether the lower bound itself is excluded.
+    pub min_open: bool,
+    /// Upper bound (`f64::INFINITY`: none).
+    pub max: f64,
+    /// Whether the upper bound itself is excluded.
+    pub max_open: bool,
+}
+
+impl OptionRange {
+    /// `[min, ∞)`: at least `min`.
+    pub const fn at_least(min: f64) -> Self {
+        Self {
+            min,
+            min_open: false,
+            max: f64::INFINITY,
+            max_open: true,
+        }
+    }
+
+    /// Whether `v` lies in the range (NaN and infinities never do).
+    pub fn contains(&self, v: f64) -> bool {
+        let above = if self.min_open {
+            v > self.min
+        } else {
+            v >= self.min
+        };
+        let below = if self.max_open {
+            v < self.max
+        } else {
+            v <= self.max
+        };
+        v.is_finite() && above && below
+    }
+}
+
+impl fmt::Display for OptionRange {
+    /// `≥ 0`, `> 0` or `in (0, 1]`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let min = number_text(self.min);
+        if self.max.is_infinite() {
+            return write!(f, "{} {min}", if self.min_open { ">" } else { "≥" });
+        }
+        write!(
+            f,
+            "in {}{min}, {}{}",
+            if self.min_open { "(" } else { "[" },
+            number_text(self.max),
+            if self.max_open { ")" } else { "]" }
+        )
+    }
+}
+
+/// A method option: everything a front end needs to offer it (flag,
+/// keyword, type, range, unit, help). Defined once, next to the method(s)
+/// that have it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OptionSpec {
+    /// Key, snake_case (`"time_origin"`); the CLI flag is `--time-origin`.
+    pub key: &'static str,
+    /// The Python keyword when it differs from the key (`lambda_`).
+    pub python: Option<&'static str>,
+    /// Placeholder of the value in help texts (`"NAME"`, `"LAMBDA"`).
+    pub value_name: &'static str,
+    /// Type of the value.
+    pub kind: OptionKind,
+    /// Valid range of a numeric value.
+    pub range: Option<OptionRange>,
+    /// Unit of a numeric value (`"samples"`), if any.
+    pub unit: Option<&'static str>,
+    /// What it sets, without the methods and the default (`"forgetting factor λ"`).
+    pub help: &'static str,
+    /// Another option's value it works only with (`("solver", "simplex")`).
+    pub requires: Option<(&'static str, &'static str)>,
+}
+
+impl OptionSpec {
+    /// The command-line flag (`--time-origin`).
+    pub fn flag(&self) -> String {
+        format!("--{}", self.key.replace('_', "-"))
+    }
+
+    /// The Python keyword (`time_origin`, `lambda_`).
+    pub fn python_keyword(&self) -> &'static str {
+        self.python.unwrap_or(self.key)
+    }
+
+    /// Parse a value given as text, checked against the kind and range.
+    pub fn parse(&self, value: &str) -> Result<OptionValue> {
+        let invalid = |expected: String| Error::InvalidOption {
+            key: self.key,
+            value: value.to_string(),
+            expected,
+        };
+        let in_range = |v: f64| match self.range {
+            Some(r) if !r.contains(v) => Err(invalid(format!("expected a number {r}"))),
+            _ => Ok(v),
+        };
+        match self.kind {
+            OptionKind::Float => {
+                let v: f64 = value
+                    .trim()
+                    .parse()
+                    .map_err(|_| invalid("expected a number".into()))?;
+                Ok(OptionValue::Float(in_range(v)?))
+            }
+            OptionKind::Int => {
+                let v: usize = value
+                    .trim()
+                    .parse()
+                    .map_err(|_| invalid("expected a whole number ≥ 0".into()))?;
+                in_range(v as f64)?;
+                Ok(OptionValue::Int(v))
+            }
+            OptionKind::Choice(_) => Ok(OptionValue::Choice(value.trim().to_string())),
+            OptionKind::Orders => {
+                let bad = || invalid("expected na,nb,nk (e.g. 8,8,1)".into());
+                let v = value
+                    .split(',')
+                    .map(|x| x.trim().parse::<usize>().map_err(|_| bad()))
+                    .collect::<Result<Vec<_>>>()?;
+                match v.as_slice() {
+                    [na, nb, nk] => Ok(OptionValue::Orders(ArxOrders::new(*na, *nb, *nk))),
+                    _ => Err(bad()),
+                }
+            }
+        }
+    }
+}
+
+/// A parsed option value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OptionValue {
+    /// A real number.
+    Float(f64),
+    /// A whole number.
+    Int(usize),
+    /// A name (parsed further by the method: `"simplex"`).
+    Choice(String),
+    /// ARX orders.
+    Orders(ArxOrders),
+}
+
+impl fmt::Display for OptionValue {
+    /// As given on the command line (`0.999`, `1e-10`, `qr`, `8,8,0`).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            OptionValue::Float(v) => f.write_str(&number_text(*v)),
+            OptionValue::Int(v) => write!(f, "{v}"),
+            OptionValue::Choice(s) => f.write_str(s),
+            OptionValue::Orders(o) => write!(f, "{},{},{}", o.na, o.nb, o.nk),
+        }
+    }
+}
+
+/// A number as a user writes it: `0.999`, `0`, `1e-10`.
+fn number_text(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&a) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// One method's entry for an option it has.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MethodOption {
+    /// The option.
+    pub spec: &'static OptionSpec,
+    /// What of the method it sets, when not the whole method (`"its long-memory candidate"`).
+    pub note: Option<&'static str>,
+}
+
+impl MethodOption {
+    /// The option, for the whole method.
+    pub const fn new(spec: &'static OptionSpec) -> Self {
+        Self { spec, note: None }
+    }
+
+    /// The option, for a part of the method (`"its windowed candidates"`).
+    pub const fn of(spec: &'static OptionSpec, note: &'static str) -> Self {
+        Self {
+            spec,
+            note: Some(note),
+        }
+    }
+}
+
+/// A method that has an option, and its default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OptionUse {
+    /// Method name.
+    pub method: &'static str,
+    /// What of the method it sets ([`MethodOption::note`]).
+    pub note: Option<&'static str>,
+    /// The method's default value, as text.
+    pub default: String,
+}
+
+/// An option with every method that has it ([`Method::options`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OptionInfo {
+    /// The option.
+    pub spec: &'static OptionSpec,
+    /// The methods that have it, with their defaults.
+    pub methods: Vec<OptionUse>,
+}
+
+impl OptionInfo {
+    /// The methods it applies to, for messages: `arx, rls, auto`, or
+    /// `paper (with --solver simplex)` in the front end's syntax.
+    pub fn applies_to(&self, syntax: Syntax) -> String {
+        let names: Vec<&str> = self.methods.iter().map(|u| u.method).collect();
+        let mut s = names.join(", ");
+        if let Some((key, value)) = self.spec.requires {
+            s += &format!(" (with {})", syntax.setting(key, value));
+        }
+        s
+    }
+
+    /// The defaults: `qr`, or `arx 3,3,0; rls 8,8,0` when several methods have it.
+    pub fn defaults(&self) -> String {
+        match self.methods.as_slice() {
+            [one] => one.default.clone(),
+            many => many
+                .iter()
+                .map(|u| format!("{} {}", u.method, u.default))
+                .collect::<Vec<_>>()
+                .join("; "),
+        }
+    }
+
+    /// The help line: who has it, what it sets, the valid range, the
+    /// defaults (`rls: forgetting factor λ … [default: 0.999]`).
+    pub fn help(&self, syntax: Syntax) -> String {
+        let who: Vec<String> = self
+            .methods
+            .iter()
+            .map(|u| match u.note {
+                Some(n) => format!("{} ({n})", u.method),
+                None => u.method.to_string(),
+            })
+            .collect();
+        let mut who = who.join(", ");
+        if let Some((key, value)) = self.spec.requires {
+            who += &format!(" (with {})", syntax.setting(key, value));
+        }
+        let mut help = format!("{who}: {}", self.spec.help);
+        if let Some(r) = self.spec.range {
+            help += &format!(", {r}");
+        }
+        if let Some(u) = self.spec.unit {
+            help += &format!(" [{u}]");
+        }
+        format!("{help} [default: {}]", self.defaults())
+    }
+}
+
+/// How a method's settings answer the option interface; each method's
+/// settings implement it next to their option specs.
+pub(crate) trait MethodSettings {
+    /// The options the method has.
+    fn options(&self) -> &'static [MethodOption] {
+        &[]
+    }
+
+    /// The current value of one of its options.
+    fn option(&self, _key: &str) -> Option<OptionValue> {
+        None
+    }
+
+    /// Set one of its options (the value parsed by its spec).
+    fn set_option(&mut self, key: &str, _value: &OptionValue) -> Result<()> {
+        Err(Error::UnknownOption {
+            key: key.to_string(),
+            known: String::new(),
+        })
+    }
 }
 
 impl fmt::Display for Method {
@@ -328,5 +816,115 @@ mod tests {
             Method::default().global_model(),
             Some(GlobalModelKind::Auto)
         );
+    }
+
+    #[test]
+    fn every_option_is_described_once_and_reads_back_its_default() {
+        let infos = Method::options();
+        let keys: Vec<&str> = infos.iter().map(|o| o.spec.key).collect();
+        assert_eq!(
+            keys,
+            [
+                "solver",
+                "time_origin",
+                "prediction",
+                "simplex_start",
+                "order",
+                "ridge",
+                "lambda"
+            ]
+        );
+        let who = |key: &str| {
+            let o = infos.iter().find(|o| o.spec.key == key).unwrap();
+            o.applies_to(Syntax::Library)
+        };
+        assert_eq!(who("order"), "arx, rls, auto");
+        assert_eq!(who("ridge"), "arx, auto");
+        assert_eq!(who("lambda"), "rls");
+        assert_eq!(who("simplex_start"), "paper (with solver = simplex)");
+        for o in &infos {
+            assert!(o
+                .spec
+                .key
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c == '_'));
+            assert!(!o.spec.help.is_empty() && !o.methods.is_empty());
+            for u in &o.methods {
+                // the default reads back and sets to itself
+                let mut m: Method = u.method.parse().unwrap();
+                let before = m.clone();
+                assert_eq!(m.option(o.spec.key).as_deref(), Some(u.default.as_str()));
+                m.set_option(o.spec.key, &u.default).unwrap();
+                assert_eq!(m, before, "{} {}", u.method, o.spec.key);
+            }
+        }
+        assert_eq!(
+            infos[4].help(Syntax::Cli),
+            "arx, rls, auto (its long-memory candidate): ARX orders `na,nb,nk` (poles, input \
+             terms, input delay in samples), or `auto` (chosen from the recording by BIC; \
+             identify only) [default: arx 3,3,0; rls 8,8,0; auto 8,8,0]"
+        );
+        let d = Method::default().describe();
+        assert_eq!(
+            (d.name, d.default_window, d.takes_orders),
+            ("auto", 50, true)
+        );
+        assert_eq!(d.options.len(), 2);
+        assert!(!"oe".parse::<Method>().unwrap().describe().takes_orders);
+    }
+
+    #[test]
+    fn set_option_parses_checks_and_refuses_with_typed_errors() {
+        let mut m: Method = "rls".parse().unwrap();
+        m.set_option("lambda", "0.99").unwrap();
+        m.set_option("order", " 4, 4, 1 ").unwrap();
+        assert_eq!(m.label(), "RLS 4,4,1 λ=0.99");
+        let before = m.clone();
+        for (key, value) in [
+            ("lambda", "1.5"),
+            ("lambda", "0"),
+            ("lambda", "x"),
+            ("order", "2,2"),
+        ] {
+            let e = m.set_option(key, value).unwrap_err();
+            assert!(
+                matches!(&e, Error::InvalidOption { key: k, value: v, .. } if *k == key && v == value),
+                "{e}"
+            );
+            assert!(e.to_string().contains(&format!("`{value}`")), "{e}");
+        }
+        let e = m.set_option("lambda", "NaN").unwrap_err();
+        assert!(e.to_string().contains("in (0, 1]"), "{e}");
+        // invalid orders: the method's own check
+        assert!(m.set_option("order", "2,0,1").is_err());
+        let e = m.set_option("ridge", "0").unwrap_err();
+        assert!(
+            matches!(&e, Error::OptionNotApplicable { key: "ridge", method: "rls", applies_to } if applies_to == "arx, auto"),
+            "{e}"
+        );
+        let e = m.set_option("magic", "1").unwrap_err();
+        assert!(matches!(e, Error::UnknownOption { .. }), "{e}");
+        assert!(e.to_string().contains("lambda"), "{e}");
+        assert_eq!(m, before);
+        // choices: the method's names and aliases
+        let mut p: Method = "paper".parse().unwrap();
+        p.set_option("solver", "Nelder-Mead").unwrap();
+        p.set_option("simplex_start", "previous").unwrap();
+        assert_eq!(p.option("solver").as_deref(), Some("simplex"));
+        assert!(p.set_option("prediction", "cubic").is_err());
+        let mut a = Method::default();
+        a.set_option("ridge", "1e-6").unwrap();
+        assert_eq!(a.option("ridge").as_deref(), Some("1e-6"));
+        assert!(a.set_option("ridge", "-1").is_err());
+    }
+
+    #[test]
+    fn the_window_is_the_given_one_or_the_methods() {
+        for m in Method::all() {
+            assert_eq!(m.window_for(None, f64::NAN).unwrap(), m.default_window());
+            assert_eq!(m.window_for(Some(Span::Samples(7)), f64::NAN).unwrap(), 7);
+            assert_eq!(m.window_for(Some(Span::Seconds(2e-3)), 5000.0).unwrap(), 10);
+            assert!(m.window_for(Some(Span::Seconds(2e-3)), f64::NAN).is_err());
+        }
     }
 }

@@ -25,7 +25,10 @@ pub use engine::{
     Regime, RegimeCoverage, Samples, Signals, SlidingResult, Span, SpanParseError, StreamOptions,
     StreamStats, Streamer, WindowFit, WindowOutcome, WindowRecord,
 };
-pub use method::{Method, METHOD_NAMES};
+pub use method::{
+    Method, MethodInfo, MethodOption, OptionInfo, OptionKind, OptionRange, OptionSpec, OptionUse,
+    OptionValue, METHOD_NAMES,
+};
 pub use methods::{
     coefficients_from_polynomials, fit_arx, fit_arx_segments, fit_oe, fit_oe_measured,
     polynomials_from_coefficients, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders,

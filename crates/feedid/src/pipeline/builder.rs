@@ -191,10 +191,7 @@ impl<'a> Pipeline<'a> {
     /// sampled at `rate_hz` (times converted to samples).
     pub fn engine_config(&self, method: &Method, rate_hz: f64) -> Result<EngineConfig> {
         Ok(EngineConfig {
-            window: match self.window {
-                Some(w) => w.samples(rate_hz, "window")?,
-                None => method.default_window(),
-            },
+            window: method.window_for(self.window, rate_hz)?,
             horizon: self.horizon.samples(rate_hz, "horizon")?,
             hop: self.hop.map(|h| h.samples(rate_hz, "hop")).transpose()?,
             warm_up: self.warm_up,

@@ -19,6 +19,35 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::ident::{LinearModel, Signals};
 
+/// Option `order` of the methods with an ARX regressor: its [`ArxOrders`]
+/// (`auto` as a value — choose them from the recording — is the front
+/// ends' to handle, before [`crate::ident::Method::set_option`]).
+pub(crate) const ORDER_OPTION: crate::ident::OptionSpec = crate::ident::OptionSpec {
+    key: "order",
+    python: None,
+    value_name: "NA,NB,NK|auto",
+    kind: crate::ident::OptionKind::Orders,
+    range: None,
+    unit: None,
+    help: "ARX orders `na,nb,nk` (poles, input terms, input delay in samples), or `auto` \
+           (chosen from the recording by BIC; identify only)",
+    requires: None,
+};
+
+/// Option `ridge` of the least-squares fits on the ARX regressor: `arx`
+/// ([`crate::ident::ArxConfig::ridge`]) and `auto`'s windowed candidates.
+pub(crate) const RIDGE_OPTION: crate::ident::OptionSpec = crate::ident::OptionSpec {
+    key: "ridge",
+    python: None,
+    value_name: "R",
+    kind: crate::ident::OptionKind::Float,
+    range: Some(crate::ident::OptionRange::at_least(0.0)),
+    unit: None,
+    help: "ridge of the least squares, relative to the regressors' scale (arx: on the \
+           column-normalised coefficients; 0 = none)",
+    requires: None,
+};
+
 /// Largest accepted `na` and `nb` (guards against absurd allocations).
 pub const MAX_ARX_ORDER: usize = 64;
 

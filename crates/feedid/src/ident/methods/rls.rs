@@ -89,8 +89,10 @@ use std::ops::Range;
 
 use crate::error::{Error, Result};
 use crate::ident::engine::rate_changed;
-use crate::ident::methods::regressor::{poles_inside, predict_horizon};
+use crate::ident::method::MethodSettings;
+use crate::ident::methods::regressor::{poles_inside, predict_horizon, ORDER_OPTION};
 use crate::ident::{ArxOrders, Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::{MethodOption, OptionKind, OptionRange, OptionSpec, OptionValue};
 use crate::solve::Termination;
 
 /// Configuration of the RLS estimator (defaults chosen on the drive zoo,
@@ -144,6 +146,58 @@ impl Default for RlsConfig {
             frame_span: 1.0,
             max_pole_radius: 1.0,
         }
+    }
+}
+
+/// Option `lambda` of `rls` ([`RlsConfig::lambda`]); `lambda_` in Python.
+const LAMBDA_OPTION: OptionSpec = OptionSpec {
+    key: "lambda",
+    python: Some("lambda_"),
+    value_name: "LAMBDA",
+    kind: OptionKind::Float,
+    range: Some(OptionRange {
+        min: 0.0,
+        min_open: true,
+        max: 1.0,
+        max_open: false,
+    }),
+    unit: None,
+    help: "forgetting factor λ (memory ≈ 1/(1−λ) samples)",
+    requires: None,
+};
+
+impl MethodSettings for RlsConfig {
+    fn options(&self) -> &'static [MethodOption] {
+        const OPTIONS: &[MethodOption] = &[
+            MethodOption::new(&ORDER_OPTION),
+            MethodOption::new(&LAMBDA_OPTION),
+        ];
+        OPTIONS
+    }
+
+    fn option(&self, key: &str) -> Option<OptionValue> {
+        match key {
+            "order" => Some(OptionValue::Orders(self.orders)),
+            "lambda" => Some(OptionValue::Float(self.lambda)),
+            _ => None,
+        }
+    }
+
+    fn set_option(&mut self, key: &str, value: &OptionValue) -> Result<()> {
+        match (key, value) {
+            ("order", OptionValue::Orders(o)) => {
+                o.validate()?;
+                self.orders = *o;
+            }
+            ("lambda", OptionValue::Float(l)) => self.lambda = *l,
+            _ => {
+                return Err(Error::UnknownOption {
+                    key: key.to_string(),
+                    known: "order, lambda".to_string(),
+                })
+            }
+        }
+        Ok(())
     }
 }
 

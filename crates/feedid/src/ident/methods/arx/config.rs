@@ -5,7 +5,44 @@
 
 use super::estimator::ArxEstimator;
 use crate::error::{Error, Result};
-use crate::ident::methods::regressor::ArxOrders;
+use crate::ident::method::MethodSettings;
+use crate::ident::methods::regressor::{ArxOrders, ORDER_OPTION, RIDGE_OPTION};
+use crate::ident::{MethodOption, OptionValue};
+
+impl MethodSettings for ArxConfig {
+    fn options(&self) -> &'static [MethodOption] {
+        const OPTIONS: &[MethodOption] = &[
+            MethodOption::new(&ORDER_OPTION),
+            MethodOption::new(&RIDGE_OPTION),
+        ];
+        OPTIONS
+    }
+
+    fn option(&self, key: &str) -> Option<OptionValue> {
+        match key {
+            "order" => Some(OptionValue::Orders(self.orders)),
+            "ridge" => Some(OptionValue::Float(self.ridge)),
+            _ => None,
+        }
+    }
+
+    fn set_option(&mut self, key: &str, value: &OptionValue) -> Result<()> {
+        match (key, value) {
+            ("order", OptionValue::Orders(o)) => {
+                o.validate()?;
+                self.orders = *o;
+            }
+            ("ridge", OptionValue::Float(r)) => self.ridge = *r,
+            _ => {
+                return Err(Error::UnknownOption {
+                    key: key.to_string(),
+                    known: "order, ridge".to_string(),
+                })
+            }
+        }
+        Ok(())
+    }
+}
 
 /// Configuration of the windowed ARX estimator.
 ///

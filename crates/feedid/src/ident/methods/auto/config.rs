@@ -6,7 +6,47 @@
 use super::candidate::Candidate;
 use super::estimator::AutoEstimator;
 use crate::error::{Error, Result};
-use crate::ident::ArxOrders;
+use crate::ident::method::MethodSettings;
+use crate::ident::methods::regressor::{ORDER_OPTION, RIDGE_OPTION};
+use crate::ident::{ArxOrders, MethodOption, OptionValue};
+
+impl MethodSettings for AutoConfig {
+    fn options(&self) -> &'static [MethodOption] {
+        const OPTIONS: &[MethodOption] = &[
+            MethodOption::of(&ORDER_OPTION, "its long-memory candidate"),
+            MethodOption::of(&RIDGE_OPTION, "its windowed candidates"),
+        ];
+        OPTIONS
+    }
+
+    fn option(&self, key: &str) -> Option<OptionValue> {
+        match key {
+            "order" => self.orders().map(OptionValue::Orders),
+            "ridge" => self.candidates.iter().find_map(|c| match c {
+                Candidate::Windowed { ridge, .. } => Some(OptionValue::Float(*ridge)),
+                _ => None,
+            }),
+            _ => None,
+        }
+    }
+
+    fn set_option(&mut self, key: &str, value: &OptionValue) -> Result<()> {
+        match (key, value) {
+            ("order", OptionValue::Orders(o)) => {
+                o.validate()?;
+                self.set_orders(*o)
+            }
+            ("ridge", OptionValue::Float(r)) => {
+                self.set_ridge(*r);
+                Ok(())
+            }
+            _ => Err(Error::UnknownOption {
+                key: key.to_string(),
+                known: "order, ridge".to_string(),
+            }),
+        }
+    }
+}
 
 /// Settings of the `auto` method.
 #[derive(Debug, Clone, PartialEq)]

@@ -155,6 +155,9 @@ impl Default for OeConfig {
     }
 }
 
+/// `oe` has no options of its own (its orders are poles and zeros, set in code).
+impl crate::ident::method::MethodSettings for OeConfig {}
+
 impl OeConfig {
     /// Check the settings.
     pub fn validate(&self) -> Result<()> {

@@ -5,7 +5,102 @@ use std::str::FromStr;
 
 use super::estimator::PaperMethod;
 use crate::error::{Error, Result};
-use crate::ident::Signals;
+use crate::ident::method::MethodSettings;
+use crate::ident::{MethodOption, OptionKind, OptionSpec, OptionValue, Signals};
+
+/// Option `solver` of `paper` ([`PaperConfig::solver`]).
+const SOLVER_OPTION: OptionSpec = OptionSpec {
+    key: "solver",
+    python: None,
+    value_name: "NAME",
+    kind: OptionKind::Choice(&["qr", "simplex"]),
+    range: None,
+    unit: None,
+    help: "solver, qr (exact least squares) or simplex (Nelder–Mead, as in the paper)",
+    requires: None,
+};
+
+/// Option `time_origin` of `paper` ([`PaperConfig::time_origin`]).
+const TIME_ORIGIN_OPTION: OptionSpec = OptionSpec {
+    key: "time_origin",
+    python: None,
+    value_name: "NAME",
+    kind: OptionKind::Choice(&["motion", "window"]),
+    range: None,
+    unit: None,
+    help: "time origin, motion (start of motion) or window (each window's first sample; \
+           accurate coefficients, but it cannot predict a moving axis)",
+    requires: None,
+};
+
+/// Option `prediction` of `paper` ([`PaperConfig::prediction`]).
+const PREDICTION_OPTION: OptionSpec = OptionSpec {
+    key: "prediction",
+    python: None,
+    value_name: "NAME",
+    kind: OptionKind::Choice(&["polynomial", "tf"]),
+    range: None,
+    unit: None,
+    help: "prediction, polynomial (fitted output continued) or tf (identified Tf on the next \
+           command)",
+    requires: None,
+};
+
+/// Option `simplex_start` of `paper` ([`PaperConfig::simplex_start`]).
+const SIMPLEX_START_OPTION: OptionSpec = OptionSpec {
+    key: "simplex_start",
+    python: None,
+    value_name: "NAME",
+    kind: OptionKind::Choice(&["zeros", "previous"]),
+    range: None,
+    unit: None,
+    help: "start of each window's simplex, zeros (every window on its own) or previous (the \
+           previous window's fit: fewer iterations, about 2.5× faster)",
+    requires: Some(("solver", "simplex")),
+};
+
+impl MethodSettings for PaperConfig {
+    fn options(&self) -> &'static [MethodOption] {
+        const OPTIONS: &[MethodOption] = &[
+            MethodOption::new(&SOLVER_OPTION),
+            MethodOption::new(&TIME_ORIGIN_OPTION),
+            MethodOption::new(&PREDICTION_OPTION),
+            MethodOption::new(&SIMPLEX_START_OPTION),
+        ];
+        OPTIONS
+    }
+
+    fn option(&self, key: &str) -> Option<OptionValue> {
+        let label = match key {
+            "solver" => self.solver.label(),
+            "time_origin" => self.time_origin.label(),
+            "prediction" => self.prediction.label(),
+            "simplex_start" => self.simplex_start.label(),
+            _ => return None,
+        };
+        Some(OptionValue::Choice(label.to_string()))
+    }
+
+    fn set_option(&mut self, key: &str, value: &OptionValue) -> Result<()> {
+        let s = match value {
+            OptionValue::Choice(s) => s.as_str(),
+            _ => "",
+        };
+        match key {
+            "solver" => self.solver = s.parse()?,
+            "time_origin" => self.time_origin = s.parse()?,
+            "prediction" => self.prediction = s.parse()?,
+            "simplex_start" => self.simplex_start = s.parse()?,
+            _ => {
+                return Err(Error::UnknownOption {
+                    key: key.to_string(),
+                    known: "solver, time_origin, prediction, simplex_start".to_string(),
+                })
+            }
+        }
+        Ok(())
+    }
+}
 
 /// How the window's least-squares problems are solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

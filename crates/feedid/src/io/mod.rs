@@ -6,6 +6,7 @@
 //! leaving partial files ([`OutputSet`], [`write_atomic`]), and the CSV
 //! tables of results.
 
+mod columns;
 mod csv;
 mod info;
 mod layout;
@@ -16,8 +17,9 @@ mod read;
 mod source;
 mod stream;
 mod table;
+mod text;
 
-pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
+pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str};
 pub use self::info::{recording_info, ChannelStats, RecordingInfo};
 pub use self::mat::{
     list_mat_variables, list_mat_variables_from_bytes, read_mat, read_mat_from_bytes,
@@ -45,3 +47,4 @@ pub use self::stream::{
 pub use self::table::{
     cell, write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
 };
+pub use self::text::DECIMAL_COMMA_HINT;

@@ -17,7 +17,8 @@ use std::ops::Range;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::ident::{LinearModel, Signals};
+use crate::ident::engine::Signals;
+use crate::ident::model::LinearModel;
 
 /// Largest accepted `na` and `nb` (guards against absurd allocations).
 pub const MAX_ARX_ORDER: usize = 64;

@@ -88,9 +88,8 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::engine::rate_changed;
-use crate::ident::methods::regressor::{poles_inside, predict_horizon};
-use crate::ident::{ArxOrders, Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::engine::{rate_changed, Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::methods::regressor::{poles_inside, predict_horizon, ArxOrders};
 use crate::solve::Termination;
 
 /// Configuration of the RLS estimator (defaults chosen on the drive zoo,
@@ -857,8 +856,8 @@ impl Estimator for RlsEstimator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ident::engine::FitStatus;
     use crate::ident::methods::regressor::regressor;
-    use crate::ident::FitStatus;
     use nalgebra::{DMatrix, DVector};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;

@@ -6,7 +6,7 @@
 use super::candidate::Candidate;
 use super::estimator::AutoEstimator;
 use crate::error::{Error, Result};
-use crate::ident::ArxOrders;
+use crate::ident::methods::regressor::ArxOrders;
 
 /// Settings of the `auto` method.
 #[derive(Debug, Clone, PartialEq)]

@@ -86,7 +86,8 @@ use super::companion::{is_hurwitz, output, reflect_unstable, MAX_ORDER};
 use super::srivc::srivc;
 use super::window::WindowWork;
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
+use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::model::LinearModel;
 use crate::lti::TransferFunction;
 use crate::solve::{LevenbergMarquardt, LmConfig, LmReport, Termination};
 
@@ -772,9 +773,8 @@ impl Estimator for OeEstimator {
 mod tests {
     use super::*;
     use crate::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
-    use crate::ident::engine::{run, EngineConfig};
-    use crate::ident::fit_oe;
-    use crate::ident::FitStatus;
+    use crate::ident::engine::{run, EngineConfig, FitStatus};
+    use crate::ident::methods::fit_oe;
     use crate::signal::Scenario;
     use crate::solve::Termination;
     use nalgebra::Complex;

@@ -5,7 +5,7 @@ use std::str::FromStr;
 
 use super::estimator::PaperMethod;
 use crate::error::{Error, Result};
-use crate::ident::Signals;
+use crate::ident::engine::Signals;
 
 /// How the window's least-squares problems are solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -238,7 +238,7 @@ impl PaperConfig {
     pub fn worst_shift_amplification(
         &self,
         signals: &Signals<'_>,
-        config: &crate::ident::EngineConfig,
+        config: &crate::ident::engine::EngineConfig,
     ) -> f64 {
         let time = signals.all().time;
         let mut worst = 1.0f64;

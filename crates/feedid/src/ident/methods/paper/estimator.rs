@@ -12,7 +12,7 @@ use super::polynomials::{coefficients_from_polynomials, NAMES, NC, NP, NQ};
 use super::projection::{LegendreTables, Projection};
 use super::simplex::{simplex_fit, Reduced};
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowFit};
 use crate::lti::TransferFunction;
 use crate::solve::{lstsq_fixed, LstsqInfo, NelderMead, QrWorkspace, Termination};
 

@@ -9,7 +9,7 @@ use crate::ident::{
     SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
-use crate::plausibility::check_recording;
+use crate::recording::plausibility::check_recording;
 use crate::recording::{Recording, RecordingRef, DEFAULT_JITTER_TOLERANCE};
 use crate::stats::ErrorStats;
 

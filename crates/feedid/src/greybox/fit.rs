@@ -53,7 +53,7 @@ use super::omitted::{missing_feed_forward, MissingFeedForward};
 use super::whiteness::{residual_structure, ResidualStructure};
 use crate::drive::{RigEffects, RigParams};
 use crate::error::{Error, Result};
-use crate::solve::{LevenbergMarquardt, LmConfig, Termination};
+use crate::solve::{LevenbergMarquardt, LmConfig, LmReport, Termination};
 use crate::stats::ErrorStats;
 
 /// Step of the central differences of the identifiability analysis (in `θ = ln p`).
@@ -580,37 +580,7 @@ pub fn fit_greybox_with_progress(
     )?;
     data.check(2 * estimate.len() + 2)?;
     let n = estimate.len();
-    let len = data.command.len();
-    let deviation_rms = |v: &[f64]| {
-        let v0 = v.first().copied().unwrap_or(0.0);
-        let d: Vec<f64> = v.iter().map(|x| x - v0).collect();
-        crate::stats::rms(&d)
-    };
-    let y_scale = deviation_rms(data.position).max(1e-12);
-    let i_scale = data
-        .current
-        .map_or(1.0, |c| crate::stats::rms(c).max(1e-12));
-    let mut prob = Problem {
-        data: *data,
-        estimate,
-        base: base.clone(),
-        model: PhysicalModel {
-            params: *start,
-            effects: cfg.effects,
-            dynamics: cfg.dynamics,
-            position_loop: cfg.position_loop,
-        },
-        sim_position: vec![0.0; len],
-        sim_current: vec![0.0; if data.current.is_some() { len } else { 0 }],
-        rows: data.rows(),
-        weights: if data.current.is_some() {
-            (1.0 / y_scale, 1.0 / i_scale)
-        } else {
-            (1.0, 1.0)
-        },
-        penalty: 1e3 * if data.current.is_some() { 1.0 } else { y_scale },
-        evaluations: 0,
-    };
+    let (mut prob, scales) = problem(data, start, estimate, cfg, base.clone());
     let m = prob.residuals();
 
     // identifiability at the start
@@ -642,77 +612,18 @@ pub fn fit_greybox_with_progress(
         max_iterations: cfg.max_iterations.max(1),
         ..LmConfig::default()
     };
-    let mut report = lm.minimize(
-        |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+    let mut report = minimize(
+        &mut prob, &mut lm, &mut theta, &mut r, &lm_cfg, &scales, &mut step,
+    )?;
+    let restart_ends = restart(
+        &mut prob,
+        &mut lm,
         &mut theta,
         &lm_cfg,
+        cfg.restarts,
+        &mut report,
+        &mut step,
     )?;
-    step();
-    if data.current.is_some() {
-        // second pass: each channel weighted by its residual level
-        prob.eval(&theta, &mut r);
-        let (sy, si) = prob.channel_rms();
-        let floor = |s: f64, scale: f64| s.max(1e-9 * scale).max(f64::MIN_POSITIVE);
-        prob.weights = (
-            1.0 / floor(sy, y_scale),
-            1.0 / floor(si.unwrap_or(i_scale), i_scale),
-        );
-        let second = lm.minimize(
-            |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-            &mut theta,
-            &lm_cfg,
-        )?;
-        report.iterations += second.iterations;
-        report.evaluations += second.evaluations;
-        report.termination = second.termination;
-        report.residual_norm = second.residual_norm;
-        step();
-    }
-
-    // restarts: does the fit end where it started?
-    let mut ends: Vec<Vec<f64>> = Vec::new();
-    if cfg.restarts > 0 {
-        prob.eval(&theta, &mut r);
-        let mut best_ss: f64 = r.iter().map(|v| v * v).sum();
-        let main = theta.clone();
-        for k in 0..cfg.restarts {
-            let mut t: Vec<f64> = main
-                .iter()
-                .enumerate()
-                .map(|(j, v)| {
-                    let even = j % 2 == 0;
-                    let sign = match k % 4 {
-                        0 if even => 1.0,
-                        0 => -1.0,
-                        1 if even => -1.0,
-                        1 => 1.0,
-                        2 => 1.0,
-                        _ => -1.0,
-                    };
-                    v + sign * RESTART_STEP * (1.0 + (k / 4) as f64)
-                })
-                .collect();
-            let rep = lm.minimize(
-                |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-                &mut t,
-                &lm_cfg,
-            )?;
-            report.evaluations += rep.evaluations;
-            step();
-            prob.eval(&t, &mut r);
-            let ss_k: f64 = r.iter().map(|v| v * v).sum();
-            if ss_k < best_ss * (1.0 - 1e-9) {
-                // a better minimum: it becomes the estimate
-                best_ss = ss_k;
-                ends.push(std::mem::replace(&mut theta, t));
-            } else {
-                ends.push(t);
-            }
-        }
-        if theta != main {
-            ends.push(main);
-        }
-    }
 
     central_jacobian(
         &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
@@ -726,67 +637,9 @@ pub fn fit_greybox_with_progress(
     let mut analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
     step();
     let (rms_y, rms_i) = prob.channel_rms();
-
-    // structure left in the residuals; not measured when the fit is exact to
-    // within EXACT_FIT of the signal (integration or rounding differences,
-    // which cannot bias an estimate by more than about that share)
-    // (with dropped samples: the residuals of the measured ones in a row,
-    // a lag off by the few dropped samples across each gap)
-    let rows = prob.rows.len();
-    let mut structure = Vec::new();
-    if rms_y > EXACT_FIT * y_scale {
-        structure.extend(residual_structure("position", &r[..rows]));
-    }
-    if let (Some(ri), true) = (rms_i, data.current.is_some()) {
-        if ri > EXACT_FIT * i_scale {
-            structure.extend(residual_structure("current", &r[rows..]));
-        }
-    }
-    // feed-forward left out? (only asked when the model has none)
-    let no_feed_forward = start.control.kvff == 0.0
-        && start.control.kaff == 0.0
-        && !estimate.iter().any(|p| p.is_feed_forward());
-    let missing = if no_feed_forward && rms_y > EXACT_FIT * y_scale {
-        let position_jacobian: Vec<f64> = (0..n)
-            .flat_map(|j| jac[j * m..j * m + rows].iter().copied())
-            .collect();
-        missing_feed_forward(
-            &prob.model,
-            data.command,
-            data.dt,
-            &prob.rows,
-            &r[..rows],
-            &position_jacobian,
-            prob.weights.0,
-        )?
-    } else {
-        None
-    };
+    let (structure, missing) = residual_checks(&prob, &r, &jac, start, &scales, rms_y, rms_i)?;
     let structured = structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
-    // spread of the restarts in log-parameters, against the standard error
-    let spread: Vec<Option<f64>> = (0..n)
-        .map(|j| {
-            (!ends.is_empty()).then(|| {
-                ends.iter()
-                    .map(|t| (t[j] - theta[j]).abs())
-                    .fold(0.0_f64, f64::max)
-                    .exp_m1()
-            })
-        })
-        .collect();
-    for (j, v) in analysis.verdicts.iter_mut().enumerate() {
-        let moved = match (spread[j], analysis.relative_std_errors[j]) {
-            // beyond the standard error, and beyond what the LM tolerance leaves
-            (Some(s), Some(se)) => s > RESTART_TOLERANCE_SE * se && s > 1e-4,
-            (Some(s), None) => s > 1e-4,
-            _ => false,
-        };
-        if moved {
-            *v = Verdict::NotIdentifiable;
-        } else if structured && *v != Verdict::NotIdentifiable {
-            *v = Verdict::Unreliable;
-        }
-    }
+    let spread = restart_verdicts(&mut analysis, &restart_ends, &theta, structured);
     let stats = ErrorStats::from_pairs(
         prob.rows
             .iter()
@@ -818,6 +671,247 @@ pub fn fit_greybox_with_progress(
         params,
         effects,
     })
+}
+
+/// The scales of the two channels: the rms deviation of the position from
+/// its first value and the rms current (floored at 1e-12).
+struct Scales {
+    y: f64,
+    i: f64,
+}
+
+/// The weighted residual problem of a recording at the start parameters.
+fn problem<'a>(
+    data: &Measurements<'a>,
+    start: &RigParams,
+    estimate: &'a [PhysicalParameter],
+    cfg: &GreyboxConfig,
+    base: Vec<f64>,
+) -> (Problem<'a>, Scales) {
+    let len = data.command.len();
+    let deviation_rms = |v: &[f64]| {
+        let v0 = v.first().copied().unwrap_or(0.0);
+        let d: Vec<f64> = v.iter().map(|x| x - v0).collect();
+        crate::stats::rms(&d)
+    };
+    let y_scale = deviation_rms(data.position).max(1e-12);
+    let i_scale = data
+        .current
+        .map_or(1.0, |c| crate::stats::rms(c).max(1e-12));
+    let prob = Problem {
+        data: *data,
+        estimate,
+        base,
+        model: PhysicalModel {
+            params: *start,
+            effects: cfg.effects,
+            dynamics: cfg.dynamics,
+            position_loop: cfg.position_loop,
+        },
+        sim_position: vec![0.0; len],
+        sim_current: vec![0.0; if data.current.is_some() { len } else { 0 }],
+        rows: data.rows(),
+        weights: if data.current.is_some() {
+            (1.0 / y_scale, 1.0 / i_scale)
+        } else {
+            (1.0, 1.0)
+        },
+        penalty: 1e3 * if data.current.is_some() { 1.0 } else { y_scale },
+        evaluations: 0,
+    };
+    (
+        prob,
+        Scales {
+            y: y_scale,
+            i: i_scale,
+        },
+    )
+}
+
+/// The least-squares fit from `theta` (written back): one pass, and with a
+/// current a second, each channel weighted by its residual level.
+fn minimize(
+    prob: &mut Problem<'_>,
+    lm: &mut LevenbergMarquardt,
+    theta: &mut [f64],
+    r: &mut [f64],
+    lm_cfg: &LmConfig,
+    scales: &Scales,
+    step: &mut dyn FnMut(),
+) -> Result<LmReport> {
+    let mut report = lm.minimize(
+        |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        theta,
+        lm_cfg,
+    )?;
+    step();
+    if prob.data.current.is_some() {
+        // second pass: each channel weighted by its residual level
+        prob.eval(theta, r);
+        let (sy, si) = prob.channel_rms();
+        let floor = |s: f64, scale: f64| s.max(1e-9 * scale).max(f64::MIN_POSITIVE);
+        prob.weights = (
+            1.0 / floor(sy, scales.y),
+            1.0 / floor(si.unwrap_or(scales.i), scales.i),
+        );
+        let second = lm.minimize(
+            |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+            theta,
+            lm_cfg,
+        )?;
+        report.iterations += second.iterations;
+        report.evaluations += second.evaluations;
+        report.termination = second.termination;
+        report.residual_norm = second.residual_norm;
+        step();
+    }
+    Ok(report)
+}
+
+/// Restarts: does the fit end where it started? `restarts` fits from
+/// points around the estimate; a better minimum becomes the estimate. The
+/// end points of the other fits (the first estimate among them if it was
+/// replaced).
+fn restart(
+    prob: &mut Problem<'_>,
+    lm: &mut LevenbergMarquardt,
+    theta: &mut Vec<f64>,
+    lm_cfg: &LmConfig,
+    restarts: usize,
+    report: &mut LmReport,
+    step: &mut dyn FnMut(),
+) -> Result<Vec<Vec<f64>>> {
+    let mut ends: Vec<Vec<f64>> = Vec::new();
+    if restarts == 0 {
+        return Ok(ends);
+    }
+    let r = &mut vec![0.0; prob.residuals()];
+    prob.eval(theta, r);
+    let mut best_ss: f64 = r.iter().map(|v| v * v).sum();
+    let main = theta.clone();
+    for k in 0..restarts {
+        let mut t: Vec<f64> = main
+            .iter()
+            .enumerate()
+            .map(|(j, v)| {
+                let even = j % 2 == 0;
+                let sign = match k % 4 {
+                    0 if even => 1.0,
+                    0 => -1.0,
+                    1 if even => -1.0,
+                    1 => 1.0,
+                    2 => 1.0,
+                    _ => -1.0,
+                };
+                v + sign * RESTART_STEP * (1.0 + (k / 4) as f64)
+            })
+            .collect();
+        let rep = lm.minimize(
+            |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+            &mut t,
+            lm_cfg,
+        )?;
+        report.evaluations += rep.evaluations;
+        step();
+        prob.eval(&t, r);
+        let ss_k: f64 = r.iter().map(|v| v * v).sum();
+        if ss_k < best_ss * (1.0 - 1e-9) {
+            // a better minimum: it becomes the estimate
+            best_ss = ss_k;
+            ends.push(std::mem::replace(theta, t));
+        } else {
+            ends.push(t);
+        }
+    }
+    if *theta != main {
+        ends.push(main);
+    }
+    Ok(ends)
+}
+
+/// Structure left in the residuals `r` at the estimate, and feed-forward
+/// left out of the model (asked only when it has none).
+fn residual_checks(
+    prob: &Problem<'_>,
+    r: &[f64],
+    jac: &[f64],
+    start: &RigParams,
+    scales: &Scales,
+    rms_y: f64,
+    rms_i: Option<f64>,
+) -> Result<(Vec<ResidualStructure>, Option<MissingFeedForward>)> {
+    let data = &prob.data;
+    let (m, n) = (r.len(), prob.estimate.len());
+    // not measured when the fit is exact to within EXACT_FIT of the signal
+    // (integration or rounding differences, which cannot bias an estimate by
+    // more than about that share) (with dropped samples: the residuals of
+    // the measured ones in a row, a lag off by the few dropped samples
+    // across each gap)
+    let rows = prob.rows.len();
+    let mut structure = Vec::new();
+    if rms_y > EXACT_FIT * scales.y {
+        structure.extend(residual_structure("position", &r[..rows]));
+    }
+    if let (Some(ri), true) = (rms_i, data.current.is_some()) {
+        if ri > EXACT_FIT * scales.i {
+            structure.extend(residual_structure("current", &r[rows..]));
+        }
+    }
+    let no_feed_forward = start.control.kvff == 0.0
+        && start.control.kaff == 0.0
+        && !prob.estimate.iter().any(|p| p.is_feed_forward());
+    let missing = if no_feed_forward && rms_y > EXACT_FIT * scales.y {
+        let position_jacobian: Vec<f64> = (0..n)
+            .flat_map(|j| jac[j * m..j * m + rows].iter().copied())
+            .collect();
+        missing_feed_forward(
+            &prob.model,
+            data.command,
+            data.dt,
+            &prob.rows,
+            &r[..rows],
+            &position_jacobian,
+            prob.weights.0,
+        )?
+    } else {
+        None
+    };
+    Ok((structure, missing))
+}
+
+/// The spread of the restarts per parameter in log-parameters (`None`
+/// without restarts); a parameter that moved beyond its standard error is
+/// not identifiable, and with structured residuals the others unreliable.
+fn restart_verdicts(
+    analysis: &mut Identifiability,
+    ends: &[Vec<f64>],
+    theta: &[f64],
+    structured: bool,
+) -> Vec<Option<f64>> {
+    let spread: Vec<Option<f64>> = (0..theta.len())
+        .map(|j| {
+            (!ends.is_empty()).then(|| {
+                ends.iter()
+                    .map(|t| (t[j] - theta[j]).abs())
+                    .fold(0.0_f64, f64::max)
+                    .exp_m1()
+            })
+        })
+        .collect();
+    for (j, v) in analysis.verdicts.iter_mut().enumerate() {
+        let moved = match (spread[j], analysis.relative_std_errors[j]) {
+            // beyond the standard error, and beyond what the LM tolerance leaves
+            (Some(s), Some(se)) => s > RESTART_TOLERANCE_SE * se && s > 1e-4,
+            (Some(s), None) => s > 1e-4,
+            _ => false,
+        };
+        if moved {
+            *v = Verdict::NotIdentifiable;
+        } else if structured && *v != Verdict::NotIdentifiable {
+            *v = Verdict::Unreliable;
+        }
+    }
+    spread
 }
 
 /// Lengths, finiteness, sample time.

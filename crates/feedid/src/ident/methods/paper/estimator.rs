@@ -690,11 +690,11 @@ impl PaperMethod {
         let norm_in = self.projection.vnorm;
         let mut a_out = [0.0; NP];
         let mut a_in = [0.0; NQ];
-        for k in 0..NP {
-            a_out[k] = sol.z_out[k] / pb.norm_out[k];
+        for ((a, z), nk) in a_out.iter_mut().zip(&sol.z_out).zip(&pb.norm_out) {
+            *a = z / nk;
         }
-        for k in 0..NQ {
-            a_in[k] = sol.z_in[k] / norm_in[k];
+        for ((a, z), nk) in a_in.iter_mut().zip(&sol.z_in).zip(&norm_in) {
+            *a = z / nk;
         }
         let mut ms = [0.0; NQ];
         for (ak, lk) in a_out.iter().zip(&self.tables.table) {

@@ -28,10 +28,15 @@ fn sources(dir: &Path) -> Vec<PathBuf> {
 /// The code of a file before its test module (whole files named `tests.rs`
 /// and files under a `tests/` folder are tests).
 fn code(p: &Path) -> String {
+    // the folders between `src/` and the file
+    let folders: Vec<_> = p
+        .components()
+        .rev()
+        .skip(1)
+        .take_while(|c| c.as_os_str() != "src")
+        .collect();
     if p.file_name().is_some_and(|n| n == "tests.rs")
-        || p.parent()
-            .is_some_and(|d| d.components().any(|c| c.as_os_str() == "tests"))
-            && p.components().any(|c| c.as_os_str() == "src")
+        || folders.iter().any(|c| c.as_os_str() == "tests")
     {
         return String::new();
     }

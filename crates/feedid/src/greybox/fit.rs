@@ -565,13 +565,7 @@ pub fn fit_greybox_with_progress(
     progress: Option<&(dyn Fn(u64, u64) + Sync)>,
 ) -> Result<GreyboxFit> {
     let stages = 3 + u64::from(data.current.is_some()) + cfg.restarts as u64;
-    let mut stage = 0;
-    let mut step = || {
-        stage += 1;
-        if let Some(p) = progress {
-            p(stage.min(stages), stages);
-        }
-    };
+    let mut step = stepper(progress, stages);
     let base = check_set(
         estimate,
         start,
@@ -580,23 +574,14 @@ pub fn fit_greybox_with_progress(
     )?;
     data.check(2 * estimate.len() + 2)?;
     let n = estimate.len();
-    let (mut prob, scales) = problem(data, start, estimate, cfg, base.clone());
+    let (mut prob, scales) = problem(data, start, estimate, cfg, base);
     let m = prob.residuals();
 
     // identifiability at the start
     let mut theta = vec![0.0; n];
     let mut jac = vec![0.0; m * n];
     let mut r = vec![0.0; m];
-    central_jacobian(
-        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-        &theta,
-        m,
-        &mut r,
-        &mut jac,
-    );
-    prob.eval(&theta, &mut r);
-    let ss0: f64 = r.iter().map(|v| v * v).sum();
-    let at_start = analyse(&jac, m, estimate, ss0, &cfg.thresholds)?;
+    let at_start = analyse_at(&mut prob, &theta, &cfg.thresholds, &mut r, &mut jac)?;
     if cfg.refuse_unidentifiable {
         if let Some(e) = at_start.refusal() {
             return Err(e);
@@ -625,33 +610,14 @@ pub fn fit_greybox_with_progress(
         &mut step,
     )?;
 
-    central_jacobian(
-        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-        &theta,
-        m,
-        &mut r,
-        &mut jac,
-    );
-    prob.eval(&theta, &mut r);
-    let ss: f64 = r.iter().map(|v| v * v).sum();
-    let mut analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
+    let mut analysis = analyse_at(&mut prob, &theta, &cfg.thresholds, &mut r, &mut jac)?;
     step();
     let (rms_y, rms_i) = prob.channel_rms();
     let (structure, missing) = residual_checks(&prob, &r, &jac, start, &scales, rms_y, rms_i)?;
     let structured = structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
     let spread = restart_verdicts(&mut analysis, &restart_ends, &theta, structured);
-    let stats = ErrorStats::from_pairs(
-        prob.rows
-            .iter()
-            .map(|&k| (data.position[k], prob.sim_position[k])),
-    );
-    let mut params = *start;
-    let mut effects = cfg.effects;
-    apply(estimate, &base, &theta, &mut params, &mut effects);
-    let mut ests = estimates(estimate, &base, &theta, &analysis);
-    for (e, s) in ests.iter_mut().zip(&spread) {
-        e.start_spread = *s;
-    }
+    let (ests, params, effects, fit_percent) =
+        estimates_at(&prob, start, cfg, &theta, &analysis, &spread);
     Ok(GreyboxFit {
         source: "recording",
         estimates: ests,
@@ -663,7 +629,7 @@ pub fn fit_greybox_with_progress(
         evaluations: prob.evaluations,
         residual_rms: rms_y,
         current_residual_rms: rms_i,
-        fit_percent: Some(stats.fit_percent),
+        fit_percent: Some(fit_percent),
         residuals: m,
         residual_structure: structure,
         restarts: cfg.restarts,
@@ -671,6 +637,64 @@ pub fn fit_greybox_with_progress(
         params,
         effects,
     })
+}
+
+/// The estimates at `theta` with the spread of the restarts, the parameter
+/// set and effects they give, and the fit of the simulated position \[%\].
+fn estimates_at(
+    prob: &Problem<'_>,
+    start: &RigParams,
+    cfg: &GreyboxConfig,
+    theta: &[f64],
+    analysis: &Identifiability,
+    spread: &[Option<f64>],
+) -> (Vec<ParameterEstimate>, RigParams, RigEffects, f64) {
+    let stats = ErrorStats::from_pairs(
+        prob.rows
+            .iter()
+            .map(|&k| (prob.data.position[k], prob.sim_position[k])),
+    );
+    let mut params = *start;
+    let mut effects = cfg.effects;
+    apply(prob.estimate, &prob.base, theta, &mut params, &mut effects);
+    let mut ests = estimates(prob.estimate, &prob.base, theta, analysis);
+    for (e, s) in ests.iter_mut().zip(spread) {
+        e.start_spread = *s;
+    }
+    (ests, params, effects, stats.fit_percent)
+}
+
+/// A progress step of `stages`: each call reports one more done.
+fn stepper(progress: Option<&(dyn Fn(u64, u64) + Sync)>, stages: u64) -> impl FnMut() + '_ {
+    let mut stage = 0;
+    move || {
+        stage += 1;
+        if let Some(p) = progress {
+            p(stage.min(stages), stages);
+        }
+    }
+}
+
+/// The identifiability analysis at `theta`: the Jacobian into `jac`, the
+/// residuals at `theta` into `r`.
+fn analyse_at(
+    prob: &mut Problem<'_>,
+    theta: &[f64],
+    thresholds: &IdentifiabilityThresholds,
+    r: &mut [f64],
+    jac: &mut [f64],
+) -> Result<Identifiability> {
+    let m = r.len();
+    central_jacobian(
+        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        theta,
+        m,
+        r,
+        jac,
+    );
+    prob.eval(theta, r);
+    let ss: f64 = r.iter().map(|v| v * v).sum();
+    analyse(jac, m, prob.estimate, ss, thresholds)
 }
 
 /// The scales of the two channels: the rms deviation of the position from

@@ -30,7 +30,6 @@ pub mod ident;
 pub mod io;
 pub mod lti;
 pub mod pipeline;
-pub mod plausibility;
 pub mod recording;
 pub mod signal;
 pub mod solve;
@@ -39,4 +38,5 @@ pub mod zoo;
 
 pub use error::{Error, Result};
 pub use pipeline::Pipeline;
+pub use recording::plausibility;
 pub use recording::{Recording, RecordingRef};

@@ -94,37 +94,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
 
     let mut text = String::new();
     let (source, comp) = match (&a.model, &a.params) {
-        (Some(path), _) => {
-            let file = crate::cmd::load_model_file(path)?;
-            cfg.quality = match &a.check {
-                Some(check) => {
-                    // (dropped samples: the model runs through them)
-                    let opts = ReadOptions {
-                        allow_gaps: true,
-                        ..ReadOptions::default()
-                    };
-                    let r = read_recording(check, &opts)?;
-                    ModelQuality::from_recording(&file.model, &r)
-                        .map_err(|e| anyhow::anyhow!("{}: {e}", check.display()))?
-                }
-                // the fits on the model's own identification recording
-                None => ModelQuality {
-                    position_fit_percent: file.identified_by.as_ref().map(|p| p.fit_percent),
-                    error_fit_percent: file
-                        .identified_by
-                        .as_ref()
-                        .and_then(|p| p.error_fit_percent),
-                    noise_rms_m: None,
-                },
-            };
-            let comp = compensate_model(&file.model, desired, dt, &cfg)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-            let how = match &file.identified_by {
-                Some(p) => format!("{} {} (fit {:.2} %)", p.method, p.orders, p.fit_percent),
-                None => "model".to_string(),
-            };
-            (format!("{} [{how}]", path.display()), comp)
-        }
+        (Some(path), _) => from_model(a, path, desired, dt, &mut cfg)?,
         (None, Some(path)) => {
             let params = load_model_params(Some(path), a.allow_unstable)?;
             let comp = compensate_params(&params, position_loop, desired, dt, &cfg)
@@ -140,20 +110,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         }
         (None, None) => anyhow::bail!("give --model model.json or --params rig.toml"),
     };
-    // an unstable model (allowed by --allow-unstable) can give a command that runs away
-    for (name, v) in [
-        ("command", &comp.command),
-        ("predicted position", &comp.predicted),
-    ] {
-        if let Some(k) = v.iter().position(|x| !feedid::recording::is_usable(*x)) {
-            anyhow::bail!(
-                "{}: the {name} runs away ({:e} at t = {} s): the model cannot be inverted here; nothing written",
-                a.output.display(),
-                v[k],
-                rec.time()[k]
-            );
-        }
-    }
+    refuse_runaway(a, &rec, &comp)?;
     let _ = writeln!(
         text,
         "{}: {} samples at {:.2} Hz; model {source}",
@@ -172,10 +129,77 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     };
     write_command(a, verify_rig.as_ref(), &mut text, command, &[], |_| Ok(()))?;
     print!("{text}");
+    warn(a, &comp, desired);
+    Ok(())
+}
+
+/// The compensation from an identified model (`--model`), its quality on
+/// `--check` or on its own identification recording set in `cfg`; the
+/// model's description and the compensation.
+fn from_model(
+    a: &CompensateArgs,
+    path: &Path,
+    desired: &[f64],
+    dt: f64,
+    cfg: &mut CompensateConfig,
+) -> Result<(String, Compensation)> {
+    let file = crate::cmd::load_model_file(path)?;
+    cfg.quality = match &a.check {
+        Some(check) => {
+            // (dropped samples: the model runs through them)
+            let opts = ReadOptions {
+                allow_gaps: true,
+                ..ReadOptions::default()
+            };
+            let r = read_recording(check, &opts)?;
+            ModelQuality::from_recording(&file.model, &r)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", check.display()))?
+        }
+        // the fits on the model's own identification recording
+        None => ModelQuality {
+            position_fit_percent: file.identified_by.as_ref().map(|p| p.fit_percent),
+            error_fit_percent: file
+                .identified_by
+                .as_ref()
+                .and_then(|p| p.error_fit_percent),
+            noise_rms_m: None,
+        },
+    };
+    let comp = compensate_model(&file.model, desired, dt, cfg)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let how = match &file.identified_by {
+        Some(p) => format!("{} {} (fit {:.2} %)", p.method, p.orders, p.fit_percent),
+        None => "model".to_string(),
+    };
+    Ok((format!("{} [{how}]", path.display()), comp))
+}
+
+/// An unstable model (allowed by --allow-unstable) can give a command that
+/// runs away: refused, nothing written.
+fn refuse_runaway(a: &CompensateArgs, rec: &feedid::Recording, comp: &Compensation) -> Result<()> {
+    for (name, v) in [
+        ("command", &comp.command),
+        ("predicted position", &comp.predicted),
+    ] {
+        if let Some(k) = v.iter().position(|x| !feedid::recording::is_usable(*x)) {
+            anyhow::bail!(
+                "{}: the {name} runs away ({:e} at t = {} s): the model cannot be inverted here; nothing written",
+                a.output.display(),
+                v[k],
+                rec.time()[k]
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The warnings on standard error: a fallback to the plain trajectory (and
+/// where it exceeds a limit), approximated zeros, pre-actuation.
+fn warn(a: &CompensateArgs, comp: &Compensation, desired: &[f64]) {
     if let Some(f) = &comp.fallback {
         eprintln!(
             "warning: the plain desired trajectory is sent as the command: {f}; {}",
-            fallback_hint(f, a, &comp, desired)
+            fallback_hint(f, a, comp, desired)
         );
         // the plain trajectory is sent as it is: say where it exceeds a limit
         for (quantity, peak, at, limit, unit) in [
@@ -214,7 +238,6 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
             1e6 * comp.pre_actuation_m
         );
     }
-    Ok(())
 }
 
 /// `command.csv`: `time_s,command_m,desired_m,predicted_m`.

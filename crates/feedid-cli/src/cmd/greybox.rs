@@ -37,6 +37,38 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     if a.validate.is_some() {
         bail!("--validate simulates a drive structure (--params structure.toml); for the paper's rig it is not there yet");
     }
+    let settings = settings(a)?;
+
+    let mut text = String::new();
+    let mut context = serde_json::Map::new();
+    let (fit, track) = match (&a.from_model, &a.input) {
+        (Some(path), _) => (from_model(path, &settings, &mut text, &mut context)?, None),
+        (None, Some(input)) => from_recording(a, input, &settings, &mut text, &mut context)?,
+        (None, None) => bail!("give a recording or --from-model model.json"),
+    };
+
+    report(&mut text, &fit);
+    if let Some(rows) = &track {
+        report_track(&mut text, &settings.estimate, rows);
+    }
+    write_outputs(a, &fit, track.as_deref(), &settings.estimate, context)?;
+    print!("{text}");
+    for w in fit.warnings() {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
+}
+
+/// What to estimate, from where, with which model.
+struct Settings {
+    estimate: Vec<PhysicalParameter>,
+    start: feedid::drive::RigParams,
+    position_loop: LoopModel,
+    cfg: GreyboxConfig,
+}
+
+/// The settings of a fit of the paper's rig from the arguments.
+fn settings(a: &GreyboxArgs) -> Result<Settings> {
     let estimate = PhysicalParameter::parse_list(&a.estimate)?;
     let start = load_model_params(a.params.as_deref(), a.allow_unstable)?;
     let position_loop: LoopModel = a.position_loop.parse()?;
@@ -60,184 +92,244 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     if a.track_window.is_some() && a.track_out.is_none() {
         bail!("--track-window needs --track-out track.csv");
     }
+    Ok(Settings {
+        estimate,
+        start,
+        position_loop,
+        cfg,
+    })
+}
 
-    let mut text = String::new();
-    let mut context = serde_json::Map::new();
-    let (fit, track) = match (&a.from_model, &a.input) {
-        (Some(path), _) => {
-            let file = crate::cmd::load_model_file(path)?;
-            let (num, den) = match &file.model {
-                LinearModel::Continuous { num, den } if den.len() == 8 && num.len() <= 3 => {
-                    (num.clone(), den.clone())
-                }
-                _ => bail!(
-                    "{}: parameters from coefficients need a continuous model N(s)/D(s) with 7 poles and at most 2 zeros (identify with --model-out M --model-kind oe --model-order 7,2)",
-                    path.display()
-                ),
-            };
-            let fit = fit_coefficients(&num, &den, &start, &estimate, &cfg)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-            let _ = writeln!(
-                text,
-                "{}: N2…N0, D7…D0 of the identified model, {} coefficient ratios",
-                path.display(),
-                fit.residuals
-            );
-            context.insert("from_model".into(), path.display().to_string().into());
-            (fit, None)
+/// Parameters from the coefficients of an identified continuous model.
+fn from_model(
+    path: &Path,
+    st: &Settings,
+    text: &mut String,
+    context: &mut serde_json::Map<String, serde_json::Value>,
+) -> Result<GreyboxFit> {
+    let file = crate::cmd::load_model_file(path)?;
+    let (num, den) = match &file.model {
+        LinearModel::Continuous { num, den } if den.len() == 8 && num.len() <= 3 => {
+            (num.clone(), den.clone())
         }
-        (None, Some(input)) => {
-            // dropped samples: the simulation runs through them on the
-            // regular grid (the command interpolated there) and only the
-            // measured samples are compared
-            let (rec, warnings) = recording::load_checked(input, &a.recording)?;
-            context.insert("warnings".into(), warnings.into());
-            let current = match &a.current {
-                Some(name) => Some(
-                    rec.extra()
-                        .iter()
-                        .find(|(n, _)| n == name || n.eq_ignore_ascii_case(name))
-                        .map(|(_, v)| v.as_slice())
-                        .ok_or_else(|| {
-                            let names: Vec<&str> =
-                                rec.extra().iter().map(|(n, _)| n.as_str()).collect();
-                            anyhow::anyhow!(
-                                "{}: no current column `{name}`; numeric columns besides time, command and position: {}",
-                                input.display(),
-                                if names.is_empty() { "none".to_string() } else { names.join(", ") }
-                            )
-                        })?,
-                ),
-                None => None,
-            };
-            let gapped = !rec.gaps().is_empty();
-            let fill = |v: &[f64]| -> Result<Vec<f64>> {
-                Ok(if gapped {
-                    rec.fill_gaps(v)?
-                } else {
-                    Vec::new()
-                })
-            };
-            let (command, position) = (fill(rec.command())?, fill(rec.position())?);
-            let current_grid = current.map(fill).transpose()?;
-            let measured = if gapped {
-                rec.grid_indices()
-            } else {
-                Vec::new()
-            };
-            let mut data = if gapped {
-                Measurements::new(&command, &position, rec.dt()).with_measured(&measured)
-            } else {
-                Measurements::new(rec.command(), rec.position(), rec.dt())
-            };
-            if let Some(c) = current {
-                data = data.with_current(match &current_grid {
-                    Some(g) if gapped => g,
-                    _ => c,
-                });
-            }
-            let bar = ProgressBar::new("greybox", "fits");
-            let update = |done: u64, total: u64| bar.update(done, total);
-            let fit = fit_greybox_with_progress(&data, &start, &estimate, &cfg, Some(&update));
-            bar.finish();
-            let fit = fit.map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
-            let _ = writeln!(
-                text,
-                "{}: {} samples at {:.2} Hz; {} model, {} position loop; outputs: position{}",
-                input.display(),
-                rec.len(),
-                rec.rate_hz(),
-                if a.friction {
-                    "nonlinear (friction)"
-                } else {
-                    "linear"
-                },
-                position_loop.name(),
-                if current.is_some() { ", current" } else { "" }
-            );
-            if gapped {
-                let _ = writeln!(
-                    text,
-                    "{} gap(s) of dropped samples ({} missing): the model runs through them on the command interpolated there; only the {} measured samples are compared",
-                    rec.gaps().len(),
-                    rec.missing_samples(),
-                    rec.len()
-                );
-            }
-            context.insert("input".into(), input.display().to_string().into());
-            context.insert("samples".into(), rec.len().into());
-            context.insert("gaps".into(), rec.gaps().len().into());
-            context.insert("missing_samples".into(), rec.missing_samples().into());
-            context.insert("rate_hz".into(), rec.rate_hz().into());
-            context.insert(
-                "dynamics".into(),
-                (if a.friction { "nonlinear" } else { "linear" }).into(),
-            );
-            context.insert("position_loop".into(), position_loop.name().into());
-            if let Some(c) = &a.current {
-                context.insert("current".into(), c.clone().into());
-            }
-            let track = match a.track_window {
-                Some(w) => {
-                    let samples = |s: f64, what: &str| -> Result<usize> {
-                        let n = (s * rec.rate_hz()).round();
-                        if !(n.is_finite() && n >= 1.0) {
-                            bail!("invalid {what} {s} s: must be at least one sample");
-                        }
-                        Ok(n as usize)
-                    };
-                    let window = samples(w, "--track-window")?;
-                    let hop = match a.track_hop {
-                        Some(h) => samples(h, "--track-hop")?,
-                        None => (window / 2).max(1),
-                    };
-                    let tc = TrackConfig {
-                        window,
-                        hop,
-                        ..TrackConfig::default()
-                    };
-                    let start_track = fit.params;
-                    let bar = ProgressBar::new("tracking", "windows");
-                    let update = |done: u64, total: u64| bar.update(done, total);
-                    let rows = track_greybox_with_progress(
-                        &data,
-                        &start_track,
-                        &estimate,
-                        &cfg,
-                        &tc,
-                        Some(&update),
-                    );
-                    bar.finish();
-                    let rows =
-                        rows.map_err(|e| anyhow::anyhow!("{}: tracking: {e}", input.display()))?;
-                    Some(rows)
-                }
-                None => None,
-            };
-            (fit, track)
-        }
-        (None, None) => bail!("give a recording or --from-model model.json"),
+        _ => bail!(
+            "{}: parameters from coefficients need a continuous model N(s)/D(s) with 7 poles and at most 2 zeros (identify with --model-out M --model-kind oe --model-order 7,2)",
+            path.display()
+        ),
     };
+    let fit = fit_coefficients(&num, &den, &st.start, &st.estimate, &st.cfg)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let _ = writeln!(
+        text,
+        "{}: N2…N0, D7…D0 of the identified model, {} coefficient ratios",
+        path.display(),
+        fit.residuals
+    );
+    context.insert("from_model".into(), path.display().to_string().into());
+    Ok(fit)
+}
 
-    report(&mut text, &fit);
-    if let Some(rows) = &track {
-        report_track(&mut text, &estimate, rows);
+/// The recording's column `--current` names, if any.
+fn current_column<'r>(
+    rec: &'r feedid::Recording,
+    a: &GreyboxArgs,
+    input: &Path,
+) -> Result<Option<&'r [f64]>> {
+    let Some(name) = &a.current else {
+        return Ok(None);
+    };
+    let column = rec
+        .extra()
+        .iter()
+        .find(|(n, _)| n == name || n.eq_ignore_ascii_case(name))
+        .map(|(_, v)| v.as_slice())
+        .ok_or_else(|| {
+            let names: Vec<&str> = rec.extra().iter().map(|(n, _)| n.as_str()).collect();
+            anyhow::anyhow!(
+                "{}: no current column `{name}`; numeric columns besides time, command and position: {}",
+                input.display(),
+                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+            )
+        })?;
+    Ok(Some(column))
+}
+
+/// Parameters from a recording by simulation error, and the tracking over
+/// windows if asked.
+fn from_recording(
+    a: &GreyboxArgs,
+    input: &Path,
+    st: &Settings,
+    text: &mut String,
+    context: &mut serde_json::Map<String, serde_json::Value>,
+) -> Result<(GreyboxFit, Option<Vec<TrackWindow>>)> {
+    // dropped samples: the simulation runs through them on the
+    // regular grid (the command interpolated there) and only the
+    // measured samples are compared
+    let (rec, warnings) = recording::load_checked(input, &a.recording)?;
+    context.insert("warnings".into(), warnings.into());
+    let current = current_column(&rec, a, input)?;
+    let gapped = !rec.gaps().is_empty();
+    let fill = |v: &[f64]| -> Result<Vec<f64>> {
+        Ok(if gapped {
+            rec.fill_gaps(v)?
+        } else {
+            Vec::new()
+        })
+    };
+    let (command, position) = (fill(rec.command())?, fill(rec.position())?);
+    let current_grid = current.map(fill).transpose()?;
+    let measured = if gapped {
+        rec.grid_indices()
+    } else {
+        Vec::new()
+    };
+    let mut data = if gapped {
+        Measurements::new(&command, &position, rec.dt()).with_measured(&measured)
+    } else {
+        Measurements::new(rec.command(), rec.position(), rec.dt())
+    };
+    if let Some(c) = current {
+        data = data.with_current(match &current_grid {
+            Some(g) if gapped => g,
+            _ => c,
+        });
     }
+    let bar = ProgressBar::new("greybox", "fits");
+    let update = |done: u64, total: u64| bar.update(done, total);
+    let fit = fit_greybox_with_progress(&data, &st.start, &st.estimate, &st.cfg, Some(&update));
+    bar.finish();
+    let fit = fit.map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    describe_recording(
+        a,
+        input,
+        &rec,
+        st.position_loop,
+        current.is_some(),
+        text,
+        context,
+    );
+    let track = match a.track_window {
+        Some(w) => Some(track(a, input, &rec, &data, &fit, st, w)?),
+        None => None,
+    };
+    Ok((fit, track))
+}
 
+/// The report's line on the recording and its context in the summary.
+fn describe_recording(
+    a: &GreyboxArgs,
+    input: &Path,
+    rec: &feedid::Recording,
+    position_loop: LoopModel,
+    with_current: bool,
+    text: &mut String,
+    context: &mut serde_json::Map<String, serde_json::Value>,
+) {
+    let gapped = !rec.gaps().is_empty();
+    let _ = writeln!(
+        text,
+        "{}: {} samples at {:.2} Hz; {} model, {} position loop; outputs: position{}",
+        input.display(),
+        rec.len(),
+        rec.rate_hz(),
+        if a.friction {
+            "nonlinear (friction)"
+        } else {
+            "linear"
+        },
+        position_loop.name(),
+        if with_current { ", current" } else { "" }
+    );
+    if gapped {
+        let _ = writeln!(
+            text,
+            "{} gap(s) of dropped samples ({} missing): the model runs through them on the command interpolated there; only the {} measured samples are compared",
+            rec.gaps().len(),
+            rec.missing_samples(),
+            rec.len()
+        );
+    }
+    context.insert("input".into(), input.display().to_string().into());
+    context.insert("samples".into(), rec.len().into());
+    context.insert("gaps".into(), rec.gaps().len().into());
+    context.insert("missing_samples".into(), rec.missing_samples().into());
+    context.insert("rate_hz".into(), rec.rate_hz().into());
+    context.insert(
+        "dynamics".into(),
+        (if a.friction { "nonlinear" } else { "linear" }).into(),
+    );
+    context.insert("position_loop".into(), position_loop.name().into());
+    if let Some(c) = &a.current {
+        context.insert("current".into(), c.clone().into());
+    }
+}
+
+/// The parameters tracked over windows of `window_s` seconds, from the
+/// whole recording's fit.
+fn track(
+    a: &GreyboxArgs,
+    input: &Path,
+    rec: &feedid::Recording,
+    data: &Measurements<'_>,
+    fit: &GreyboxFit,
+    st: &Settings,
+    window_s: f64,
+) -> Result<Vec<TrackWindow>> {
+    let samples = |s: f64, what: &str| -> Result<usize> {
+        let n = (s * rec.rate_hz()).round();
+        if !(n.is_finite() && n >= 1.0) {
+            bail!("invalid {what} {s} s: must be at least one sample");
+        }
+        Ok(n as usize)
+    };
+    let window = samples(window_s, "--track-window")?;
+    let hop = match a.track_hop {
+        Some(h) => samples(h, "--track-hop")?,
+        None => (window / 2).max(1),
+    };
+    let tc = TrackConfig {
+        window,
+        hop,
+        ..TrackConfig::default()
+    };
+    let start_track = fit.params;
+    let bar = ProgressBar::new("tracking", "windows");
+    let update = |done: u64, total: u64| bar.update(done, total);
+    let rows = track_greybox_with_progress(
+        data,
+        &start_track,
+        &st.estimate,
+        &st.cfg,
+        &tc,
+        Some(&update),
+    );
+    bar.finish();
+    rows.map_err(|e| anyhow::anyhow!("{}: tracking: {e}", input.display()))
+}
+
+/// The parameter file, the track table and the summary, written together.
+fn write_outputs(
+    a: &GreyboxArgs,
+    fit: &GreyboxFit,
+    track: Option<&[TrackWindow]>,
+    estimate: &[PhysicalParameter],
+    context: serde_json::Map<String, serde_json::Value>,
+) -> Result<()> {
     let mut outputs = Outputs::default();
     if let Some(p) = &a.params_out {
         outputs.add_text(p, fit.params.to_toml_string())?;
     }
-    if let (Some(p), Some(rows)) = (&a.track_out, &track) {
-        outputs.add(p, |w| write_track_csv(w, &estimate, rows))?;
+    if let (Some(p), Some(rows)) = (&a.track_out, track) {
+        outputs.add(p, |w| write_track_csv(w, estimate, rows))?;
     }
     if let Some(p) = &a.summary {
-        let mut v = serde_json::to_value(&fit)?;
+        let mut v = serde_json::to_value(fit)?;
         if let Some(obj) = v.as_object_mut() {
             for (k, val) in context {
                 obj.insert(k, val);
             }
-            if let Some(rows) = &track {
+            if let Some(rows) = track {
                 obj.insert("track".into(), serde_json::to_value(rows)?);
             }
         }
@@ -245,10 +337,6 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
         outputs.add_text(p, format!("{json}\n"))?;
     }
     outputs.commit()?;
-    print!("{text}");
-    for w in fit.warnings() {
-        eprintln!("warning: {w}");
-    }
     Ok(())
 }
 

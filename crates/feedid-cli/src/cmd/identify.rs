@@ -10,7 +10,6 @@ use feedid::io::{
     write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
 };
 use feedid::pipeline::Pipeline;
-use rayon::prelude::*;
 
 use crate::args::{IdentifyArgs, RecordingArgs};
 use crate::cmd::method::OrderOption;
@@ -178,26 +177,24 @@ pub fn run(a: &IdentifyArgs) -> Result<()> {
             ins.extend(a.params.as_deref());
             let outs: Vec<&Path> = batch_outputs.iter().map(PathBuf::as_path).collect();
             check_distinct(&ins, &outs)?;
-            let results: Vec<Result<String>> = inputs
-                .par_iter()
-                .map(|input| {
-                    let stem = output_stem(input);
-                    let paths = OutputPaths {
-                        predictions: dir.join(format!("{stem}.predictions.csv")),
-                        coefficients: Some(dir.join(format!("{stem}.coefficients.csv"))),
-                        summary: Some(dir.join(format!("{stem}.summary.json"))),
-                        model: None,
-                    };
-                    identify_file(
-                        input,
-                        &a.recording,
-                        &pipeline,
-                        &rig,
-                        &paths,
-                        &ProgressBar::hidden(),
-                    )
-                })
-                .collect();
+            // read, identify and write each recording in its own task
+            let results: Vec<Result<String>> = pipeline.run_each(inputs, |pipeline, input| {
+                let stem = output_stem(input);
+                let paths = OutputPaths {
+                    predictions: dir.join(format!("{stem}.predictions.csv")),
+                    coefficients: Some(dir.join(format!("{stem}.coefficients.csv"))),
+                    summary: Some(dir.join(format!("{stem}.summary.json"))),
+                    model: None,
+                };
+                identify_file(
+                    input,
+                    &a.recording,
+                    pipeline,
+                    &rig,
+                    &paths,
+                    &ProgressBar::hidden(),
+                )
+            });
             let mut failed = 0;
             for r in &results {
                 match r {

@@ -53,7 +53,7 @@ use super::omitted::{missing_feed_forward, MissingFeedForward};
 use super::whiteness::{residual_structure, ResidualStructure};
 use crate::drive::{RigEffects, RigParams};
 use crate::error::{Error, Result};
-use crate::solve::{LevenbergMarquardt, LmConfig, Termination};
+use crate::solve::{LevenbergMarquardt, LmConfig, LmReport, Termination};
 use crate::stats::ErrorStats;
 
 /// Step of the central differences of the identifiability analysis (in `θ = ln p`).
@@ -565,13 +565,7 @@ pub fn fit_greybox_with_progress(
     progress: Option<&(dyn Fn(u64, u64) + Sync)>,
 ) -> Result<GreyboxFit> {
     let stages = 3 + u64::from(data.current.is_some()) + cfg.restarts as u64;
-    let mut stage = 0;
-    let mut step = || {
-        stage += 1;
-        if let Some(p) = progress {
-            p(stage.min(stages), stages);
-        }
-    };
+    let mut step = stepper(progress, stages);
     let base = check_set(
         estimate,
         start,
@@ -580,6 +574,144 @@ pub fn fit_greybox_with_progress(
     )?;
     data.check(2 * estimate.len() + 2)?;
     let n = estimate.len();
+    let (mut prob, scales) = problem(data, start, estimate, cfg, base);
+    let m = prob.residuals();
+
+    // identifiability at the start
+    let mut theta = vec![0.0; n];
+    let mut jac = vec![0.0; m * n];
+    let mut r = vec![0.0; m];
+    let at_start = analyse_at(&mut prob, &theta, &cfg.thresholds, &mut r, &mut jac)?;
+    if cfg.refuse_unidentifiable {
+        if let Some(e) = at_start.refusal() {
+            return Err(e);
+        }
+    }
+
+    step();
+    let mut lm = LevenbergMarquardt::new(m, n);
+    let lm_cfg = LmConfig {
+        ftol: cfg.tolerance,
+        xtol: cfg.tolerance,
+        gtol: cfg.tolerance,
+        max_iterations: cfg.max_iterations.max(1),
+        ..LmConfig::default()
+    };
+    let mut report = minimize(
+        &mut prob, &mut lm, &mut theta, &mut r, &lm_cfg, &scales, &mut step,
+    )?;
+    let restart_ends = restart(
+        &mut prob,
+        &mut lm,
+        &mut theta,
+        &lm_cfg,
+        cfg.restarts,
+        &mut report,
+        &mut step,
+    )?;
+
+    let mut analysis = analyse_at(&mut prob, &theta, &cfg.thresholds, &mut r, &mut jac)?;
+    step();
+    let (rms_y, rms_i) = prob.channel_rms();
+    let (structure, missing) = residual_checks(&prob, &r, &jac, start, &scales, rms_y, rms_i)?;
+    let structured = structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
+    let spread = restart_verdicts(&mut analysis, &restart_ends, &theta, structured);
+    let (ests, params, effects, fit_percent) =
+        estimates_at(&prob, start, cfg, &theta, &analysis, &spread);
+    Ok(GreyboxFit {
+        source: "recording",
+        estimates: ests,
+        correlation: analysis.correlation.clone(),
+        condition_number: analysis.condition_number,
+        null_directions: analysis.null_directions.clone(),
+        termination: report.termination,
+        iterations: report.iterations,
+        evaluations: prob.evaluations,
+        residual_rms: rms_y,
+        current_residual_rms: rms_i,
+        fit_percent: Some(fit_percent),
+        residuals: m,
+        residual_structure: structure,
+        restarts: cfg.restarts,
+        missing_feed_forward: missing,
+        params,
+        effects,
+    })
+}
+
+/// The estimates at `theta` with the spread of the restarts, the parameter
+/// set and effects they give, and the fit of the simulated position \[%\].
+fn estimates_at(
+    prob: &Problem<'_>,
+    start: &RigParams,
+    cfg: &GreyboxConfig,
+    theta: &[f64],
+    analysis: &Identifiability,
+    spread: &[Option<f64>],
+) -> (Vec<ParameterEstimate>, RigParams, RigEffects, f64) {
+    let stats = ErrorStats::from_pairs(
+        prob.rows
+            .iter()
+            .map(|&k| (prob.data.position[k], prob.sim_position[k])),
+    );
+    let mut params = *start;
+    let mut effects = cfg.effects;
+    apply(prob.estimate, &prob.base, theta, &mut params, &mut effects);
+    let mut ests = estimates(prob.estimate, &prob.base, theta, analysis);
+    for (e, s) in ests.iter_mut().zip(spread) {
+        e.start_spread = *s;
+    }
+    (ests, params, effects, stats.fit_percent)
+}
+
+/// A progress step of `stages`: each call reports one more done.
+fn stepper(progress: Option<&(dyn Fn(u64, u64) + Sync)>, stages: u64) -> impl FnMut() + '_ {
+    let mut stage = 0;
+    move || {
+        stage += 1;
+        if let Some(p) = progress {
+            p(stage.min(stages), stages);
+        }
+    }
+}
+
+/// The identifiability analysis at `theta`: the Jacobian into `jac`, the
+/// residuals at `theta` into `r`.
+fn analyse_at(
+    prob: &mut Problem<'_>,
+    theta: &[f64],
+    thresholds: &IdentifiabilityThresholds,
+    r: &mut [f64],
+    jac: &mut [f64],
+) -> Result<Identifiability> {
+    let m = r.len();
+    central_jacobian(
+        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+        theta,
+        m,
+        r,
+        jac,
+    );
+    prob.eval(theta, r);
+    let ss: f64 = r.iter().map(|v| v * v).sum();
+    analyse(jac, m, prob.estimate, ss, thresholds)
+}
+
+/// The scales of the two channels: the rms deviation of the position from
+/// its first value and the rms current (floored at 1e-12).
+struct Scales {
+    y: f64,
+    i: f64,
+}
+
+/// The weighted residual problem of a recording at the start parameters.
+fn problem<'a>(
+    data: &Measurements<'a>,
+    start: &RigParams,
+    estimate: &'a [PhysicalParameter],
+    cfg: &GreyboxConfig,
+    base: Vec<f64>,
+) -> (Problem<'a>, Scales) {
     let len = data.command.len();
     let deviation_rms = |v: &[f64]| {
         let v0 = v.first().copied().unwrap_or(0.0);
@@ -590,10 +722,10 @@ pub fn fit_greybox_with_progress(
     let i_scale = data
         .current
         .map_or(1.0, |c| crate::stats::rms(c).max(1e-12));
-    let mut prob = Problem {
+    let prob = Problem {
         data: *data,
         estimate,
-        base: base.clone(),
+        base,
         model: PhysicalModel {
             params: *start,
             effects: cfg.effects,
@@ -611,56 +743,45 @@ pub fn fit_greybox_with_progress(
         penalty: 1e3 * if data.current.is_some() { 1.0 } else { y_scale },
         evaluations: 0,
     };
-    let m = prob.residuals();
+    (
+        prob,
+        Scales {
+            y: y_scale,
+            i: i_scale,
+        },
+    )
+}
 
-    // identifiability at the start
-    let mut theta = vec![0.0; n];
-    let mut jac = vec![0.0; m * n];
-    let mut r = vec![0.0; m];
-    central_jacobian(
-        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-        &theta,
-        m,
-        &mut r,
-        &mut jac,
-    );
-    prob.eval(&theta, &mut r);
-    let ss0: f64 = r.iter().map(|v| v * v).sum();
-    let at_start = analyse(&jac, m, estimate, ss0, &cfg.thresholds)?;
-    if cfg.refuse_unidentifiable {
-        if let Some(e) = at_start.refusal() {
-            return Err(e);
-        }
-    }
-
-    step();
-    let mut lm = LevenbergMarquardt::new(m, n);
-    let lm_cfg = LmConfig {
-        ftol: cfg.tolerance,
-        xtol: cfg.tolerance,
-        gtol: cfg.tolerance,
-        max_iterations: cfg.max_iterations.max(1),
-        ..LmConfig::default()
-    };
+/// The least-squares fit from `theta` (written back): one pass, and with a
+/// current a second, each channel weighted by its residual level.
+fn minimize(
+    prob: &mut Problem<'_>,
+    lm: &mut LevenbergMarquardt,
+    theta: &mut [f64],
+    r: &mut [f64],
+    lm_cfg: &LmConfig,
+    scales: &Scales,
+    step: &mut dyn FnMut(),
+) -> Result<LmReport> {
     let mut report = lm.minimize(
         |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-        &mut theta,
-        &lm_cfg,
+        theta,
+        lm_cfg,
     )?;
     step();
-    if data.current.is_some() {
+    if prob.data.current.is_some() {
         // second pass: each channel weighted by its residual level
-        prob.eval(&theta, &mut r);
+        prob.eval(theta, r);
         let (sy, si) = prob.channel_rms();
         let floor = |s: f64, scale: f64| s.max(1e-9 * scale).max(f64::MIN_POSITIVE);
         prob.weights = (
-            1.0 / floor(sy, y_scale),
-            1.0 / floor(si.unwrap_or(i_scale), i_scale),
+            1.0 / floor(sy, scales.y),
+            1.0 / floor(si.unwrap_or(scales.i), scales.i),
         );
         let second = lm.minimize(
             |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-            &mut theta,
-            &lm_cfg,
+            theta,
+            lm_cfg,
         )?;
         report.iterations += second.iterations;
         report.evaluations += second.evaluations;
@@ -668,85 +789,102 @@ pub fn fit_greybox_with_progress(
         report.residual_norm = second.residual_norm;
         step();
     }
+    Ok(report)
+}
 
-    // restarts: does the fit end where it started?
+/// Restarts: does the fit end where it started? `restarts` fits from
+/// points around the estimate; a better minimum becomes the estimate. The
+/// end points of the other fits (the first estimate among them if it was
+/// replaced).
+fn restart(
+    prob: &mut Problem<'_>,
+    lm: &mut LevenbergMarquardt,
+    theta: &mut Vec<f64>,
+    lm_cfg: &LmConfig,
+    restarts: usize,
+    report: &mut LmReport,
+    step: &mut dyn FnMut(),
+) -> Result<Vec<Vec<f64>>> {
     let mut ends: Vec<Vec<f64>> = Vec::new();
-    if cfg.restarts > 0 {
-        prob.eval(&theta, &mut r);
-        let mut best_ss: f64 = r.iter().map(|v| v * v).sum();
-        let main = theta.clone();
-        for k in 0..cfg.restarts {
-            let mut t: Vec<f64> = main
-                .iter()
-                .enumerate()
-                .map(|(j, v)| {
-                    let even = j % 2 == 0;
-                    let sign = match k % 4 {
-                        0 if even => 1.0,
-                        0 => -1.0,
-                        1 if even => -1.0,
-                        1 => 1.0,
-                        2 => 1.0,
-                        _ => -1.0,
-                    };
-                    v + sign * RESTART_STEP * (1.0 + (k / 4) as f64)
-                })
-                .collect();
-            let rep = lm.minimize(
-                |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-                &mut t,
-                &lm_cfg,
-            )?;
-            report.evaluations += rep.evaluations;
-            step();
-            prob.eval(&t, &mut r);
-            let ss_k: f64 = r.iter().map(|v| v * v).sum();
-            if ss_k < best_ss * (1.0 - 1e-9) {
-                // a better minimum: it becomes the estimate
-                best_ss = ss_k;
-                ends.push(std::mem::replace(&mut theta, t));
-            } else {
-                ends.push(t);
-            }
-        }
-        if theta != main {
-            ends.push(main);
+    if restarts == 0 {
+        return Ok(ends);
+    }
+    let r = &mut vec![0.0; prob.residuals()];
+    prob.eval(theta, r);
+    let mut best_ss: f64 = r.iter().map(|v| v * v).sum();
+    let main = theta.clone();
+    for k in 0..restarts {
+        let mut t: Vec<f64> = main
+            .iter()
+            .enumerate()
+            .map(|(j, v)| {
+                let even = j % 2 == 0;
+                let sign = match k % 4 {
+                    0 if even => 1.0,
+                    0 => -1.0,
+                    1 if even => -1.0,
+                    1 => 1.0,
+                    2 => 1.0,
+                    _ => -1.0,
+                };
+                v + sign * RESTART_STEP * (1.0 + (k / 4) as f64)
+            })
+            .collect();
+        let rep = lm.minimize(
+            |t: &[f64], out: &mut [f64]| prob.eval(t, out),
+            &mut t,
+            lm_cfg,
+        )?;
+        report.evaluations += rep.evaluations;
+        step();
+        prob.eval(&t, r);
+        let ss_k: f64 = r.iter().map(|v| v * v).sum();
+        if ss_k < best_ss * (1.0 - 1e-9) {
+            // a better minimum: it becomes the estimate
+            best_ss = ss_k;
+            ends.push(std::mem::replace(theta, t));
+        } else {
+            ends.push(t);
         }
     }
+    if *theta != main {
+        ends.push(main);
+    }
+    Ok(ends)
+}
 
-    central_jacobian(
-        &mut |t: &[f64], out: &mut [f64]| prob.eval(t, out),
-        &theta,
-        m,
-        &mut r,
-        &mut jac,
-    );
-    prob.eval(&theta, &mut r);
-    let ss: f64 = r.iter().map(|v| v * v).sum();
-    let mut analysis = analyse(&jac, m, estimate, ss, &cfg.thresholds)?;
-    step();
-    let (rms_y, rms_i) = prob.channel_rms();
-
-    // structure left in the residuals; not measured when the fit is exact to
-    // within EXACT_FIT of the signal (integration or rounding differences,
-    // which cannot bias an estimate by more than about that share)
-    // (with dropped samples: the residuals of the measured ones in a row,
-    // a lag off by the few dropped samples across each gap)
+/// Structure left in the residuals `r` at the estimate, and feed-forward
+/// left out of the model (asked only when it has none).
+fn residual_checks(
+    prob: &Problem<'_>,
+    r: &[f64],
+    jac: &[f64],
+    start: &RigParams,
+    scales: &Scales,
+    rms_y: f64,
+    rms_i: Option<f64>,
+) -> Result<(Vec<ResidualStructure>, Option<MissingFeedForward>)> {
+    let data = &prob.data;
+    let (m, n) = (r.len(), prob.estimate.len());
+    // not measured when the fit is exact to within EXACT_FIT of the signal
+    // (integration or rounding differences, which cannot bias an estimate by
+    // more than about that share) (with dropped samples: the residuals of
+    // the measured ones in a row, a lag off by the few dropped samples
+    // across each gap)
     let rows = prob.rows.len();
     let mut structure = Vec::new();
-    if rms_y > EXACT_FIT * y_scale {
+    if rms_y > EXACT_FIT * scales.y {
         structure.extend(residual_structure("position", &r[..rows]));
     }
     if let (Some(ri), true) = (rms_i, data.current.is_some()) {
-        if ri > EXACT_FIT * i_scale {
+        if ri > EXACT_FIT * scales.i {
             structure.extend(residual_structure("current", &r[rows..]));
         }
     }
-    // feed-forward left out? (only asked when the model has none)
     let no_feed_forward = start.control.kvff == 0.0
         && start.control.kaff == 0.0
-        && !estimate.iter().any(|p| p.is_feed_forward());
-    let missing = if no_feed_forward && rms_y > EXACT_FIT * y_scale {
+        && !prob.estimate.iter().any(|p| p.is_feed_forward());
+    let missing = if no_feed_forward && rms_y > EXACT_FIT * scales.y {
         let position_jacobian: Vec<f64> = (0..n)
             .flat_map(|j| jac[j * m..j * m + rows].iter().copied())
             .collect();
@@ -762,9 +900,19 @@ pub fn fit_greybox_with_progress(
     } else {
         None
     };
-    let structured = structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
-    // spread of the restarts in log-parameters, against the standard error
-    let spread: Vec<Option<f64>> = (0..n)
+    Ok((structure, missing))
+}
+
+/// The spread of the restarts per parameter in log-parameters (`None`
+/// without restarts); a parameter that moved beyond its standard error is
+/// not identifiable, and with structured residuals the others unreliable.
+fn restart_verdicts(
+    analysis: &mut Identifiability,
+    ends: &[Vec<f64>],
+    theta: &[f64],
+    structured: bool,
+) -> Vec<Option<f64>> {
+    let spread: Vec<Option<f64>> = (0..theta.len())
         .map(|j| {
             (!ends.is_empty()).then(|| {
                 ends.iter()
@@ -787,37 +935,7 @@ pub fn fit_greybox_with_progress(
             *v = Verdict::Unreliable;
         }
     }
-    let stats = ErrorStats::from_pairs(
-        prob.rows
-            .iter()
-            .map(|&k| (data.position[k], prob.sim_position[k])),
-    );
-    let mut params = *start;
-    let mut effects = cfg.effects;
-    apply(estimate, &base, &theta, &mut params, &mut effects);
-    let mut ests = estimates(estimate, &base, &theta, &analysis);
-    for (e, s) in ests.iter_mut().zip(&spread) {
-        e.start_spread = *s;
-    }
-    Ok(GreyboxFit {
-        source: "recording",
-        estimates: ests,
-        correlation: analysis.correlation.clone(),
-        condition_number: analysis.condition_number,
-        null_directions: analysis.null_directions.clone(),
-        termination: report.termination,
-        iterations: report.iterations,
-        evaluations: prob.evaluations,
-        residual_rms: rms_y,
-        current_residual_rms: rms_i,
-        fit_percent: Some(stats.fit_percent),
-        residuals: m,
-        residual_structure: structure,
-        restarts: cfg.restarts,
-        missing_feed_forward: missing,
-        params,
-        effects,
-    })
+    spread
 }
 
 /// Lengths, finiteness, sample time.

@@ -10,14 +10,14 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::io::csv::{
-    decimal_comma_hint, detect_delimiter, for_each_field, number_like, parse_number,
-    resolve_column, split_checked, Delim, Line,
-};
+use crate::io::columns::short_text;
 use crate::io::options::{
     ChannelRef, ReadOptions, DEFAULT_COMMAND_COLUMN, DEFAULT_POSITION_COLUMN, DEFAULT_TIME_COLUMN,
 };
-use crate::io::read::short_text;
+use crate::io::text::{
+    decimal_comma_hint, detect_delimiter, for_each_field, number_like, parse_number,
+    resolve_column, split_checked, Delim, Line,
+};
 
 /// Which columns hold time, command and position when the options name none
 /// and the text has no header.

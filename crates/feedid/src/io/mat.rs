@@ -61,8 +61,8 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
+use crate::io::columns::{build_recording, failing_sample, in_file, short_list, Role};
 use crate::io::options::{ChannelRef, ReadOptions};
-use crate::io::read::{build_recording, failing_sample, in_file, short_list, Role};
 use crate::io::source::read_file;
 use crate::recording::Recording;
 

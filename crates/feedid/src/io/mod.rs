@@ -1,13 +1,12 @@
 //! Reading recordings from CSV/text and MATLAB v5 files ([`read_recording`]
-//! dispatches), the options that pick columns and units ([`ReadOptions`]),
-//! the summary a user checks before identifying ([`recording_info`]), a
+//! dispatches), the options that pick columns and units ([`ReadOptions`]), a
 //! live text stream read line by line with the same options
 //! ([`StreamReader`]), and writing results without destroying anything or
 //! leaving partial files ([`OutputSet`], [`write_atomic`]), and the CSV
 //! tables of results.
 
+mod columns;
 mod csv;
-mod info;
 mod layout;
 mod mat;
 mod options;
@@ -16,9 +15,9 @@ mod read;
 mod source;
 mod stream;
 mod table;
+mod text;
 
-pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str, DECIMAL_COMMA_HINT};
-pub use self::info::{recording_info, ChannelStats, RecordingInfo};
+pub use self::csv::{read_csv, read_csv_from_bytes, read_csv_from_str};
 pub use self::mat::{
     list_mat_variables, list_mat_variables_from_bytes, read_mat, read_mat_from_bytes,
     MatVariableInfo,
@@ -42,6 +41,9 @@ pub use self::stream::{
     CommandRows, PredictionRows, StreamLine, StreamReader, COMMAND_COLUMNS, MAX_STREAM_LINE,
     PREDICTION_COLUMNS,
 };
+// the summary of a recording moved to `recording`; its old path stays
 pub use self::table::{
     cell, write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
 };
+pub use self::text::DECIMAL_COMMA_HINT;
+pub use crate::recording::{recording_info, ChannelStats, RecordingInfo};

@@ -47,10 +47,10 @@ use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::io::csv::Line;
 use crate::io::layout::{Headerless, TextLayout};
 use crate::io::options::ReadOptions;
 use crate::io::source::LineReader;
+use crate::io::text::Line;
 
 /// Longest line of a stream \[bytes\] (1 MiB, [`crate::io::MAX_LINE_BYTES`]);
 /// a longer one is skipped.

@@ -5,11 +5,11 @@ use crate::error::{Error, Result};
 use crate::ident::engine::{run_with, Progress};
 use crate::ident::{
     fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind,
-    GuardConfig, Method, OrderSearch, PredictionMode, Span, TimeOrigin, RESIDUAL_LAGS,
-    SHIFT_AMPLIFICATION_WARNING,
+    GuardConfig, Method, ModelFile, OrderSearch, PredictionMode, Signals, SlidingResult, Span,
+    TimeOrigin, RESIDUAL_LAGS, SHIFT_AMPLIFICATION_WARNING,
 };
 use crate::pipeline::{Identification, OrderChoice, Warning};
-use crate::plausibility::check_recording;
+use crate::recording::plausibility::check_recording;
 use crate::recording::{Recording, RecordingRef, DEFAULT_JITTER_TOLERANCE};
 use crate::stats::ErrorStats;
 
@@ -220,62 +220,119 @@ impl<'a> Pipeline<'a> {
         let mut method = self.method.clone();
         method.validate()?;
         self.guard.validate()?;
-        let order_choice = match &self.order_search {
-            None => None,
-            Some(search) => {
-                if method.orders().is_none() {
-                    return Err(Error::NotApplicable {
-                        setting: "order selection",
-                        method: method.name(),
-                        applies_to: "arx, rls, auto",
-                    });
-                }
-                // on the stretch without dropped samples where the command moves most
-                let part = recording.moving_segment();
-                let sel = select_order(
-                    &recording.command()[part.clone()],
-                    &recording.position()[part],
-                    recording.dt(),
-                    search,
-                )
-                .map_err(|e| Error::Stage {
-                    stage: "order selection",
-                    source: Box::new(e),
-                })?;
-                method.set_orders(sel.chosen)?;
-                Some(OrderChoice {
-                    orders: sel.chosen,
-                    criterion: sel.criterion,
-                })
-            }
-        };
+        let order_choice = self.choose_orders(&mut method, recording)?;
         let config = self.engine_config(&method, recording.rate_hz())?;
         let signals = recording.signals();
-        let mut warnings: Vec<Warning> = check_recording(recording)
-            .into_iter()
-            .map(Warning::Recording)
-            .collect();
-        if let Method::Paper(paper) = &method {
-            let g = paper.worst_shift_amplification(&signals, &config);
-            if g > SHIFT_AMPLIFICATION_WARNING {
-                warnings.push(Warning::PaperCoefficientAccuracy { amplification: g });
-            }
-            if paper.time_origin == TimeOrigin::Window {
-                warnings.push(Warning::PaperWindowOrigin);
-            }
-        }
+        let mut warnings = setup_warnings(&method, recording, &signals, &config);
+        let sliding = self.slide(&method, &signals, &config, &mut warnings)?;
+        self.sliding_warnings(recording, &sliding, &mut warnings);
+        let (simulated, simulation_stats) = self.simulate(recording, &sliding)?;
+        let residuals = self.residual_lags.and_then(|lags| {
+            prediction_residuals(
+                &sliding,
+                recording.command(),
+                recording.position(),
+                lags,
+                config.horizon,
+            )
+        });
+        let (global, global_note, model) = self.global_models(&method, recording)?;
+        Ok(Identification {
+            method,
+            config,
+            samples: recording.len(),
+            rate_hz: recording.rate_hz(),
+            gaps: recording.gaps().len(),
+            missing_samples: recording.missing_samples(),
+            order_choice,
+            sliding,
+            simulated,
+            simulation_stats,
+            residuals,
+            global,
+            global_note,
+            model,
+            warnings,
+        })
+    }
+}
 
-        let sliding = match &method {
+/// The recording's plausibility warnings and the paper method's warnings
+/// about its coefficients, known before the run.
+fn setup_warnings<S: AsRef<[f64]>>(
+    method: &Method,
+    recording: &Recording<S>,
+    signals: &Signals<'_>,
+    config: &EngineConfig,
+) -> Vec<Warning> {
+    let mut warnings: Vec<Warning> = check_recording(recording)
+        .into_iter()
+        .map(Warning::Recording)
+        .collect();
+    if let Method::Paper(paper) = method {
+        let g = paper.worst_shift_amplification(signals, config);
+        if g > SHIFT_AMPLIFICATION_WARNING {
+            warnings.push(Warning::PaperCoefficientAccuracy { amplification: g });
+        }
+        if paper.time_origin == TimeOrigin::Window {
+            warnings.push(Warning::PaperWindowOrigin);
+        }
+    }
+    warnings
+}
+
+/// The steps of [`Pipeline::run`]: orders, the sliding run and what it
+/// warns of, the nominal simulation, the global models.
+impl Pipeline<'_> {
+    /// The orders chosen from the data, set on `method` (if asked).
+    fn choose_orders<S: AsRef<[f64]>>(
+        &self,
+        method: &mut Method,
+        recording: &Recording<S>,
+    ) -> Result<Option<OrderChoice>> {
+        let Some(search) = &self.order_search else {
+            return Ok(None);
+        };
+        if method.orders().is_none() {
+            return Err(Error::NotApplicable {
+                setting: "order selection",
+                method: method.name(),
+                applies_to: "arx, rls, auto",
+            });
+        }
+        // on the stretch without dropped samples where the command moves most
+        let part = recording.moving_segment();
+        let sel = select_order(
+            &recording.command()[part.clone()],
+            &recording.position()[part],
+            recording.dt(),
+            search,
+        )
+        .map_err(|e| Error::Stage {
+            stage: "order selection",
+            source: Box::new(e),
+        })?;
+        method.set_orders(sel.chosen)?;
+        Ok(Some(OrderChoice {
+            orders: sel.chosen,
+            criterion: sel.criterion,
+        }))
+    }
+
+    /// The sliding identification and prediction of the method.
+    fn slide(
+        &self,
+        method: &Method,
+        signals: &Signals<'_>,
+        config: &EngineConfig,
+        warnings: &mut Vec<Warning>,
+    ) -> Result<SlidingResult> {
+        Ok(match method {
             // the paper's tf prediction may fall back per window: count it
             Method::Paper(paper) if paper.prediction == PredictionMode::TransferFunction => {
                 let mut estimator = (*paper).build()?;
-                let sliding = run_with(
-                    &mut estimator,
-                    &signals,
-                    &config,
-                    &self.guard,
-                    self.progress,
-                )?;
+                let sliding =
+                    run_with(&mut estimator, signals, config, &self.guard, self.progress)?;
                 let fallbacks = estimator.tf_fallbacks();
                 if fallbacks > 0 {
                     warnings.push(Warning::PaperTfFallback {
@@ -289,13 +346,23 @@ impl<'a> Pipeline<'a> {
                 let mut estimator = method.build()?;
                 run_with(
                     estimator.as_mut(),
-                    &signals,
-                    &config,
+                    signals,
+                    config,
                     &self.guard,
                     self.progress,
                 )?
             }
-        };
+        })
+    }
+
+    /// Warnings of the sliding run: dropped samples, nothing predicted,
+    /// withheld windows.
+    fn sliding_warnings<S: AsRef<[f64]>>(
+        &self,
+        recording: &Recording<S>,
+        sliding: &SlidingResult,
+        warnings: &mut Vec<Warning>,
+    ) {
         if let Some(g) = recording.gaps().first() {
             let segments = recording.segments();
             let unpredicted = segments
@@ -329,7 +396,15 @@ impl<'a> Pipeline<'a> {
                 factor: self.guard.plausibility.unwrap_or(f64::INFINITY),
             });
         }
+    }
 
+    /// The nominal simulation (if asked) and its errors over the predicted
+    /// samples (all samples if nothing was predicted).
+    fn simulate<S: AsRef<[f64]>>(
+        &self,
+        recording: &Recording<S>,
+        sliding: &SlidingResult,
+    ) -> Result<(Option<Vec<f64>>, Option<ErrorStats>)> {
         let simulated = match &self.nominal {
             Some(p) => {
                 Some(
@@ -341,7 +416,6 @@ impl<'a> Pipeline<'a> {
             }
             None => None,
         };
-        // over the predicted samples (all samples if nothing was predicted)
         let simulation_stats = simulated.as_ref().map(|sim| {
             let y = recording.position();
             let any = sliding.stats.samples > 0;
@@ -351,21 +425,20 @@ impl<'a> Pipeline<'a> {
                     .map(|k| (y[k], sim[k])),
             )
         });
-        let residuals = self.residual_lags.and_then(|lags| {
-            prediction_residuals(
-                &sliding,
-                recording.command(),
-                recording.position(),
-                lags,
-                config.horizon,
-            )
-        });
+        Ok((simulated, simulation_stats))
+    }
 
+    /// Global models of the whole recording (through any gaps): the
+    /// method's (or why it is missing) and the extra model.
+    fn global_models<S: AsRef<[f64]>>(
+        &self,
+        method: &Method,
+        recording: &Recording<S>,
+    ) -> Result<(Option<ModelFile>, Option<String>, Option<ModelFile>)> {
         let method_kind = method
             .global_model()
             .map(GlobalModelKind::for_summary)
             .filter(|_| self.method_global_model);
-        // global models of the whole recording (through any gaps)
         let fit_global = |kind: &GlobalModelKind| fit_global_model(recording, kind);
         let (global, global_note) = match &method_kind {
             None => (None, None),
@@ -382,23 +455,7 @@ impl<'a> Pipeline<'a> {
                 source: Box::new(e),
             })?),
         };
-        Ok(Identification {
-            method,
-            config,
-            samples: recording.len(),
-            rate_hz: recording.rate_hz(),
-            gaps: recording.gaps().len(),
-            missing_samples: recording.missing_samples(),
-            order_choice,
-            sliding,
-            simulated,
-            simulation_stats,
-            residuals,
-            global,
-            global_note,
-            model,
-            warnings,
-        })
+        Ok((global, global_note, model))
     }
 }
 

@@ -24,6 +24,10 @@
 //! assert!(serde_json::to_string(&s).unwrap().contains("\"rms_error_m\""));
 //! ```
 //!
+//! Many recordings: [`Pipeline::run_many`] (or [`Pipeline::run_each`] for a
+//! caller that reads and writes each in the same task) on all cores, results
+//! in input order, one failure per recording.
+//!
 //! Everything here is `Send` and free of command-line types; a binding can
 //! call [`Pipeline::run_slices`] with three `&[f64]`. Prediction intervals
 //! (per-sample lower and upper bounds) belong next to the predictions in
@@ -32,6 +36,7 @@
 //! [`Identification::warnings`].
 
 mod builder;
+mod many;
 mod run;
 mod summary;
 mod warning;

@@ -11,7 +11,7 @@ use serde::{Serialize, Serializer};
 pub enum Warning {
     /// The recording itself is implausible (a frozen position, different
     /// units, …): see [`crate::plausibility`].
-    Recording(crate::plausibility::Warning),
+    Recording(crate::recording::plausibility::Warning),
     /// Paper method with the motion time origin: the windows lie so far
     /// from the origin that the change of basis to the coefficients `N`,
     /// `D` loses digits (see

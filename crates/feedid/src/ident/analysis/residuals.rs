@@ -39,7 +39,7 @@
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::ident::SlidingResult;
+use crate::ident::engine::SlidingResult;
 
 /// z-value of the two-sided 99 % band.
 pub const Z_99: f64 = 2.58;

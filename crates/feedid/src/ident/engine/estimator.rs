@@ -4,7 +4,7 @@
 use std::ops::Range;
 
 use crate::error::Result;
-use crate::ident::Signals;
+use crate::ident::engine::Signals;
 use crate::solve::Termination;
 
 /// What a window's fit produced (returned by [`Estimator::fit`]).

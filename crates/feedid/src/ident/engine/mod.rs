@@ -1,8 +1,6 @@
 //! The estimator trait and what drives it: the sliding-window engine over a
-//! whole recording, the streaming engine fed one sample at a time, and
-//! batches of recordings on all cores.
+//! whole recording, and the streaming engine fed one sample at a time.
 
-pub mod batch;
 mod envelope;
 mod estimator;
 mod guard;

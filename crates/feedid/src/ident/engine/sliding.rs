@@ -52,7 +52,7 @@ use std::time::{Duration, Instant};
 use crate::error::{Error, Result};
 use crate::ident::engine::guard::{Guard, GuardConfig};
 use crate::ident::engine::regime::Regime;
-use crate::ident::{Estimator, PredictStatus, Signals, WindowOutcome};
+use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowOutcome};
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
 /// How often [`run_with_progress`] reports over a recording.
@@ -607,7 +607,7 @@ fn finite_or_zero(v: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::ident::engine::test_estimators::Wild;
-    use crate::ident::WindowFit;
+    use crate::ident::engine::WindowFit;
     use crate::solve::Termination;
 
     /// Predicts a straight line through the last two samples of the window;
@@ -762,12 +762,12 @@ mod tests {
         assert_eq!(r.prediction(we), Some(last + 2.0));
         // the stream cuts the same window back, by the same amount
         // (each window waiting for its command, as the batch engine has it)
-        let options = crate::ident::StreamOptions {
-            extrapolation: crate::ident::stream::CommandExtrapolation::Wait,
-            ..crate::ident::StreamOptions::default()
+        let options = crate::ident::engine::StreamOptions {
+            extrapolation: crate::ident::engine::stream::CommandExtrapolation::Wait,
+            ..crate::ident::engine::StreamOptions::default()
         };
         let mut st =
-            crate::ident::Streamer::with_options(Wild::new(30, 2.0), cfg, options).unwrap();
+            crate::ident::engine::Streamer::with_options(Wild::new(30, 2.0), cfg, options).unwrap();
         let mut cut = Vec::new();
         for k in 0..n {
             st.push(t[k], y[k], y[k]).unwrap();

@@ -6,7 +6,7 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowFit};
 use crate::solve::Termination;
 
 /// Holds the last position, except on window `wild` (counted from 1 after

@@ -6,7 +6,7 @@ mod arx;
 mod auto;
 mod oe;
 mod paper;
-mod regressor;
+pub(crate) mod regressor;
 mod rls;
 
 pub(crate) use arx::fit_arx_rows;

@@ -17,16 +17,18 @@ use std::ops::Range;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::ident::{LinearModel, Signals};
+use crate::ident::engine::Signals;
+use crate::ident::model::LinearModel;
+use crate::ident::option::{OptionKind, OptionRange, OptionSpec};
 
 /// Option `order` of the methods with an ARX regressor: its [`ArxOrders`]
 /// (`auto` as a value — choose them from the recording — is the front
 /// ends' to handle, before [`crate::ident::Method::set_option`]).
-pub(crate) const ORDER_OPTION: crate::ident::OptionSpec = crate::ident::OptionSpec {
+pub(crate) const ORDER_OPTION: OptionSpec = OptionSpec {
     key: "order",
     python: None,
     value_name: "NA,NB,NK|auto",
-    kind: crate::ident::OptionKind::Orders,
+    kind: OptionKind::Orders,
     range: None,
     unit: None,
     help: "ARX orders `na,nb,nk` (poles, input terms, input delay in samples), or `auto` \
@@ -36,12 +38,12 @@ pub(crate) const ORDER_OPTION: crate::ident::OptionSpec = crate::ident::OptionSp
 
 /// Option `ridge` of the least-squares fits on the ARX regressor: `arx`
 /// ([`crate::ident::ArxConfig::ridge`]) and `auto`'s windowed candidates.
-pub(crate) const RIDGE_OPTION: crate::ident::OptionSpec = crate::ident::OptionSpec {
+pub(crate) const RIDGE_OPTION: OptionSpec = OptionSpec {
     key: "ridge",
     python: None,
     value_name: "R",
-    kind: crate::ident::OptionKind::Float,
-    range: Some(crate::ident::OptionRange::at_least(0.0)),
+    kind: OptionKind::Float,
+    range: Some(OptionRange::at_least(0.0)),
     unit: None,
     help: "ridge of the least squares, relative to the regressors' scale (arx: on the \
            column-normalised coefficients; 0 = none)",

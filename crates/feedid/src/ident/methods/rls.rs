@@ -88,11 +88,11 @@
 use std::ops::Range;
 
 use crate::error::{Error, Result};
-use crate::ident::engine::rate_changed;
-use crate::ident::method::MethodSettings;
-use crate::ident::methods::regressor::{poles_inside, predict_horizon, ORDER_OPTION};
-use crate::ident::{ArxOrders, Estimator, PredictStatus, Signals, WindowFit};
-use crate::ident::{MethodOption, OptionKind, OptionRange, OptionSpec, OptionValue};
+use crate::ident::engine::{rate_changed, Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::methods::regressor::{poles_inside, predict_horizon, ArxOrders, ORDER_OPTION};
+use crate::ident::option::{
+    MethodOption, MethodSettings, OptionKind, OptionRange, OptionSpec, OptionValue,
+};
 use crate::solve::Termination;
 
 /// Configuration of the RLS estimator (defaults chosen on the drive zoo,
@@ -911,8 +911,8 @@ impl Estimator for RlsEstimator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ident::engine::FitStatus;
     use crate::ident::methods::regressor::regressor;
-    use crate::ident::FitStatus;
     use nalgebra::{DMatrix, DVector};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;

@@ -1,11 +1,7 @@
-//! Models of a whole recording: the linear model type and the global models
-//! (ARX, output error, the best of several) with where they came from.
+//! The linear model type every method and global fit produces: a discrete
+//! transfer function with its sample time (the global fits are in
+//! `ident/global.rs`, a layer above the methods).
 
-mod global;
 mod linear;
 
-pub use global::{
-    fit_global_model, simulation_error, GlobalModelKind, ModelFile, ModelProvenance,
-    GLOBAL_FIT_SAMPLES,
-};
 pub use linear::LinearModel;

@@ -81,8 +81,7 @@ use std::str::FromStr;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::ident::methods::{fit_arx_rows, regressor};
-use crate::ident::{ArxConfig, ArxOrders};
+use crate::ident::methods::{fit_arx_rows, regressor, ArxConfig, ArxOrders, MAX_ARX_ORDER};
 use crate::stats::InformationCriteria;
 
 /// A criterion for choosing the order.
@@ -359,7 +358,7 @@ pub struct OrderSelection {
 }
 
 fn check_range(name: &'static str, r: (usize, usize), min: usize) -> Result<()> {
-    if r.0 > r.1 || r.0 < min || r.1 > crate::ident::MAX_ARX_ORDER {
+    if r.0 > r.1 || r.0 < min || r.1 > MAX_ARX_ORDER {
         return Err(Error::InvalidParameter {
             name,
             value: r.1 as f64,
@@ -469,7 +468,7 @@ pub fn frols(u: &[f64], y: &[f64], cfg: &FrolsConfig) -> Result<FrolsResult> {
             actual: u.len(),
         });
     }
-    if !(cfg.tolerance >= 0.0) || cfg.max_lag == 0 || cfg.max_lag > crate::ident::MAX_ARX_ORDER {
+    if !(cfg.tolerance >= 0.0) || cfg.max_lag == 0 || cfg.max_lag > MAX_ARX_ORDER {
         return Err(Error::InvalidParameter {
             name: "frols",
             value: cfg.max_lag as f64,

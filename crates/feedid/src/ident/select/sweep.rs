@@ -52,7 +52,8 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::ident::engine::{run as run_engine, EngineConfig};
-use crate::ident::{ArxOrders, Method};
+use crate::ident::method::Method;
+use crate::ident::methods::ArxOrders;
 use crate::recording::Recording;
 use crate::stats::sig3;
 use crate::stats::ErrorAccumulator;

@@ -8,8 +8,9 @@ use crate::ident::engine::sliding::range;
 use crate::ident::engine::stream::options::{
     Arrival, CommandExtrapolation, HorizonCommand, Interval, Jump, StreamOptions,
 };
-use crate::ident::engine::{fit_and_predict, EngineConfig, Guard, Regime};
-use crate::ident::{Estimator, Signals, WindowOutcome};
+use crate::ident::engine::{
+    fit_and_predict, EngineConfig, Estimator, Guard, Regime, Signals, WindowOutcome,
+};
 use crate::recording::MOTION_THRESHOLD;
 use crate::stats::{ErrorAccumulator, ErrorStats};
 

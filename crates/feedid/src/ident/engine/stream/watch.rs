@@ -163,7 +163,7 @@ mod tests {
         assert_eq!(w.blocks(), (2, 1));
         let text = loss.advice(
             HorizonCommand::Extrapolated {
-                extrapolation: crate::ident::stream::CommandExtrapolation::Acceleration,
+                extrapolation: crate::ident::engine::stream::CommandExtrapolation::Acceleration,
                 known: 0,
             },
             10,

@@ -5,9 +5,8 @@
 
 use super::estimator::ArxEstimator;
 use crate::error::{Error, Result};
-use crate::ident::method::MethodSettings;
 use crate::ident::methods::regressor::{ArxOrders, ORDER_OPTION, RIDGE_OPTION};
-use crate::ident::{MethodOption, OptionValue};
+use crate::ident::option::{MethodOption, MethodSettings, OptionValue};
 
 impl MethodSettings for ArxConfig {
     fn options(&self) -> &'static [MethodOption] {

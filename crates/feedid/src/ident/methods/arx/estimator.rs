@@ -18,8 +18,9 @@ use super::config::ArxConfig;
 use super::factor::SlidingFactor;
 use crate::error::{Error, Result};
 use crate::ident::engine::rate_changed;
+use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowFit};
 use crate::ident::methods::regressor::{dc_gain, poles_inside, predict_horizon, MAX_ARX_ORDER};
-use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
+use crate::ident::model::LinearModel;
 use crate::solve::{
     hessenberg_condition, lstsq_hessenberg_view, lstsq_in_place, HessenbergWorkspace, LstsqOptions,
     QrWorkspace, Termination,

@@ -14,7 +14,7 @@ use serde::Serialize;
 use super::config::ArxConfig;
 use crate::error::{Error, Result};
 use crate::ident::methods::regressor::{regressor, ArxOrders};
-use crate::ident::LinearModel;
+use crate::ident::model::LinearModel;
 use crate::solve::{lstsq_in_place, LstsqOptions, QrWorkspace};
 
 /// Result of a batch ARX fit ([`fit_arx`]).

@@ -17,8 +17,9 @@ use std::ops::Range;
 
 use super::model::{self, with_dims};
 use crate::error::{Error, Result};
+use crate::ident::engine::Signals;
+use crate::ident::methods::regressor::ArxOrders;
 use crate::ident::methods::rls::{fold_scale, has_avx2, rls_update};
-use crate::ident::{ArxOrders, Signals};
 
 /// Initial covariance `P₀ = p0·I` of the recursive candidates, in
 /// coordinates scaled by the largest regressor of the first informative

@@ -6,9 +6,8 @@
 use super::candidate::Candidate;
 use super::estimator::AutoEstimator;
 use crate::error::{Error, Result};
-use crate::ident::method::MethodSettings;
-use crate::ident::methods::regressor::{ORDER_OPTION, RIDGE_OPTION};
-use crate::ident::{ArxOrders, MethodOption, OptionValue};
+use crate::ident::methods::regressor::{ArxOrders, ORDER_OPTION, RIDGE_OPTION};
+use crate::ident::option::{MethodOption, MethodSettings, OptionValue};
 
 impl MethodSettings for AutoConfig {
     fn options(&self) -> &'static [MethodOption] {

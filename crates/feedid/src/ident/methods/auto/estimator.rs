@@ -9,8 +9,7 @@ use super::candidate::{Candidate, Predictor};
 use super::config::AutoConfig;
 use super::model;
 use crate::error::{Error, Result};
-use crate::ident::engine::rate_changed;
-use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::engine::{rate_changed, Estimator, PredictStatus, Signals, WindowFit};
 use crate::solve::Termination;
 
 /// Regimes of a horizon, scored apart: 0 = the command is still over the
@@ -767,7 +766,12 @@ mod tests {
 
     /// `auto` with `config` over time `t` (1 kHz), command `u` and
     /// position `y` (window 50, H = hop = 10).
-    fn run_on(config: AutoConfig, t: &[f64], u: &[f64], y: &[f64]) -> crate::ident::SlidingResult {
+    fn run_on(
+        config: AutoConfig,
+        t: &[f64],
+        u: &[f64],
+        y: &[f64],
+    ) -> crate::ident::engine::SlidingResult {
         let mut est = config.build().unwrap();
         let s = Signals::new(t, u, y, 1e-3, 0.0);
         let cfg = EngineConfig {
@@ -783,7 +787,7 @@ mod tests {
     fn run_candidates(
         candidates: Vec<Candidate>,
         offset: f64,
-    ) -> (Vec<f64>, Vec<f64>, crate::ident::SlidingResult) {
+    ) -> (Vec<f64>, Vec<f64>, crate::ident::engine::SlidingResult) {
         let (t, u, y) = signals_data(offset);
         let config = AutoConfig {
             candidates,
@@ -796,7 +800,7 @@ mod tests {
 
     /// `auto` with the command as its only candidate, so that the first
     /// prediction is either the command or the held position.
-    fn run_command_only(offset: f64) -> (Vec<f64>, Vec<f64>, crate::ident::SlidingResult) {
+    fn run_command_only(offset: f64) -> (Vec<f64>, Vec<f64>, crate::ident::engine::SlidingResult) {
         run_candidates(vec![Candidate::Command], offset)
     }
 

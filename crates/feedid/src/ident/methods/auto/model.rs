@@ -40,7 +40,7 @@
 // Index loops mirror the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use crate::ident::ArxOrders;
+use crate::ident::methods::regressor::ArxOrders;
 
 /// Samples needed before a regression row: `max(na, nk + nb − 1, 1)`.
 pub(crate) fn lag(o: &ArxOrders) -> usize {

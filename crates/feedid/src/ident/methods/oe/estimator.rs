@@ -86,7 +86,8 @@ use super::companion::{is_hurwitz, output, reflect_unstable, MAX_ORDER};
 use super::srivc::srivc;
 use super::window::WindowWork;
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, LinearModel, PredictStatus, Signals, WindowFit};
+use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::model::LinearModel;
 use crate::lti::TransferFunction;
 use crate::solve::{LevenbergMarquardt, LmConfig, LmReport, Termination};
 
@@ -156,7 +157,7 @@ impl Default for OeConfig {
 }
 
 /// `oe` has no options of its own (its orders are poles and zeros, set in code).
-impl crate::ident::method::MethodSettings for OeConfig {}
+impl crate::ident::option::MethodSettings for OeConfig {}
 
 impl OeConfig {
     /// Check the settings.
@@ -775,9 +776,8 @@ impl Estimator for OeEstimator {
 mod tests {
     use super::*;
     use crate::drive::{closed_loop_coefficients, simulate_nominal, D1Variant, RigParams};
-    use crate::ident::engine::{run, EngineConfig};
-    use crate::ident::fit_oe;
-    use crate::ident::FitStatus;
+    use crate::ident::engine::{run, EngineConfig, FitStatus};
+    use crate::ident::methods::fit_oe;
     use crate::signal::Scenario;
     use crate::solve::Termination;
     use nalgebra::Complex;

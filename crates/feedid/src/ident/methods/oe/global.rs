@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use super::companion::{is_hurwitz, output, Companion};
 use super::estimator::{check_signals, initial_estimate, lm_config, OeConfig, Structure};
 use crate::error::{Error, Result};
-use crate::ident::LinearModel;
+use crate::ident::model::LinearModel;
 use crate::lti::TransferFunction;
 use crate::solve::{LevenbergMarquardt, LmReport};
 use nalgebra::Complex;

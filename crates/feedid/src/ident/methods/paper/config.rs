@@ -5,8 +5,8 @@ use std::str::FromStr;
 
 use super::estimator::PaperMethod;
 use crate::error::{Error, Result};
-use crate::ident::method::MethodSettings;
-use crate::ident::{MethodOption, OptionKind, OptionSpec, OptionValue, Signals};
+use crate::ident::engine::Signals;
+use crate::ident::option::{MethodOption, MethodSettings, OptionKind, OptionSpec, OptionValue};
 
 /// Option `solver` of `paper` ([`PaperConfig::solver`]).
 const SOLVER_OPTION: OptionSpec = OptionSpec {
@@ -333,7 +333,7 @@ impl PaperConfig {
     pub fn worst_shift_amplification(
         &self,
         signals: &Signals<'_>,
-        config: &crate::ident::EngineConfig,
+        config: &crate::ident::engine::EngineConfig,
     ) -> f64 {
         let time = signals.all().time;
         let mut worst = 1.0f64;

@@ -12,7 +12,7 @@ use super::polynomials::{coefficients_from_polynomials, NAMES, NC, NP, NQ};
 use super::projection::{LegendreTables, Projection};
 use super::simplex::{simplex_fit, Reduced};
 use crate::error::{Error, Result};
-use crate::ident::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowFit};
 use crate::lti::TransferFunction;
 use crate::solve::{lstsq_fixed, LstsqInfo, NelderMead, QrWorkspace, Termination};
 
@@ -262,242 +262,14 @@ impl Estimator for PaperMethod {
         self.rest_hold = None;
         self.ensure_capacity(w);
 
-        // --- rest windows and the rest reference (motion time origin)
-        let (y_ref, u_ref) = match self.config.time_origin {
-            TimeOrigin::Window => (0.0, 0.0),
-            TimeOrigin::Motion => {
-                // The output model has no constant term, so positions are
-                // measured from the rest position at the motion start. The
-                // input model has one (Q0 = D7), so the command is fitted as
-                // given, as in the paper.
-                // The reference is fixed by the first motion window, which
-                // holds the motion-start sample when windows overlap or touch
-                // (hop ≤ W), in batch and streaming alike. If the recording
-                // starts in motion (no sample at or before the motion start),
-                // positions are taken as given.
-                let y_ref = *self.reference.get_or_insert_with(|| {
-                    let all = signals.all();
-                    all.time
-                        .iter()
-                        .rposition(|&t| t <= signals.motion_start())
-                        .map_or(0.0, |k| all.position[k])
-                });
-                (y_ref, 0.0)
-            }
+        let (y_ref, u_ref) = self.rest_reference(signals);
+        let axis = self.time_axis(signals, time)?;
+        let problem = self.project(pos, cmd, y_ref, u_ref, &axis);
+        let solution = match self.config.solver {
+            Solver::Qr => self.solve_qr(&problem)?,
+            Solver::Simplex => self.solve_simplex(&problem, time, y_ref, u_ref)?,
         };
-
-        // --- time scaling
-        let origin = match self.config.time_origin {
-            TimeOrigin::Motion => signals.motion_start(),
-            TimeOrigin::Window => time[0],
-        };
-        if !origin.is_finite() {
-            return Err(Error::InvalidParameter {
-                name: "motion_start",
-                value: origin,
-                reason: "must be finite",
-            });
-        }
-        let tau = &mut self.tau[..w];
-        for (ti, t) in tau.iter_mut().zip(time) {
-            *ti = t - origin;
-        }
-        let t_first = tau[0];
-        let t_last = tau[w - 1];
-        let centre = 0.5 * (t_first + t_last);
-        let half = 0.5 * (t_last - t_first);
-        let t_scale = tau.iter().fold(0.0f64, |a, t| a.max(t.abs()));
-        if !(half > 0.0 && t_scale > 0.0 && half.is_finite() && t_scale.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "window time span",
-                value: half,
-                reason: "time must increase over the window",
-            });
-        }
-
-        // --- the grid s_i; the cached projection if the grid repeats
-        let inv_half = 1.0 / half;
-        for v in tau.iter_mut() {
-            *v = (*v - centre) * inv_half;
-        }
-        let tol = (8.0 * (time[0].abs() + time[w - 1].abs() + origin.abs()) * inv_half + 64.0)
-            * f64::EPSILON;
-        if !self.projection.matches(&self.tau[..w], tol) {
-            self.projection.build(&self.tau[..w], &mut self.qr)?;
-        }
-        let proj = &self.projection;
-
-        // --- data projected on the 8 Legendre polynomials of the window
-        for (r, p) in self.rhs[..w].iter_mut().zip(pos) {
-            *r = p - y_ref;
-        }
-        for (r, c) in self.data[..w].iter_mut().zip(cmd) {
-            *r = c - u_ref;
-        }
-        let (mut cy, mut cu) = ([0.0; NQ], [0.0; NQ]);
-        let (rest_y, rest_u) = proj.project2(&self.rhs[..w], &self.data[..w], &mut cy, &mut cu);
-        // the output basis (τ/T)⁵·L_k(s) in the projected coordinates, unit-norm columns
-        let mut m_out = [0.0; NQ * NP];
-        let mut norm_out = [0.0; NP];
-        proj.output_matrix(
-            &self.tables,
-            centre / t_scale,
-            half / t_scale,
-            &mut m_out,
-            &mut norm_out,
-        );
-        for (k, nk) in norm_out.iter_mut().enumerate() {
-            if !(*nk > 0.0 && nk.is_finite()) {
-                *nk = 1.0;
-            }
-            m_out[k * NQ..(k + 1) * NQ]
-                .iter_mut()
-                .for_each(|v| *v /= *nk);
-        }
-        // rank tolerance of the direct W×3 fit
-        let rank_tol = Some(w as f64 * f64::EPSILON);
-
-        // --- solve both problems (coordinates of the unit-norm bases)
-        let mut z_out = [0.0; NP];
-        let mut z_in = [0.0; NQ];
-        let (out_sse, in_sse, iterations, termination, out_info, in_info);
-        match self.config.solver {
-            Solver::Qr => {
-                let (z, io) = lstsq_fixed::<NQ, NP>(&columns(&m_out), &cy, rank_tol)?;
-                z_out = z;
-                let mut a = [0.0; NQ];
-                proj.input_coefficients(&cu, &mut a);
-                for k in 0..NQ {
-                    z_in[k] = a[k] * proj.vnorm[k];
-                }
-                out_sse = io.residual_norm * io.residual_norm + rest_y * rest_y;
-                in_sse = rest_u * rest_u;
-                iterations = 0;
-                termination = Termination::Exact;
-                out_info = Some(LstsqInfo {
-                    residual_norm: out_sse.sqrt(),
-                    ..io
-                });
-                in_info = Some(proj.input_info(rest_u));
-            }
-            Solver::Simplex => {
-                let settings = self.config.simplex;
-                let mut m_in = [0.0; NQ * NQ];
-                proj.input_matrix(&mut m_in);
-                // the start: zeros, or the previous window's polynomials on this window
-                let start = match (self.config.simplex_start, self.last.as_ref()) {
-                    (SimplexStart::Previous, Some(prev)) => {
-                        let prev = *prev;
-                        for ((v, &t), r) in self.resid[..w]
-                            .iter_mut()
-                            .zip(time)
-                            .zip(self.work.iter_mut())
-                        {
-                            *v = prev.y_ref + Self::eval_output(&prev, t) - y_ref;
-                            *r = prev.u_ref + Self::eval_input(&prev, t) - u_ref;
-                        }
-                        let (mut py, mut pu) = ([0.0; NQ], [0.0; NQ]);
-                        proj.project2(&self.resid[..w], &self.work[..w], &mut py, &mut pu);
-                        z_out = lstsq_fixed::<NQ, NP>(&columns(&m_out), &py, rank_tol)
-                            .map_or([0.0; NP], |(z, _)| z);
-                        let mut a = [0.0; NQ];
-                        proj.input_coefficients(&pu, &mut a);
-                        for k in 0..NQ {
-                            z_in[k] = a[k] * proj.vnorm[k];
-                        }
-                        let finite = z_out.iter().chain(&z_in).all(|v| v.is_finite());
-                        if !finite {
-                            z_out = [0.0; NP];
-                            z_in = [0.0; NQ];
-                        }
-                        finite
-                    }
-                    _ => false,
-                };
-                let ynorm = (self.rhs[..w].iter().map(|v| v * v).sum::<f64>()).sqrt();
-                let unorm = (self.data[..w].iter().map(|v| v * v).sum::<f64>()).sqrt();
-                let mut steps = [0.0; NQ];
-                let (fo, it_o, term_o) = simplex_fit(
-                    &mut self.nm_out,
-                    &Reduced {
-                        m: &m_out,
-                        c: &cy,
-                        rest2: rest_y * rest_y,
-                        bnorm: ynorm,
-                        rows: w,
-                        triangular: false,
-                    },
-                    &mut z_out,
-                    start,
-                    &settings,
-                    &mut steps[..NP],
-                )?;
-                let (fi, it_i, term_i) = simplex_fit(
-                    &mut self.nm_in,
-                    &Reduced {
-                        m: &m_in,
-                        c: &cu,
-                        rest2: rest_u * rest_u,
-                        bnorm: unorm,
-                        rows: w,
-                        triangular: true,
-                    },
-                    &mut z_in,
-                    start,
-                    &settings,
-                    &mut steps,
-                )?;
-                out_sse = fo;
-                in_sse = fi;
-                iterations = it_o + it_i;
-                termination = if term_o == Termination::MaxIterations
-                    || term_i == Termination::MaxIterations
-                {
-                    Termination::MaxIterations
-                } else {
-                    Termination::Converged
-                };
-                out_info = None;
-                in_info = None;
-            }
-        }
-        let norm_in = proj.vnorm;
-
-        // --- back to the unnormalised Legendre basis, then to monomials in τ
-        let mut a_out = [0.0; NP];
-        let mut a_in = [0.0; NQ];
-        for k in 0..NP {
-            a_out[k] = z_out[k] / norm_out[k];
-        }
-        for k in 0..NQ {
-            a_in[k] = z_in[k] / norm_in[k];
-        }
-        let mut ms = [0.0; NQ];
-        for (ak, lk) in a_out.iter().zip(&self.tables.table) {
-            for (mj, lkj) in ms.iter_mut().zip(lk).take(NP) {
-                *mj += ak * lkj;
-            }
-        }
-        let mut r = [0.0; NQ];
-        affine_to_monomial(&ms[..NP], centre, half, &mut r[..NP]);
-        let t5 = t_scale.powi(5);
-        let p = [r[0] / t5, r[1] / t5, r[2] / t5];
-        let mut ms = [0.0; NQ];
-        for (ak, lk) in a_in.iter().zip(&self.tables.table) {
-            for (mj, lkj) in ms.iter_mut().zip(lk) {
-                *mj += ak * lkj;
-            }
-        }
-        let mut q = [0.0; NQ];
-        affine_to_monomial(&ms, centre, half, &mut q);
-        let c = coefficients_from_polynomials(p, q);
-        if let Some(i) = c.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                channel: format!("paper coefficient {}", NAMES[i]),
-                index: window.start,
-                value: c[i],
-            });
-        }
+        let (c, out, inp) = self.assemble(&solution, &problem, &axis, window.start)?;
         coef.copy_from_slice(&c);
 
         let in_norm = cmd
@@ -506,31 +278,31 @@ impl Estimator for PaperMethod {
             .sum::<f64>()
             .sqrt();
         self.last = Some(LastFit {
-            origin,
-            t_scale,
-            centre,
-            half,
-            out: a_out,
-            inp: a_in,
+            origin: axis.origin,
+            t_scale: axis.t_scale,
+            centre: axis.centre,
+            half: axis.half,
+            out,
+            inp,
             coef: c,
             y_ref,
             u_ref,
         });
         self.diagnostics = Some(PaperDiagnostics {
-            output_qr: out_info,
-            input_qr: in_info,
-            shift_amplification: shift_amplification(t_first, t_last),
+            output_qr: solution.out_info,
+            input_qr: solution.in_info,
+            shift_amplification: shift_amplification(axis.t_first, axis.t_last),
             tf_fallback: false,
             input_residual_rel: if in_norm > 0.0 {
-                in_sse.max(0.0).sqrt() / in_norm
+                solution.in_sse.max(0.0).sqrt() / in_norm
             } else {
                 0.0
             },
         });
         Ok(WindowFit::identified(
-            (out_sse.max(0.0) / w as f64).sqrt(),
-            iterations,
-            termination,
+            (solution.out_sse.max(0.0) / w as f64).sqrt(),
+            solution.iterations,
+            solution.termination,
         ))
     }
 
@@ -595,6 +367,362 @@ impl Estimator for PaperMethod {
             });
         }
         Ok(PredictStatus::Predicted)
+    }
+}
+
+/// The window's time axis: `τ = t − origin`, its first and last value, the
+/// centre `τ_c` and half width `h`, and `T = max |τ|` \[s\].
+#[derive(Debug, Clone, Copy)]
+struct TimeAxis {
+    origin: f64,
+    t_first: f64,
+    t_last: f64,
+    centre: f64,
+    half: f64,
+    t_scale: f64,
+}
+
+/// A window's two least-squares problems in the projected coordinates: the
+/// data's Legendre coefficients, what the projection leaves, and the output
+/// basis with unit-norm columns (and their norms).
+struct Problem {
+    w: usize,
+    cy: [f64; NQ],
+    cu: [f64; NQ],
+    rest_y: f64,
+    rest_u: f64,
+    m_out: [f64; NQ * NP],
+    norm_out: [f64; NP],
+    rank_tol: Option<f64>,
+}
+
+/// Both problems solved, in the coordinates of the unit-norm bases, with
+/// what the solver reports.
+struct Solution {
+    z_out: [f64; NP],
+    z_in: [f64; NQ],
+    out_sse: f64,
+    in_sse: f64,
+    iterations: usize,
+    termination: Termination,
+    out_info: Option<LstsqInfo>,
+    in_info: Option<LstsqInfo>,
+}
+
+/// The steps of a window fit ([`Estimator::fit`]): the rest reference, the
+/// time axis and grid, the projected problem, its solution by QR or the
+/// simplex, and the coefficients `N`, `D`.
+impl PaperMethod {
+    /// The position and command subtracted before fitting.
+    fn rest_reference(&mut self, signals: &Signals<'_>) -> (f64, f64) {
+        match self.config.time_origin {
+            TimeOrigin::Window => (0.0, 0.0),
+            TimeOrigin::Motion => {
+                // The output model has no constant term, so positions are
+                // measured from the rest position at the motion start. The
+                // input model has one (Q0 = D7), so the command is fitted as
+                // given, as in the paper.
+                // The reference is fixed by the first motion window, which
+                // holds the motion-start sample when windows overlap or touch
+                // (hop ≤ W), in batch and streaming alike. If the recording
+                // starts in motion (no sample at or before the motion start),
+                // positions are taken as given.
+                let y_ref = *self.reference.get_or_insert_with(|| {
+                    let all = signals.all();
+                    all.time
+                        .iter()
+                        .rposition(|&t| t <= signals.motion_start())
+                        .map_or(0.0, |k| all.position[k])
+                });
+                (y_ref, 0.0)
+            }
+        }
+    }
+
+    /// The time axis of the window, the grid `s_i` in `self.tau`, and the
+    /// projection on it (the cached one if the grid repeats).
+    fn time_axis(&mut self, signals: &Signals<'_>, time: &[f64]) -> Result<TimeAxis> {
+        let w = time.len();
+        let origin = match self.config.time_origin {
+            TimeOrigin::Motion => signals.motion_start(),
+            TimeOrigin::Window => time[0],
+        };
+        if !origin.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "motion_start",
+                value: origin,
+                reason: "must be finite",
+            });
+        }
+        let tau = &mut self.tau[..w];
+        for (ti, t) in tau.iter_mut().zip(time) {
+            *ti = t - origin;
+        }
+        let t_first = tau[0];
+        let t_last = tau[w - 1];
+        let centre = 0.5 * (t_first + t_last);
+        let half = 0.5 * (t_last - t_first);
+        let t_scale = tau.iter().fold(0.0f64, |a, t| a.max(t.abs()));
+        if !(half > 0.0 && t_scale > 0.0 && half.is_finite() && t_scale.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "window time span",
+                value: half,
+                reason: "time must increase over the window",
+            });
+        }
+
+        // the grid s_i; the cached projection if the grid repeats
+        let inv_half = 1.0 / half;
+        for v in tau.iter_mut() {
+            *v = (*v - centre) * inv_half;
+        }
+        let tol = (8.0 * (time[0].abs() + time[w - 1].abs() + origin.abs()) * inv_half + 64.0)
+            * f64::EPSILON;
+        if !self.projection.matches(&self.tau[..w], tol) {
+            self.projection.build(&self.tau[..w], &mut self.qr)?;
+        }
+        Ok(TimeAxis {
+            origin,
+            t_first,
+            t_last,
+            centre,
+            half,
+            t_scale,
+        })
+    }
+
+    /// The data projected on the 8 Legendre polynomials of the window, and
+    /// the output basis `(τ/T)⁵·L_k(s)` in the projected coordinates.
+    fn project(
+        &mut self,
+        pos: &[f64],
+        cmd: &[f64],
+        y_ref: f64,
+        u_ref: f64,
+        axis: &TimeAxis,
+    ) -> Problem {
+        let w = pos.len();
+        let proj = &self.projection;
+        for (r, p) in self.rhs[..w].iter_mut().zip(pos) {
+            *r = p - y_ref;
+        }
+        for (r, c) in self.data[..w].iter_mut().zip(cmd) {
+            *r = c - u_ref;
+        }
+        let (mut cy, mut cu) = ([0.0; NQ], [0.0; NQ]);
+        let (rest_y, rest_u) = proj.project2(&self.rhs[..w], &self.data[..w], &mut cy, &mut cu);
+        // unit-norm columns
+        let mut m_out = [0.0; NQ * NP];
+        let mut norm_out = [0.0; NP];
+        proj.output_matrix(
+            &self.tables,
+            axis.centre / axis.t_scale,
+            axis.half / axis.t_scale,
+            &mut m_out,
+            &mut norm_out,
+        );
+        for (k, nk) in norm_out.iter_mut().enumerate() {
+            if !(*nk > 0.0 && nk.is_finite()) {
+                *nk = 1.0;
+            }
+            m_out[k * NQ..(k + 1) * NQ]
+                .iter_mut()
+                .for_each(|v| *v /= *nk);
+        }
+        Problem {
+            w,
+            cy,
+            cu,
+            rest_y,
+            rest_u,
+            m_out,
+            norm_out,
+            // rank tolerance of the direct W×3 fit
+            rank_tol: Some(w as f64 * f64::EPSILON),
+        }
+    }
+
+    /// Both problems by QR: the output fit directly, the input from the
+    /// projection.
+    fn solve_qr(&self, pb: &Problem) -> Result<Solution> {
+        let proj = &self.projection;
+        let (z_out, io) = lstsq_fixed::<NQ, NP>(&columns(&pb.m_out), &pb.cy, pb.rank_tol)?;
+        let mut a = [0.0; NQ];
+        proj.input_coefficients(&pb.cu, &mut a);
+        let mut z_in = [0.0; NQ];
+        for k in 0..NQ {
+            z_in[k] = a[k] * proj.vnorm[k];
+        }
+        let out_sse = io.residual_norm * io.residual_norm + pb.rest_y * pb.rest_y;
+        Ok(Solution {
+            z_out,
+            z_in,
+            out_sse,
+            in_sse: pb.rest_u * pb.rest_u,
+            iterations: 0,
+            termination: Termination::Exact,
+            out_info: Some(LstsqInfo {
+                residual_norm: out_sse.sqrt(),
+                ..io
+            }),
+            in_info: Some(proj.input_info(pb.rest_u)),
+        })
+    }
+
+    /// The start of the simplex: the previous window's polynomials on this
+    /// window (if asked and finite), written to `z_out`, `z_in`; whether it
+    /// is used.
+    fn simplex_start(
+        &mut self,
+        pb: &Problem,
+        time: &[f64],
+        y_ref: f64,
+        u_ref: f64,
+        z_out: &mut [f64; NP],
+        z_in: &mut [f64; NQ],
+    ) -> bool {
+        let (SimplexStart::Previous, Some(prev)) = (self.config.simplex_start, self.last) else {
+            return false;
+        };
+        let w = pb.w;
+        let proj = &self.projection;
+        for ((v, &t), r) in self.resid[..w]
+            .iter_mut()
+            .zip(time)
+            .zip(self.work.iter_mut())
+        {
+            *v = prev.y_ref + Self::eval_output(&prev, t) - y_ref;
+            *r = prev.u_ref + Self::eval_input(&prev, t) - u_ref;
+        }
+        let (mut py, mut pu) = ([0.0; NQ], [0.0; NQ]);
+        proj.project2(&self.resid[..w], &self.work[..w], &mut py, &mut pu);
+        *z_out = lstsq_fixed::<NQ, NP>(&columns(&pb.m_out), &py, pb.rank_tol)
+            .map_or([0.0; NP], |(z, _)| z);
+        let mut a = [0.0; NQ];
+        proj.input_coefficients(&pu, &mut a);
+        for k in 0..NQ {
+            z_in[k] = a[k] * proj.vnorm[k];
+        }
+        let finite = z_out.iter().chain(z_in.iter()).all(|v| v.is_finite());
+        if !finite {
+            *z_out = [0.0; NP];
+            *z_in = [0.0; NQ];
+        }
+        finite
+    }
+
+    /// Both problems by the simplex, from zeros or the previous window.
+    fn solve_simplex(
+        &mut self,
+        pb: &Problem,
+        time: &[f64],
+        y_ref: f64,
+        u_ref: f64,
+    ) -> Result<Solution> {
+        let w = pb.w;
+        let settings = self.config.simplex;
+        let mut m_in = [0.0; NQ * NQ];
+        self.projection.input_matrix(&mut m_in);
+        let mut z_out = [0.0; NP];
+        let mut z_in = [0.0; NQ];
+        let start = self.simplex_start(pb, time, y_ref, u_ref, &mut z_out, &mut z_in);
+        let ynorm = (self.rhs[..w].iter().map(|v| v * v).sum::<f64>()).sqrt();
+        let unorm = (self.data[..w].iter().map(|v| v * v).sum::<f64>()).sqrt();
+        let mut steps = [0.0; NQ];
+        let (fo, it_o, term_o) = simplex_fit(
+            &mut self.nm_out,
+            &Reduced {
+                m: &pb.m_out,
+                c: &pb.cy,
+                rest2: pb.rest_y * pb.rest_y,
+                bnorm: ynorm,
+                rows: w,
+                triangular: false,
+            },
+            &mut z_out,
+            start,
+            &settings,
+            &mut steps[..NP],
+        )?;
+        let (fi, it_i, term_i) = simplex_fit(
+            &mut self.nm_in,
+            &Reduced {
+                m: &m_in,
+                c: &pb.cu,
+                rest2: pb.rest_u * pb.rest_u,
+                bnorm: unorm,
+                rows: w,
+                triangular: true,
+            },
+            &mut z_in,
+            start,
+            &settings,
+            &mut steps,
+        )?;
+        let termination =
+            if term_o == Termination::MaxIterations || term_i == Termination::MaxIterations {
+                Termination::MaxIterations
+            } else {
+                Termination::Converged
+            };
+        Ok(Solution {
+            z_out,
+            z_in,
+            out_sse: fo,
+            in_sse: fi,
+            iterations: it_o + it_i,
+            termination,
+            out_info: None,
+            in_info: None,
+        })
+    }
+
+    /// Back to the unnormalised Legendre basis, then to monomials in `τ`:
+    /// the coefficients `[N2, N1, N0, D7, …, D0]` and the Legendre
+    /// coefficients of the output and input fits.
+    fn assemble(
+        &self,
+        sol: &Solution,
+        pb: &Problem,
+        axis: &TimeAxis,
+        first_sample: usize,
+    ) -> Result<([f64; NC], [f64; NP], [f64; NQ])> {
+        let norm_in = self.projection.vnorm;
+        let mut a_out = [0.0; NP];
+        let mut a_in = [0.0; NQ];
+        for ((a, z), nk) in a_out.iter_mut().zip(&sol.z_out).zip(&pb.norm_out) {
+            *a = z / nk;
+        }
+        for ((a, z), nk) in a_in.iter_mut().zip(&sol.z_in).zip(&norm_in) {
+            *a = z / nk;
+        }
+        let mut ms = [0.0; NQ];
+        for (ak, lk) in a_out.iter().zip(&self.tables.table) {
+            for (mj, lkj) in ms.iter_mut().zip(lk).take(NP) {
+                *mj += ak * lkj;
+            }
+        }
+        let mut r = [0.0; NQ];
+        affine_to_monomial(&ms[..NP], axis.centre, axis.half, &mut r[..NP]);
+        let t5 = axis.t_scale.powi(5);
+        let p = [r[0] / t5, r[1] / t5, r[2] / t5];
+        let mut ms = [0.0; NQ];
+        for (ak, lk) in a_in.iter().zip(&self.tables.table) {
+            for (mj, lkj) in ms.iter_mut().zip(lk) {
+                *mj += ak * lkj;
+            }
+        }
+        let mut q = [0.0; NQ];
+        affine_to_monomial(&ms, axis.centre, axis.half, &mut q);
+        let c = coefficients_from_polynomials(p, q);
+        if let Some(i) = c.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                channel: format!("paper coefficient {}", NAMES[i]),
+                index: first_sample,
+                value: c[i],
+            });
+        }
+        Ok((c, a_out, a_in))
     }
 }
 

@@ -44,9 +44,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::ident::{
-    fit_arx, fit_arx_segments, fit_oe, fit_oe_measured, ArxConfig, ArxOrders, LinearModel, OeConfig,
+use crate::ident::methods::{
+    fit_arx, fit_arx_segments, fit_oe, fit_oe_measured, ArxConfig, ArxOrders, OeConfig,
 };
+use crate::ident::model::LinearModel;
 use crate::recording::Recording;
 use crate::stats::{error_fit_percent, noise_level_of_run, ErrorStats};
 

@@ -32,7 +32,7 @@ use std::fmt;
 
 use serde::Serialize;
 
-use crate::plausibility::check_recording;
+use crate::recording::plausibility::check_recording;
 use crate::recording::{Gap, MotionSegment, Recording, MOTION_THRESHOLD};
 
 /// Motion threshold per step, relative to the command range.

@@ -3,7 +3,7 @@
 `cargo run --release -p feedid --example pipeline_hour -- PREFIX`, loaded
 with NumPy and identified with the default method: once with everything
 `feedid identify` computes, then repeatedly the sliding identification
-alone, as the Rust example times them (README, "Python": the figures beside the Rust ones).
+alone, as the Rust example times them (python/README.md, "Speed from Python").
 
     python python/examples/bench_hour.py PREFIX [REPEATS]
 """

@@ -408,7 +408,7 @@ def identify(
         and its free-run fit (``global_model``, ``global_model_samples``,
         ``sim_fit_percent``, ``model``), the residual analysis
         (``residuals``). On long recordings they cost several times the
-        sliding identification (README, "Python"): False leaves them out
+        sliding identification (python/README.md): False leaves them out
         and their keys out of the summary.
     interval : float
         Probability of the prediction intervals ``lower``/``upper`` [%],

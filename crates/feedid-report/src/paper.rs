@@ -152,7 +152,7 @@ pub fn paper_report(
         }
         Axis::Real(_) => {
             "Here the measurement comes from the virtual rig moved off the nominal model as a real axis is off its \
-             data sheet (mass, stiffness, damping, motor constants, friction, dead time; see the README), while the \
+             data sheet (mass, stiffness, damping, motor constants, friction, dead time; see docs/METHODS.md), while the \
              simulation model stays nominal — the paper's situation; the paper method's error is still dominated \
              by the first windows after the motion start."
         }

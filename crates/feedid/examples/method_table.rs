@@ -1,4 +1,4 @@
-//! The README's method × recording table: 2 ms-ahead (H = 10) prediction
+//! The method × recording table of README.md and docs/RESULTS.md: 2 ms-ahead (H = 10) prediction
 //! error of every method, with its default window, on the six rig scenarios
 //! (all effects, 0.2 µm noise, 0.1 µm quantisation, 5 kHz, seed 7) and on
 //! EMPS (1 kHz, `qg` → `qm`, path in `FEEDID_EMPS_MAT` or the workplace's).

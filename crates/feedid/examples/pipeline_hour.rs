@@ -2,7 +2,7 @@
 //! the whole pipeline (`feedid identify`'s computation: engine, nominal
 //! simulation, global model, residual analysis), timed here and written as
 //! raw little-endian f64 files for the Python binding's timing of the same
-//! data (`python/examples/bench_hour.py`; README, "Python").
+//! data (`python/examples/bench_hour.py`; docs/RESULTS.md, "Speed").
 //!
 //! ```sh
 //! cargo run --release -p feedid --example pipeline_hour -- /tmp/hour [REPEATS]

@@ -57,14 +57,14 @@
 //! method's losses at every phase. The methods' own blocks start where their first window
 //! ends, so the phase decides which lead time each baseline has at each
 //! sample the two share: on a short recording whose error is made in its
-//! first horizons this alone moves the ratio by tens of percent (README,
+//! first horizons this alone moves the ratio by tens of percent (docs/RESULTS.md,
 //! "The zoo benchmark").
 //!
 //! `--offset M` adds `M` metres to every member's command and position
 //! before anything runs (a recording in machine coordinates, far from the
 //! origin): the library methods that are offset-invariant predict the same
 //! motion, while `arx220`, whose equations are in absolute coordinates,
-//! changes (see README, "The zoo benchmark").
+//! changes (see docs/RESULTS.md, the zoo benchmark).
 //!
 //! `--via-unit mm|um|nm` converts every member's command and position to
 //! that unit and back as the reader does with `--unit` (`v·10³`, then

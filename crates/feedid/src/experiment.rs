@@ -33,7 +33,7 @@ use crate::stats::ErrorStats;
 
 /// How far a real axis is off its nominal (data-sheet) model: factors on the
 /// nominal values and a dead time. The defaults are one fixed, plausible
-/// set (design notes §4), not fitted to anything:
+/// set (docs/METHODS.md §2.4), not fitted to anything:
 ///
 /// | what | default | why |
 /// |---|---|---|

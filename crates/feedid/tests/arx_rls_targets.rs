@@ -4,7 +4,7 @@
 //! H = 10).
 //!
 //! Settings: the settings tuned on the rig, the defaults before the drive
-//! zoo chose the present ones (see the README's zoo benchmark):
+//! zoo chose the present ones (see the zoo benchmark in docs/RESULTS.md):
 //! `arx` na = nb = 8, nk = 1, ridge 1e-8, DC gain in [0.5, 2], excitation
 //! gate 0.1 µm, over windows of W = 200 samples; `rls` na = nb = 8, nk = 1,
 //! λ = 0.999, p0 = 1e4, coordinates scaled by 1 mm, predictions every H

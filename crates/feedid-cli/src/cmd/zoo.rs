@@ -236,7 +236,7 @@ fn write_members(zoo: &Zoo, specs: &[MemberSpec], dir: &Path) -> Result<()> {
     }
     // every spec with `file` (its CSV, relative to the manifest) and
     // `readable` (false for dropped rows: not uniformly sampled; read with
-    // their gaps, see "Dropped samples" in the README)
+    // their gaps, see docs/METHODS.md, "The drive zoo")
     let entries = specs
         .iter()
         .map(|s| {

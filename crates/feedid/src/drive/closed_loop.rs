@@ -358,7 +358,7 @@ mod tests {
         let c = closed_loop_coefficients(&p, D1Variant::Corrected);
         let e = c.following_error_per_velocity();
         assert!(rel(e, 1.0 / p.control.kv) < 1e-12, "{e}");
-        // 50 mm/s → 71.4 µm (NOTES.md)
+        // 50 mm/s → 71.4 µm (docs/METHODS.md §2.5)
         assert!((0.05 * e - 71.4e-6).abs() < 0.05e-6);
     }
 

@@ -9,7 +9,7 @@
 //!
 //! `l` is the distance from the fixed bearing to the nut, so `K` depends on the
 //! nut position (a fixed–free screw). All quantities are SI. The default set is
-//! the default rig of the design notes: it gives `K = 3.0e7 N/m` and
+//! the default rig of docs/METHODS.md §2.5: it gives `K = 3.0e7 N/m` and
 //! `J = 1.6e-5 kg·m²` at the default nut position of 0.16 m.
 //!
 //! Parameter files are TOML with the sections below; every key is optional

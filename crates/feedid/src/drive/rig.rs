@@ -21,7 +21,7 @@
 //! (`*` marks the unsaturated value). With every effect off (`sat` = identity,
 //! `T_f = F_f = 0`, `K(l) = K`, `x̂_a = x_a`, `dz_b` = identity, P loop
 //! continuous) and no feed-forward these are exactly the linear equations of
-//! the design notes §1.
+//! the docs/METHODS.md §2.
 //!
 //! # Feed-forward
 //!
@@ -51,7 +51,7 @@
 //!   sticking as very slow creep; `v_ε` is chosen so that this rate stays well
 //!   inside the RK4 stability region at the default step (`F_s/(M·v_ε)` =
 //!   2·10⁴ 1/s at the table, `T_s/(J·ω_ε)` = 1.5·10⁴ 1/s at the motor, against
-//!   `2.8/h` = 2.8·10⁵ 1/s). Defaults (design notes): motor `T_c` = 0.01 N·m,
+//!   `2.8/h` = 2.8·10⁵ 1/s). Defaults (docs/METHODS.md §2.5): motor `T_c` = 0.01 N·m,
 //!   `T_s` = 0.012 N·m, `ω_s` = 0.5 rad/s, `ω_ε` = 0.05 rad/s; table `F_c` = 5 N,
 //!   `F_s` = 6 N, `v_s` = 1 mm/s, `v_ε` = 0.1 mm/s.
 //! * **Position-dependent stiffness** (`variable_stiffness`): `K(l)` from paper
@@ -102,7 +102,7 @@
 //!
 //! With the position-loop sampling switched off as well
 //! ([`RigEffects::linear`], `PositionLoop::Continuous`) the rig is exactly the
-//! continuous linear ODE of the design notes §1 driven by the zero-order-held
+//! continuous linear ODE of the docs/METHODS.md §2 driven by the zero-order-held
 //! command, i.e. the same convention as an exact ZOH simulation of the closed-loop
 //! transfer function `X_a/X_s`; `PositionLoop::Interpolated` drives it with the
 //! linearly interpolated command instead (exact for the paper's ramp and step,
@@ -305,7 +305,7 @@ impl Default for RigEffects {
 
 impl RigEffects {
     /// Every effect off (values kept at their defaults), including the sampling
-    /// of the position loop: the continuous linear cascade of the design notes
+    /// of the position loop: the continuous linear cascade of docs/METHODS.md §2.2
     /// driven by the zero-order-held command.
     pub fn linear() -> Self {
         Self {
@@ -1034,7 +1034,7 @@ mod tests {
             PositionLoop::Interpolated,
         ] {
             let out = linear_with(pl).simulate(&cmd, RATE).unwrap();
-            // within 2 % from 7 ms after the step (design notes: settles ≈ 7 ms)
+            // within 2 % from 7 ms after the step (docs/METHODS.md: settles ≈ 7 ms)
             for k in 50 + 40..cmd.len() {
                 assert!((out.position[k] - 1e-3).abs() < 2e-5, "{pl:?} k={k}");
             }

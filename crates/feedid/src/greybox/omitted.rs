@@ -1,7 +1,7 @@
 //! Is feed-forward missing from the model? A score test for the omitted
 //! feed-forward gains of a grey-box fit.
 //!
-//! Most CNC axes run velocity feed-forward (design notes §4); a model
+//! Most CNC axes run velocity feed-forward (docs/METHODS.md §2.4); a model
 //! without it explains the small following error only by an absurd
 //! position-loop gain and leaves a structured residual. When neither `Kvff`
 //! nor `Kaff` is estimated and the starting rig has none, the residual `e`
@@ -129,7 +129,7 @@ mod tests {
 
     const RATE: f64 = 5000.0;
 
-    /// A slow axis with velocity feed-forward (design notes §4): Kv 30 1/s,
+    /// A slow axis with velocity feed-forward (docs/METHODS.md §2.4): Kv 30 1/s,
     /// kvff 0.97, measured by the linear rig with a sampled loop, 0.2 µm noise.
     fn ff_axis() -> RigParams {
         let mut p = RigParams::default();

@@ -24,7 +24,7 @@
 //!
 //! ```
 //! use feedid::lti::TransferFunction;
-//! // Feed-drive closed loop of NOTES.md §1 (coefficients rounded to 6 digits).
+//! // Feed-drive closed loop of docs/METHODS.md §2.5 (coefficients rounded to 6 digits).
 //! let g = TransferFunction::new(
 //!     vec![4.10814e9, 1.60209e13, 6.63693e15],
 //!     vec![1.68e-8, 2.69316e-4, 1.57906, 6.30146e3, 1.77277e7, 2.71640e10, 2.55023e13, 6.63693e15],

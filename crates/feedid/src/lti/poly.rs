@@ -161,7 +161,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    const NOTES_DEN: [f64; 8] = [
+    const RIG_DEN: [f64; 8] = [
         1.68e-8, 2.69316e-4, 1.57906, 6.30146e3, 1.77277e7, 2.71640e10, 2.55023e13, 6.63693e15,
     ];
 
@@ -233,13 +233,10 @@ mod tests {
 
     #[test]
     fn notes_polynomial_round_trips_through_roots() {
-        let r = poly_roots(&NOTES_DEN).unwrap();
+        let r = poly_roots(&RIG_DEN).unwrap();
         assert_eq!(r.len(), 7);
-        let p: Vec<f64> = poly_from_roots(&r)
-            .iter()
-            .map(|c| c * NOTES_DEN[0])
-            .collect();
-        assert!(rel_close(&p, &NOTES_DEN, 1e-11), "{p:?}");
+        let p: Vec<f64> = poly_from_roots(&r).iter().map(|c| c * RIG_DEN[0]).collect();
+        assert!(rel_close(&p, &RIG_DEN, 1e-11), "{p:?}");
     }
 
     #[test]

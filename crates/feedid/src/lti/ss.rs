@@ -378,7 +378,7 @@ fn strictly_proper_numerator(sys: &StateSpace) -> Result<Vec<f64>> {
 mod tests {
     use super::*;
 
-    /// Default rig of NOTES.md §1.
+    /// Default rig of docs/METHODS.md §2.5.
     struct Rig {
         r: f64,
         k: f64,
@@ -415,7 +415,7 @@ mod tests {
         kii: 3428.6,
     };
 
-    /// The 7-state cascade [z_v, z_i, i, θ, ω, x_a, v_a] of NOTES.md §1, input x_s, output x_a.
+    /// The 7-state cascade [z_v, z_i, i, θ, ω, x_a, v_a] of docs/METHODS.md §2, input x_s, output x_a.
     fn feed_drive_ss(p: &Rig) -> StateSpace {
         let mut a = DMatrix::<f64>::zeros(7, 7);
         let mut b = DVector::<f64>::zeros(7);
@@ -452,7 +452,7 @@ mod tests {
         StateSpace::new(a, b, c, 0.0).unwrap()
     }
 
-    /// N and D of NOTES.md §1 (corrected appendix), normalised so that D7 = J·L·M.
+    /// N and D of docs/METHODS.md §2.5 (corrected appendix), normalised so that D7 = J·L·M.
     fn feed_drive_coefficients(p: &Rig) -> (Vec<f64>, Vec<f64>) {
         let Rig {
             r,
@@ -537,7 +537,7 @@ mod tests {
         let got_den: Vec<f64> = tf.den().iter().map(|c| c * scale).collect();
         assert_coeffs_close(&got_den, &den, 1e-9, "den");
         assert_coeffs_close(&got_num, &num, 1e-9, "num");
-        // And the rounded test values of NOTES.md, to half a unit of the 6th digit.
+        // And the rounded values of docs/METHODS.md §2.5, to half a unit of the 6th digit.
         let notes_num: [f64; 3] = [4.10814e9, 1.60209e13, 6.63693e15];
         let notes_den: [f64; 8] = [
             1.68000e-8, 2.69316e-4, 1.57906, 6.30146e3, 1.77277e7, 2.71640e10, 2.55023e13,
@@ -549,7 +549,10 @@ mod tests {
             .zip(notes_num.iter().chain(&notes_den))
         {
             let half_unit = 0.5 * 10f64.powf(p.abs().log10().floor() - 5.0);
-            assert!((x - p).abs() <= half_unit * 1.0001, "{x:e} vs NOTES {p:e}");
+            assert!(
+                (x - p).abs() <= half_unit * 1.0001,
+                "{x:e} vs the documented {p:e}"
+            );
         }
     }
 

@@ -273,13 +273,13 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    pub(crate) const NOTES_NUM: [f64; 3] = [4.10814e9, 1.60209e13, 6.63693e15];
-    pub(crate) const NOTES_DEN: [f64; 8] = [
+    pub(crate) const RIG_NUM: [f64; 3] = [4.10814e9, 1.60209e13, 6.63693e15];
+    pub(crate) const RIG_DEN: [f64; 8] = [
         1.68e-8, 2.69316e-4, 1.57906, 6.30146e3, 1.77277e7, 2.71640e10, 2.55023e13, 6.63693e15,
     ];
 
     fn notes_tf() -> TransferFunction {
-        TransferFunction::new(NOTES_NUM.to_vec(), NOTES_DEN.to_vec()).unwrap()
+        TransferFunction::new(RIG_NUM.to_vec(), RIG_DEN.to_vec()).unwrap()
     }
 
     /// Max |a − b| ≤ tol·max(1, max |b|).
@@ -470,7 +470,7 @@ mod tests {
 
     #[test]
     fn notes_ramp_following_error_is_v_over_kv() {
-        // NOTES: 50 mm/s ramp, steady following error 71.4 µm (= v/Kv, Kv = 700 1/s).
+        // docs/METHODS.md: 50 mm/s ramp, steady following error 71.4 µm (= v/Kv, Kv = 700 1/s).
         let v = 0.05;
         let (dt, n) = (2e-4, 1001);
         let y = notes_tf().ramp_response(v, dt, n).unwrap();
@@ -482,7 +482,7 @@ mod tests {
             err * 1e6
         );
         // Exact steady value from the coefficients: v·(D1 − N1)/D0.
-        let want = v * (NOTES_DEN[6] - NOTES_NUM[1]) / NOTES_DEN[7];
+        let want = v * (RIG_DEN[6] - RIG_NUM[1]) / RIG_DEN[7];
         assert!((err - want).abs() < 1e-9 * want, "{err} vs {want}");
     }
 

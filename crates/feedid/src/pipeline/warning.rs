@@ -67,7 +67,7 @@ pub enum Warning {
     /// `P5·τ⁵ + P6·τ⁶ + P7·τ⁷` is zero with its first four derivatives at each
     /// window's first sample, so it cannot represent an axis that is away from
     /// zero or moving there; the coefficients are accurate, the predictions are
-    /// not (design notes §2: window-local time is an option for studying the
+    /// not (docs/METHODS.md §4: window-local time is an option for studying the
     /// coefficients).
     PaperWindowOrigin,
     /// Paper method with `--prediction tf`: in these windows the identified

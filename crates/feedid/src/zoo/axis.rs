@@ -385,7 +385,7 @@ mod tests {
         let s = check(&p, &[p.stiffness_k()], 2e-4).unwrap();
         assert!(s.max_real_part < 0.0 && s.spectral_radius < 1.0, "{s:?}");
         assert!(s.min_damping > 0.1, "{s:?}");
-        // fastest pole: 1430 Hz (NOTES.md)
+        // fastest pole: 1430 Hz (docs/METHODS.md §2.5)
         let f = s.fastest_pole / (2.0 * std::f64::consts::PI);
         assert!((f - 1430.0).abs() < 10.0, "{f}");
     }

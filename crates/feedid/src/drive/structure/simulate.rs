@@ -1,5 +1,5 @@
-//! The nonlinear simulation of a drive structure: the rigid mass under the
-//! friction law and the saturated controller, integrated with the classical
+//! The nonlinear simulation of a drive structure: the rigid mass (or the
+//! motor and load of a two-mass axis) under the friction law and the saturated controller, integrated with the classical
 //! RK4 method in substeps of at most `0.3/λ` (λ the fastest closed-loop pole
 //! or friction knee) within each sample interval.
 //!

@@ -18,7 +18,7 @@
 //! root on the critical path). The dot products are summed in four lanes
 //! (short dependency chains). Memory
 //! `≈ 1/(1 − λ)` samples. Two safeguards against covariance wind-up:
-//! * **Excitation gate:** a sample updates `θ` and `P` (and is forgotten) only
+//! * **Excitation gate** (off by default, [`RlsConfig::min_excitation`] = 0): a sample updates `θ` and `P` (and is forgotten) only
 //!   when the command moved over the regressor span, i.e. the range of
 //!   `u[k−nk−nb] … u[k−nk]` exceeds [`RlsConfig::min_excitation`]. At
 //!   standstill nothing is updated, so `P` cannot grow like `λ⁻ᵏ`.
@@ -54,11 +54,12 @@
 //! Prediction is the k-step-ahead prediction of the ARX model from the
 //! measured past, in deviations from the last measured position. A model
 //! with a pole on or outside the unit circle (Schur–Cohn test) is never used
-//! for a prediction: the window gives none (`predict` fails with
-//! [`Error::InvalidModel`]) until the estimate is stable again.
+//! for a prediction: the last stable estimate predicts instead, and a
+//! window gives none (`predict` fails with [`Error::InvalidModel`]) only
+//! while there has been no stable estimate yet.
 //!
 //! References: L. Ljung, *System Identification*, 2nd ed., §11.2; S. Haykin,
-//! *Adaptive Filter Theory*, ch. 10; design notes §3.
+//! *Adaptive Filter Theory*, ch. 10; `docs/METHODS.md` §6.
 //!
 //! ```
 //! use feedid::ident::{engine, ArxOrders, EngineConfig, GuardConfig, RlsConfig, Signals};
@@ -103,23 +104,23 @@ use crate::solve::Termination;
 /// PRBS and multisine (`tests/arx_rls_targets.rs`, `--nocapture` prints
 /// them). On slow sweeps of nearly noise-free axes the ARX(8,8)
 /// coefficients are undetermined in the directions the motion does not
-/// excite and can wind up there (README, zoo benchmark, "Read in mm").
+/// excite and can wind up there (`docs/RESULTS.md`, the zoo benchmark read in mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RlsConfig {
-    /// Model orders; default `na = 8, nb = 8, nk = 1`.
+    /// Model orders; default `na = 8, nb = 8, nk = 0`.
     pub orders: ArxOrders,
     /// Forgetting factor λ ∈ (0, 1]; default 0.999 (memory ≈ 1000 samples,
     /// 0.2 s at 5 kHz). Ignored (λ = 1) with [`RlsConfig::window`].
     pub lambda: f64,
     /// Exact finite window of this many samples instead of forgetting; default `None`.
     pub window: Option<usize>,
-    /// Initial covariance `P₀ = p0·I` (scaled coordinates); default 1e4.
+    /// Initial covariance `P₀ = p0·I` (scaled coordinates); default 1e6.
     pub p0: f64,
     /// Bound on `tr P`; default `None` = the initial trace `n·p0`.
     pub max_trace: Option<f64>,
     /// Minimum command range over the regressor span for an update,
-    /// relative to the scale `s`; default 1e-6; 0 disables the gate (every
-    /// sample updates).
+    /// relative to the scale `s`; default 0: the gate is off (every sample
+    /// updates); a positive value, e.g. 1e-6, turns it on.
     pub min_excitation: f64,
     /// Scale `s` of the deviation coordinates \[m\]; default `None`: from
     /// the data, the larger of the ranges of command and position over the

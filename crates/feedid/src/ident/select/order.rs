@@ -7,7 +7,7 @@
 //! [`fit_arx`](crate::ident::fit_arx)-style batch least squares on the
 //! *same* rows (the estimation part of the recording, from the largest lag
 //! of the grid on), and with `V = Σe²/N` (one-step prediction errors, `N`
-//! rows, `np = na + nb` parameters, design notes §3):
+//! rows, `np = na + nb` parameters, docs/METHODS.md §5–6):
 //!
 //! ```text
 //! FPE  = V·(1 + np/N)/(1 − np/N)

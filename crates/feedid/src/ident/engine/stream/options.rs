@@ -38,7 +38,7 @@ pub enum CommandExtrapolation {
     /// parabola through them): `u[n−1+m] = u[n−1] + m·Δ + m(m+1)/2·Δ²`.
     /// The default: of the three, the smallest prediction error on the rig
     /// scenarios and on most of the drive zoo (example
-    /// `stream_extrapolation`; the figures are in the README, "Streaming").
+    /// `stream_extrapolation`; the figures are in docs/RESULTS.md, "Streaming").
     #[default]
     Acceleration,
 }

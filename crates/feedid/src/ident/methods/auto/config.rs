@@ -218,10 +218,10 @@ impl AutoConfig {
 mod tests {
     use super::*;
 
-    /// The order the README gives for the `candidate` column of `coef.csv`
+    /// The order docs/METHODS.md gives for the `candidate` column of `coef.csv`
     /// (an index into this list).
     #[test]
-    fn the_default_candidates_are_in_the_order_the_readme_numbers_them() {
+    fn the_default_candidates_are_in_the_order_the_methods_doc_numbers_them() {
         let names: Vec<String> = AutoConfig::default_candidates()
             .iter()
             .map(|c| c.to_string())

@@ -131,7 +131,7 @@ pub enum OeJacobian {
     /// state: the `β` columns exact (the simulated states), the `α` columns
     /// forward differences of the simulated output at the fixed state — no
     /// least squares per column. 0–25 % less time per window in the
-    /// `methods` bench (README, "Speed"); it drops the term of the derivative proportional to the residual, so
+    /// `methods` bench (docs/RESULTS.md, "Speed"); it drops the term of the derivative proportional to the residual, so
     /// the (capped) iterations take other steps: on the rig and EMPS the
     /// errors agree within 2 %, on some members of the drive zoo they differ
     /// both ways by up to several times (as do the results of the default

@@ -1,8 +1,8 @@
 //! The problem of one sliding window of the output-error method: the
 //! residual `ŷ(θ) − y` of the continuous model discretised at the window's
 //! sample interval, with the initial state eliminated by least squares
-//! (variable projection), and its Jacobian (central differences, or
-//! Kaufman's projected form). The solver (Levenberg–Marquardt) and the loop
+//! (variable projection), and its Jacobian (forward differences, the
+//! default, or Kaufman's projected form). The solver (Levenberg–Marquardt) and the loop
 //! over windows live in `estimator.rs`.
 
 use super::companion::{is_hurwitz, simulate_from, window_responses, Companion, MAX_ORDER};

@@ -111,7 +111,7 @@
 //!
 //! Reference: M.G.A. Nassef, L. Li, C. Schenck, B. Kuhfuss, "Short Time
 //! Identification of Feed Drive Systems using Nonlinear Least Squares Method",
-//! eq. (3)–(8); design notes §2.
+//! eq. (3)–(8); docs/METHODS.md §4.
 
 mod basis;
 mod config;

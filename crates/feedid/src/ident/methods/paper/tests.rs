@@ -187,7 +187,7 @@ fn exact_model_polynomial_is_reproduced_by_qr_to_rounding() {
 
 #[test]
 fn rig_coefficients_are_identified_from_noise_free_model_polynomials() {
-    // N, D of the default rig (NOTES §1), first window after the motion start
+    // N, D of the default rig (docs/METHODS.md §2), first window after the motion start
     let c_true = [
         4.10814e9, 1.60209e13, 6.63693e15, 1.68e-8, 2.69316e-4, 1.57906, 6.30146e3, 1.77277e7,
         2.71640e10, 2.55023e13, 6.63693e15,
@@ -727,7 +727,7 @@ fn sliding_engine_runs_the_paper_method_on_a_lagged_ramp_without_nan() {
     // independent reference (NumPy lstsq on t⁵, t⁶, t⁷ over samples 0..20,
     // extrapolated to 20..30): residual rms 7.71355e-6 m and a horizon
     // error of 9.56182e-3 m — the t⁵…t⁷ model cannot follow the start
-    // of a lagged ramp, and its extrapolation blows up (NOTES §2)
+    // of a lagged ramp, and its extrapolation blows up (docs/METHODS.md §4)
     let w0 = &rq.windows[0];
     let e0 = w0
         .horizon

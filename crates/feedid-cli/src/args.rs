@@ -406,7 +406,7 @@ pub struct OrderArgs {
 #[derive(Debug, Args)]
 pub struct StreamArgs {
     /// Identification method.
-    #[arg(long, default_value = "auto", value_name = "NAME", help = method_help())]
+    #[arg(long, default_value = "auto", value_name = "NAME", help = method_help(), conflicts_with = "compensate")]
     pub method: String,
     /// Options of the method.
     #[command(flatten)]
@@ -490,7 +490,7 @@ pub struct ReportArgs {
     /// Use an unstable physical model anyway (its simulation diverges; refused by default).
     #[arg(long)]
     pub allow_unstable: bool,
-    /// Length of the zoom after the motion start [ms].
+    /// Length of the zoom after the motion start [ms]; widened where it would hold too few samples or no method's first predictions.
     #[arg(long, value_name = "MS", default_value_t = 60.0)]
     pub zoom: f64,
     /// Output HTML file.
@@ -596,7 +596,7 @@ pub struct GreyboxArgs {
     /// Shift between tracking windows [s] [default: half the window].
     #[arg(long, value_name = "S", requires = "track_window")]
     pub track_hop: Option<f64>,
-    /// Tracking CSV: time_s,nut_position_m,mean_position_m, then NAME,NAME_std_error per parameter, residual_rms_m.
+    /// Tracking CSV: time_s,nut_position_m,mean_position_m, then NAME,NAME_std_error,NAME_verdict per parameter, residual_rms_m, termination.
     #[arg(long, value_name = "track.csv", requires = "track_window")]
     pub track_out: Option<PathBuf>,
 }
@@ -630,7 +630,7 @@ pub struct CompensateArgs {
     /// Output CSV: time_s,command_m,desired_m,predicted_m.
     #[arg(short, long, value_name = "command.csv")]
     pub output: PathBuf,
-    /// Zero-phase Gaussian smoothing σ of the desired trajectory [s], or auto (smallest σ within the limits).
+    /// Zero-phase Gaussian smoothing σ of the correction to the desired trajectory [s], or auto (smallest σ within the limits).
     #[arg(long, default_value = "auto", value_name = "S|auto")]
     pub smooth: String,
     /// Largest σ tried by --smooth auto [s].

@@ -161,6 +161,27 @@ fn a_short_lead_or_replay_without_compensate_exits_2() {
 }
 
 #[test]
+fn identification_options_with_compensate_are_refused_not_ignored() {
+    let run = |args: &[&str]| run(args, b"0,0,0\n0.001,0,0\n");
+    let base = ["stream", "--compensate", "--command-lead", "4"];
+    for extra in [
+        &["--method", "arx"][..],
+        &["--window", "50"],
+        &["--horizon", "5"],
+        &["--interval", "90"],
+        &["--lambda", "0.99"],
+        &["--extrapolate", "velocity"],
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra).copied().collect();
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+        let err = String::from_utf8(o.stderr).unwrap();
+        assert!(err.contains(extra[0]), "{extra:?}: {err}");
+        assert!(o.stdout.is_empty(), "{extra:?}");
+    }
+}
+
+#[test]
 fn refused_lines_are_reported_with_their_number_and_skipped() {
     let mut input = String::new();
     for k in 0..40 {

@@ -56,8 +56,8 @@ pub fn load_params(path: Option<&Path>) -> anyhow::Result<feedid::drive::RigPara
             let text = feedid::io::read_small_text(p)?;
             if feedid::drive::DriveStructure::describes(&text) {
                 anyhow::bail!(
-                    "{}: a drive structure file ([drive], [mechanics]): `feedid model` and \
-                     `feedid simulate` read it; this command needs the paper's rig parameters",
+                    "{}: a drive structure file ([drive], [mechanics]): `feedid model`, \
+                     `feedid simulate`, `feedid greybox` and `feedid tune` read it; this command needs the paper's rig parameters",
                     p.display()
                 );
             }

@@ -372,8 +372,8 @@ pub fn effects_long_help() -> String {
         + 2;
     let mut o = String::from(
         "Nonlinear effects of the virtual rig: a TOML file of any of the keys below \
-         (shown with their defaults; a missing key keeps its default, an unknown key is an \
-         error; the plain keys come before the [tables]). Default: all on but backlash, \
+         (shown with their defaults; a missing key keeps its default, but a friction table present in the file needs \
+         all four of its keys; an unknown key is an error; the plain keys come before the [tables]). Default: all on but backlash, \
          dead time and pulses; --linear switches every effect off.\n\n",
     );
     for (k, w) in &rows {

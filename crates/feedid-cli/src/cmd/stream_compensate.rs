@@ -25,6 +25,33 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
     out: W,
     mut err: E,
 ) -> Result<()> {
+    // The compensator identifies its own feed-forward model: the options of
+    // the sliding identification are refused, never ignored.
+    let w = &a.windows;
+    let mut given: Vec<String> = a
+        .options
+        .values
+        .iter()
+        .map(|(k, _)| format!("--{}", k.replace('_', "-")))
+        .collect();
+    for (flag, on) in [
+        ("--window", w.window.is_some()),
+        ("--hop", w.hop.is_some()),
+        ("--horizon", w.horizon.to_string() != "10"),
+        ("--interval", a.interval != 95.0),
+        ("--extrapolate", a.extrapolate.is_some()),
+    ] {
+        if on {
+            given.push(flag.to_string());
+        }
+    }
+    if !given.is_empty() {
+        bail!(
+            "{} not used by --compensate (the online compensator identifies its own feed-forward model); leave {} out",
+            given.join(", "),
+            if given.len() == 1 { "it" } else { "them" }
+        );
+    }
     if a.command_lead < 3 {
         bail!(
             "--compensate needs the desired program at least 3 lines ahead (--command-lead {} given): the command of a sample is computed from the desired positions two samples beyond it, before the drive needs it",

@@ -193,7 +193,7 @@ fn table(specs: &[MemberSpec]) -> String {
         count(&|m| m.feed_forward() == "vff+aff")
     );
     s += &format!(
-        "  defects                glitches on {}, dropped rows on {} (not readable by identify)\n",
+        "  defects                glitches on {}, dropped rows on {} (identify reads them segment by segment)\n",
         count(&|m| !m.glitches.is_empty()),
         count(&|m| m.has_gaps())
     );

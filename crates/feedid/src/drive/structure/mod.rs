@@ -30,7 +30,8 @@
 //! `central`, `(x[k] − x[k−2])/(2·Ts)` as the EMPS controller does, or
 //! `backward`), integrals by the rectangle rule, the output held.
 //!
-//! In the file (TOML; every table but `[mechanics]` and `[drive]` optional,
+//! In the file (TOML; `[mechanics]`, `[drive]` and `[position]` required, every
+//! other table optional,
 //! unknown keys an error):
 //!
 //! ```toml

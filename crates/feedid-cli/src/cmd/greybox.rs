@@ -525,12 +525,6 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
              a drive structure simulates its own friction law"
         );
     }
-    if a.restarts > 100 {
-        bail!(
-            "--restarts {}: at most 100 for a drive structure (each restart is a full fit)",
-            a.restarts
-        );
-    }
     let estimate = a
         .estimate
         .split(',')

@@ -222,3 +222,30 @@ fn the_residual_verdict_starts_at_the_horizon_and_captions_count_right() {
         "r_ee caption without the horizon"
     );
 }
+
+#[test]
+fn restarts_beyond_the_bound_are_refused_at_once_for_every_structure() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = simulate(
+        dir.path(),
+        "prbs.csv",
+        &["--scenario", "prbs", "--duration", "0.2"],
+    );
+    let emps = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/emps.toml");
+    for (extra, restarts) in [
+        (&["--estimate", "Kv"][..], "1000000000"),
+        (&["--params", emps, "--estimate", "M"][..], "101"),
+    ] {
+        let mut a: Vec<String> = vec!["greybox".into(), rec.display().to_string()];
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a.extend(["--restarts".into(), restarts.into()]);
+        let o = run(&a, None);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+        let err = stderr(&o);
+        assert!(
+            err.contains("restarts") && err.contains(restarts) && err.contains("at most 100"),
+            "{err}"
+        );
+        assert!(stdout(&o).is_empty(), "{extra:?}");
+    }
+}

@@ -544,7 +544,9 @@ impl Problem<'_> {
 /// than twice the parameters plus 2), [`Error::NonFinite`],
 /// [`Error::InvalidParameter`] (a start value ≤ 0, bad `dt`),
 /// [`Error::InvalidChoice`] (a friction level with the linear model),
-/// [`Error::NotIdentifiable`] (a null direction at the start, when refused).
+/// [`Error::NotIdentifiable`] (a null direction at the start, when refused);
+/// [`Error::InvalidParameter`] for more than
+/// [`MAX_RESTARTS`](crate::drive::MAX_RESTARTS) restarts.
 pub fn fit_greybox(
     data: &Measurements<'_>,
     start: &RigParams,
@@ -564,6 +566,7 @@ pub fn fit_greybox_with_progress(
     cfg: &GreyboxConfig,
     progress: Option<&(dyn Fn(u64, u64) + Sync)>,
 ) -> Result<GreyboxFit> {
+    crate::drive::check_restarts(cfg.restarts)?;
     let stages = 3 + u64::from(data.current.is_some()) + cfg.restarts as u64;
     let mut step = stepper(progress, stages);
     let base = check_set(

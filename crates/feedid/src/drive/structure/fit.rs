@@ -196,6 +196,22 @@ pub struct StructureFit {
     pub termination: Termination,
 }
 
+/// The most restarts a fit accepts: each restart is a full fit, so the
+/// bound keeps the work of one call finite.
+pub const MAX_RESTARTS: usize = 100;
+
+/// [`Error::InvalidParameter`] unless `restarts ≤ MAX_RESTARTS`.
+pub fn check_restarts(restarts: usize) -> Result<()> {
+    if restarts > MAX_RESTARTS {
+        return Err(Error::InvalidParameter {
+            name: "restarts",
+            value: restarts as f64,
+            reason: "at most 100, each restart being a full fit",
+        });
+    }
+    Ok(())
+}
+
 impl DriveStructure {
     /// Estimate the parameters `estimate` from `command` and the measured
     /// `position` at `rate_hz` (module doc of `fit.rs`).
@@ -373,6 +389,7 @@ impl DriveStructure {
         estimate: &[StructureParam],
         restarts: usize,
     ) -> Result<StructureFit> {
+        check_restarts(restarts)?;
         let mut fit = self.fit(command, position, rate_hz, estimate)?;
         for r in 0..restarts {
             let mut moved = fit.structure.clone();

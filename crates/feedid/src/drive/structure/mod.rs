@@ -76,7 +76,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
-pub use fit::{StructureEstimate, StructureFit, StructureParam, StructureValidation};
+pub use fit::{
+    check_restarts, StructureEstimate, StructureFit, StructureParam, StructureValidation,
+    MAX_RESTARTS,
+};
 pub use idim::{inverse_dynamics, IdimConfig, IdimFit};
 pub use linear::StructureSummary;
 pub use simulate::StructureRun;

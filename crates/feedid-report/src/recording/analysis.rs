@@ -1,18 +1,15 @@
-//! The analysis behind a recording's report: every method's run, the
-//! nominal simulation, the global models, and the helpers the figures share.
-
-use rayon::prelude::*;
+//! The analysis behind a recording's report: the library's comparison of
+//! every method on the recording ([`Comparison`]), with the report's
+//! options and the helpers the figures share.
 
 use crate::error::Result;
 use crate::html::{Figure, HtmlReport, Section};
 use crate::plot::{decimate_minmax, LineChart, Series};
-use feedid::drive::{closed_loop_coefficients, simulate_nominal_recording, D1Variant, RigParams};
-use feedid::ident::{
-    fit_global_model, prediction_errors, simulation_error, EngineConfig, GlobalModelKind,
-    LinearModel, Method, OeConfig, ResidualAnalysis, GLOBAL_FIT_SAMPLES,
-};
+use feedid::drive::RigParams;
+use feedid::ident::{EngineConfig, Method};
 use feedid::lti::TransferFunction;
-use feedid::pipeline::{Identification, Pipeline};
+use feedid::pipeline::{CompareOptions, Comparison};
+pub use feedid::pipeline::{GlobalModel, MethodRun};
 use feedid::stats::ErrorStats;
 use feedid::Recording;
 
@@ -21,10 +18,6 @@ pub(super) const METHOD_COLORS: [usize; 6] = [1, 2, 3, 4, 6, 7];
 pub(super) const MEASUREMENT: usize = 0;
 pub(super) const SIMULATION: usize = 5;
 pub(super) const COMMAND: usize = 8;
-
-/// Fewest samples the zoom after the motion start shows (see
-/// [`RecordingAnalysis::zoom_s`]).
-pub const MIN_ZOOM_SAMPLES: usize = 30;
 
 pub(super) fn method_color(i: usize) -> usize {
     METHOD_COLORS[i % METHOD_COLORS.len()]
@@ -67,34 +60,6 @@ impl ReportOptions {
     }
 }
 
-/// One method's sliding identification and its diagnostics.
-#[derive(Debug, Clone)]
-pub struct MethodRun {
-    /// Label for legends and tables (method and its main settings).
-    pub label: String,
-    /// Short id for element ids.
-    pub slug: String,
-    /// The method as it ran.
-    pub method: Method,
-    /// The run.
-    pub identification: Identification,
-    /// Errors over the zoom window after the motion start.
-    pub zoom_stats: ErrorStats,
-    /// Residual analysis of the prediction errors (`None` if too few predictions).
-    pub residuals: Option<ResidualAnalysis>,
-}
-
-/// A model fitted over the whole recording.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GlobalModel {
-    /// Label (structure and orders).
-    pub label: String,
-    /// The model.
-    pub model: LinearModel,
-    /// Errors of its free-run simulation against the measurement.
-    pub simulation: ErrorStats,
-}
-
 /// The analysis behind one recording's report.
 #[derive(Debug, Clone)]
 pub struct RecordingAnalysis {
@@ -121,7 +86,7 @@ pub struct RecordingAnalysis {
     /// The zoom after the motion start shown in the figures and the
     /// summary \[s\]: [`ReportOptions::zoom_s`], widened (to 1, 2 or 5 ×
     /// 10ⁿ s, at most to the recording's end) when it would hold fewer than
-    /// [`MIN_ZOOM_SAMPLES`] samples or miss a method's first predicted
+    /// [`MIN_ZOOM_SAMPLES`](feedid::pipeline::MIN_ZOOM_SAMPLES) samples or miss a method's first predicted
     /// horizon after the motion start (at 100 Hz, 60 ms are 6 samples and
     /// lie inside the first window).
     pub zoom_s: f64,
@@ -131,7 +96,7 @@ pub struct RecordingAnalysis {
 
 impl RecordingAnalysis {
     /// Identify `recording` with every method (in parallel, each through
-    /// the library's identification [`Pipeline`]), analyse the residuals of
+    /// the library's identification [`Pipeline`](feedid::pipeline::Pipeline)), analyse the residuals of
     /// every predicted sample up to [`ReportOptions::max_lag`] (shortened
     /// for short series), simulate the nominal model and fit the global
     /// models.
@@ -149,127 +114,26 @@ impl RecordingAnalysis {
         opts: &ReportOptions,
         progress: Option<&(dyn Fn(u64, u64) + Sync)>,
     ) -> Result<Self> {
-        let n = recording.len() as u64;
-        let globals = if opts.global_models { 2 } else { 0 };
-        let total = n * (opts.methods.len() as u64 + globals);
-        let done: Vec<std::sync::atomic::AtomicU64> = opts
-            .methods
-            .iter()
-            .map(|_| std::sync::atomic::AtomicU64::new(0))
-            .collect();
-        let report = |i: usize, d: u64| {
-            if let Some(p) = progress {
-                done[i].store(d, std::sync::atomic::Ordering::Relaxed);
-                let sum: u64 = done
-                    .iter()
-                    .map(|a| a.load(std::sync::atomic::Ordering::Relaxed))
-                    .sum();
-                p(sum.min(total), total);
-            }
+        let compare = CompareOptions {
+            methods: opts.methods.clone(),
+            params: opts.params,
+            zoom_s: opts.zoom_s,
+            max_lag: opts.max_lag,
+            global_models: opts.global_models,
         };
-        // (through the gaps of dropped samples, if any, at the measured ones)
-        let simulated = simulate_nominal_recording(&opts.params, &recording)?;
-        let nominal =
-            closed_loop_coefficients(&opts.params, D1Variant::Corrected).transfer_function()?;
-        let motion_start = recording.motion_start_time();
-        let t = recording.time();
-        let y = recording.position();
-
-        let runs: Vec<feedid::Result<Identification>> = opts
-            .methods
-            .par_iter()
-            .enumerate()
-            .map(|(i, (method, cfg))| {
-                let hook = |d: u64, _: u64| report(i, d);
-                let mut p = Pipeline::new(method.clone())
-                    .engine(*cfg)
-                    .method_global_model(false)
-                    .residuals(None);
-                if progress.is_some() {
-                    p = p.progress(&hook);
-                }
-                p.run(&recording)
-            })
-            .collect();
-        let runs = runs.into_iter().collect::<feedid::Result<Vec<_>>>()?;
-        let zoom_s = zoom_span(&recording, motion_start, opts.zoom_s, &runs);
-        let in_zoom = |k: usize| t[k] >= motion_start && t[k] <= motion_start + zoom_s;
-        let mut out_runs = Vec::with_capacity(runs.len());
-        for (i, identification) in runs.into_iter().enumerate() {
-            let s = &identification.sliding;
-            let zoom_stats = ErrorStats::from_pairs(
-                (0..y.len())
-                    .filter(|&k| in_zoom(k))
-                    .filter_map(|k| s.prediction(k).map(|p| (y[k], p))),
-            );
-            // every predicted sample, the lag shortened to fit a short series
-            let (uu, ee) = prediction_errors(s, recording.command(), y, usize::MAX);
-            let lag = opts.max_lag.min(ee.len().saturating_sub(2));
-            let residuals = if lag >= 1 {
-                ResidualAnalysis::for_horizon(&uu, &ee, lag, identification.config.horizon).ok()
-            } else {
-                None
-            };
-            let method = identification.method.clone();
-            out_runs.push(MethodRun {
-                label: format!("{} (W={})", method.label(), identification.config.window),
-                slug: format!("{}{}", method.name(), i + 1),
-                method,
-                identification,
-                zoom_stats,
-                residuals,
-            });
-        }
-        let simulation_stats =
-            ErrorStats::from_pairs(y.iter().copied().zip(simulated.iter().copied()));
-        let simulation_zoom = ErrorStats::from_pairs(
-            (0..y.len())
-                .filter(|&k| in_zoom(k))
-                .map(|k| (y[k], simulated[k])),
-        );
-        let (global, mut notes) = if opts.global_models {
-            let (global, mut notes) = global_models(&recording, opts);
-            if let Some(g) = recording.gaps().first() {
-                notes.push(format!(
-                    "Global models: fitted and simulated through the {} gap(s) of dropped samples \
-                     (the first before sample {}; the command interpolated there), compared with \
-                     the measured samples only.",
-                    recording.gaps().len(),
-                    g.index
-                ));
-            }
-            (global, notes)
-        } else {
-            (Vec::new(), Vec::new())
-        };
-        if let Some(g) = recording.gaps().first() {
-            notes.insert(
-                0,
-                format!(
-                    "{} sample(s) missing in {} gap(s) (the first before sample {}): every method \
-                     restarts its windows after each gap, so the start of every later segment is \
-                     not predicted; the nominal model runs through the gaps.",
-                    recording.missing_samples(),
-                    recording.gaps().len(),
-                    g.index
-                ),
-            );
-        }
-        if let Some(p) = progress {
-            p(total, total);
-        }
+        let c = Comparison::run(recording, &compare, progress)?;
         Ok(Self {
             name: name.to_string(),
-            recording,
-            runs: out_runs,
-            simulated,
-            simulation_stats,
-            simulation_zoom,
-            nominal,
-            global,
-            notes,
-            motion_start,
-            zoom_s,
+            recording: c.recording,
+            runs: c.runs,
+            simulated: c.simulated,
+            simulation_stats: c.simulation_stats,
+            simulation_zoom: c.simulation_zoom,
+            nominal: c.nominal,
+            global: c.global,
+            notes: c.notes,
+            motion_start: c.motion_start,
+            zoom_s: c.zoom_s,
             options: opts.clone(),
         })
     }
@@ -469,114 +333,6 @@ pub(super) fn span_text(s: f64) -> String {
     } else {
         format!("{} ms", sig3(ms))
     }
-}
-
-/// The zoom after the motion start actually shown \[s\] (see
-/// [`RecordingAnalysis::zoom_s`]): `requested`, unless it holds fewer than
-/// [`MIN_ZOOM_SAMPLES`] samples or ends before some method's first full
-/// horizon of predictions after the motion start; then the smallest 1, 2 or
-/// 5 × 10ⁿ s that holds them, at most up to the recording's last sample.
-fn zoom_span(
-    recording: &Recording,
-    motion_start: f64,
-    requested: f64,
-    runs: &[Identification],
-) -> f64 {
-    let t = recording.time();
-    let n = t.len();
-    let Some(first) = t.iter().position(|&v| v >= motion_start) else {
-        return requested;
-    };
-    let last = t[n - 1] - motion_start;
-    let at = |k: usize| t[k.min(n - 1)] - motion_start;
-    let mut need = at(first + MIN_ZOOM_SAMPLES - 1);
-    for run in runs {
-        let s = &run.sliding;
-        let h = run.config.horizon.max(1);
-        if let Some(k) = (first..n).find(|&k| s.has_prediction.get(k) == Some(&true)) {
-            need = need.max(at(k + h - 1));
-        }
-    }
-    if need <= requested || !need.is_finite() || last <= requested {
-        return requested;
-    }
-    // the next 1, 2 or 5 × 10ⁿ at or above what is needed
-    let decade = 10f64.powf(need.log10().floor());
-    let nice = [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * decade)
-        .find(|&v| v >= need * (1.0 - 1e-12))
-        .unwrap_or(10.0 * decade);
-    nice.min(last)
-}
-
-/// The global models of the Bode figure, through the library's one
-/// global-model path ([`fit_global_model`], at most
-/// [`GLOBAL_FIT_SAMPLES`] samples): ARX with the orders of the first method
-/// whose global model is ARX (`arx`, `rls`; else 8,8,1) and continuous OE
-/// with the poles and zeros of the first `oe` method (else 3 poles, 1
-/// zero); a model that cannot be fitted is a note, not an error.
-fn global_models(recording: &Recording, opts: &ReportOptions) -> (Vec<GlobalModel>, Vec<String>) {
-    let kinds: Vec<GlobalModelKind> = opts
-        .methods
-        .iter()
-        .filter_map(|(m, _)| m.global_model())
-        .collect();
-    let orders = kinds
-        .iter()
-        .find_map(|k| match k {
-            GlobalModelKind::Arx(o) => Some(*o),
-            _ => None,
-        })
-        .unwrap_or_default();
-    let default_oe = OeConfig::default();
-    let (poles, zeros) = kinds
-        .iter()
-        .find_map(|k| match k {
-            GlobalModelKind::Oe { poles, zeros } => Some((*poles, *zeros)),
-            _ => None,
-        })
-        .unwrap_or((default_oe.poles, default_oe.zeros));
-    let plural = |n: usize, what: &str| {
-        if n == 1 {
-            format!("1 {what}")
-        } else {
-            format!("{n} {what}s")
-        }
-    };
-    let arx_label = format!("global ARX {},{},{}", orders.na, orders.nb, orders.nk);
-    let oe_label = format!(
-        "global OE {}, {}",
-        plural(poles, "pole"),
-        plural(zeros, "zero")
-    );
-    let (arx, oe) = rayon::join(
-        || fit_global_model(recording, &GlobalModelKind::Arx(orders)),
-        || fit_global_model(recording, &GlobalModelKind::Oe { poles, zeros }),
-    );
-    let (mut global, mut notes) = (Vec::new(), Vec::new());
-    // simulated over the fitted samples (through any gaps)
-    let head = recording.head(GLOBAL_FIT_SAMPLES);
-    for (label, fit) in [(arx_label, arx), (oe_label, oe)] {
-        match fit {
-            Ok(file) => match head
-                .as_ref()
-                .map_err(|e| e.to_string())
-                .and_then(|h| simulation_error(&file.model, h).map_err(|e| e.to_string()))
-            {
-                Ok(simulation) if simulation.rms.is_finite() => global.push(GlobalModel {
-                    label,
-                    simulation,
-                    model: file.model,
-                }),
-                _ => notes.push(format!(
-                    "{label}: fitted, but its free-run simulation diverges (unstable model); not shown."
-                )),
-            },
-            Err(e) => notes.push(format!("{label}: could not be fitted ({e}); not shown.")),
-        }
-    }
-    (global, notes)
 }
 
 /// The stand-alone report of one recording.

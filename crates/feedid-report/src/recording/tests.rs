@@ -1,12 +1,12 @@
 //! Tests of the recording report.
 
-use super::analysis::MIN_ZOOM_SAMPLES;
 use super::analysis::*;
 use super::diagnostics::*;
 use crate::html::Block;
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::{EngineConfig, LinearModel, Method};
 use feedid::lti::Complex;
+use feedid::pipeline::MIN_ZOOM_SAMPLES;
 use feedid::signal::Scenario;
 use feedid::Recording;
 

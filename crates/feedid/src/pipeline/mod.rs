@@ -24,6 +24,9 @@
 //! assert!(serde_json::to_string(&s).unwrap().contains("\"rms_error_m\""));
 //! ```
 //!
+//! Every method on one recording, compared on the same samples:
+//! [`Comparison::run`] (what `feedid report` draws).
+//!
 //! Many recordings: [`Pipeline::run_many`] (or [`Pipeline::run_each`] for a
 //! caller that reads and writes each in the same task) on all cores, results
 //! in input order, one failure per recording.
@@ -36,12 +39,14 @@
 //! [`Identification::warnings`].
 
 mod builder;
+mod compare;
 mod many;
 mod run;
 mod summary;
 mod warning;
 
 pub use builder::Pipeline;
+pub use compare::{CompareOptions, Comparison, GlobalModel, MethodRun, MIN_ZOOM_SAMPLES};
 pub use run::{Identification, OrderChoice};
 pub use summary::{IdentifySummary, RegimeInterval};
 pub use warning::Warning;

@@ -103,7 +103,7 @@ pub fn identify<'py>(
         }
     }
     .py_err()?;
-    let mut summary = run.summary();
+    let mut summary = run.summary_in(feedid::error::Syntax::Python);
     if nominal {
         // whose parameters the simulation model has, as the command line says
         summary.nominal_rig = Some(match (&params_path, &params_json) {

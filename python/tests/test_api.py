@@ -191,3 +191,15 @@ def test_compensate_makes_the_model_follow_the_desired_trajectory():
     part = feedid.compensate(t, desired, run, check=gapped)
     a, b = part["benefit"]["expected_benefit"], full["benefit"]["expected_benefit"]
     assert abs(a / b - 1) < 0.02, (a, b)
+
+
+def test_warnings_name_python_keywords_not_cli_flags():
+    # lengths in mm read as metres: the position moves far too fast
+    rec = feedid.simulate("ramp", seed=1)
+    t, u, y = (np.array(v) for v in (rec.time, rec.command, rec.position))
+    run = feedid.identify(t, u * 1e3, y * 1e3, method="arx")
+    warnings = run.summary["warnings"]
+    speed = [w for w in warnings if "far beyond any feed drive" in w]
+    assert speed, warnings
+    assert 'unit="mm"' in speed[0] and "time_unit" in speed[0], speed
+    assert not any("--" in w for w in warnings), warnings

@@ -440,7 +440,7 @@ impl Syntax {
 /// front end phrases it in its own syntax ([`Error::message`]): `--unit mm`
 /// on the command line, `unit="mm"` in Python, `unit = mm` in the library's
 /// own text.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Hint {
     /// Set option `key` to `value` (`--smooth auto`).
     SetOption {
@@ -448,6 +448,14 @@ pub enum Hint {
         key: &'static str,
         /// The value (`"auto"`).
         value: &'static str,
+    },
+    /// Set option `key` to a value known only at run time
+    /// (`--estimate Kv,Kvff,Kaff`).
+    SetValue {
+        /// The option's key, snake_case (`"estimate"`).
+        key: &'static str,
+        /// The value (`"Kv,Kvff,Kaff"`).
+        value: String,
     },
     /// Change option `key` (`--max-smoothing`).
     Option {
@@ -460,14 +468,48 @@ impl Hint {
     /// The hint in `syntax`: `--smooth auto` / `smooth="auto"` / `smooth = auto`,
     /// or the option alone: `--max-smoothing` / `max_smoothing`.
     pub fn phrase(&self, syntax: Syntax) -> String {
-        match *self {
+        match self {
             Hint::SetOption { key, value } => syntax.setting(key, value),
+            Hint::SetValue { key, value } => syntax.setting(key, value),
             Hint::Option { key } => match syntax {
                 Syntax::Cli => format!("--{}", key.replace('_', "-")),
                 Syntax::Library | Syntax::Python => key.to_string(),
             },
         }
     }
+}
+
+/// `text` written with `hints` in [`Syntax::Library`] (in the order they
+/// appear), rewritten with the hints in `syntax`: scanning from the end, each
+/// hint's Library phrase, the last whole-word occurrence before the previous
+/// hint's, is replaced by its phrase in `syntax`.
+///
+/// ```
+/// use feedid::error::{phrase_hints, Hint, Syntax};
+/// let hints = [Hint::Option { key: "friction" }];
+/// assert_eq!(phrase_hints("friction? friction", &hints, Syntax::Cli), "friction? --friction");
+/// ```
+pub fn phrase_hints(text: &str, hints: &[Hint], syntax: Syntax) -> String {
+    let word = |c: char| c.is_alphanumeric() || c == '_' || c == '-';
+    let mut out = text.to_string();
+    let mut end = out.len();
+    for hint in hints.iter().rev() {
+        let lib = hint.phrase(Syntax::Library);
+        let mut search_end = end;
+        while let Some(start) = out[..search_end].rfind(&lib) {
+            let stop = start + lib.len();
+            let before = out[..start].chars().next_back();
+            let after = out[stop..].chars().next();
+            if before.is_some_and(word) || after.is_some_and(word) {
+                search_end = start;
+                continue;
+            }
+            out.replace_range(start..stop, &hint.phrase(syntax));
+            end = start;
+            break;
+        }
+    }
+    out
 }
 
 /// The hint of [`Error::LimitUnreachable`]: more smoothing.

@@ -8,6 +8,7 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use feedid::drive::RigEffects;
+use feedid::error::Syntax;
 use feedid::greybox::{
     fit_coefficients, fit_greybox_with_progress, track_greybox_with_progress, Dynamics,
     GreyboxConfig, GreyboxFit, LoopModel, Measurements, PhysicalParameter, TrackConfig,
@@ -53,7 +54,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     }
     write_outputs(a, &fit, track.as_deref(), &settings.estimate, context)?;
     print!("{text}");
-    for w in fit.warnings() {
+    for w in fit.warnings_in(Syntax::Cli) {
         eprintln!("warning: {w}");
     }
     Ok(())

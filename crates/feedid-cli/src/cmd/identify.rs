@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use feedid::error::Syntax;
 use feedid::ident::{GlobalModelKind, GuardConfig, OrderSearch, SlidingResult};
 use feedid::io::{
     write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
@@ -241,9 +242,9 @@ fn identify_file(
         .run(&rec)
         .with_context(|| input.display().to_string())?;
     for w in &run.warnings {
-        eprintln!("warning: {}: {w}", input.display());
+        eprintln!("warning: {}: {}", input.display(), w.phrased(Syntax::Cli));
     }
-    let mut summary = run.summary();
+    let mut summary = run.summary_in(Syntax::Cli);
     summary.nominal_rig = Some(rig.to_string());
 
     let mut model_line = None;

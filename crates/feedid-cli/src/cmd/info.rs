@@ -1,7 +1,8 @@
 //! `feedid info`: what a user checks before identifying.
 
 use anyhow::Result;
-use feedid::io::recording_info;
+use feedid::error::Syntax;
+use feedid::io::recording_info_in;
 
 use crate::args::InfoArgs;
 use crate::cmd::recording;
@@ -10,7 +11,7 @@ use crate::cmd::recording;
 pub fn run(a: &InfoArgs) -> Result<()> {
     // the gaps of dropped samples are described, not refused
     let rec = recording::load(&a.input, &a.recording)?;
-    let info = recording_info(&rec);
+    let info = recording_info_in(&rec, Syntax::Cli);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&info)?);
     } else {

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
+use feedid::error::Syntax;
 use feedid::io::{read_recording, read_recording_with_progress, ChannelRef, ReadOptions};
 use feedid::plausibility::check_recording;
 use feedid::Recording;
@@ -87,7 +88,7 @@ pub fn load_checked(path: &Path, a: &RecordingArgs) -> Result<(Recording, Vec<St
     let rec = read_recording(path, &opts)?;
     let warnings: Vec<String> = check_recording(&rec)
         .into_iter()
-        .map(|w| w.message)
+        .map(|w| w.phrased(Syntax::Cli))
         .collect();
     for w in &warnings {
         eprintln!("warning: {}: {w}", path.display());

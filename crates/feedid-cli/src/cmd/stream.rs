@@ -20,6 +20,7 @@ use std::io::{BufRead, BufWriter, ErrorKind, Write};
 use std::path::Path;
 
 use anyhow::{bail, Result};
+use feedid::error::Syntax;
 use feedid::ident::stream::{
     CommandExtrapolation, HoldLoss, HoldWatch, HorizonCommand, Interval, Prediction, StreamOptions,
     StreamStats,
@@ -223,7 +224,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
                     loss.samples,
                     1e6 * loss.rms,
                     1e6 * loss.hold_rms,
-                    loss.advice(s.horizon_command(), s.config().horizon, dt)
+                    loss.advice_in(s.horizon_command(), s.config().horizon, dt, Syntax::Cli)
                 );
             }
         }
@@ -262,7 +263,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         let _ = writeln!(
             err,
             "warning: the predictions lost to holding the last position: {}",
-            loss.advice(s.horizon_command(), s.config().horizon, dt)
+            loss.advice_in(s.horizon_command(), s.config().horizon, dt, Syntax::Cli)
         );
     }
     if st.lines == 0 {

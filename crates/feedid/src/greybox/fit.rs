@@ -52,7 +52,7 @@ use super::names::PhysicalParameter;
 use super::omitted::{missing_feed_forward, MissingFeedForward};
 use super::whiteness::{residual_structure, ResidualStructure};
 use crate::drive::{RigEffects, RigParams};
-use crate::error::{Error, Result};
+use crate::error::{Error, Hint, Result, Syntax};
 use crate::solve::{LevenbergMarquardt, LmConfig, LmReport, Termination};
 use crate::stats::ErrorStats;
 
@@ -188,8 +188,15 @@ impl GreyboxFit {
             .all(|e| e.verdict != Verdict::NotIdentifiable)
     }
 
-    /// One warning line per parameter that is not well determined.
+    /// One warning line per parameter that is not well determined, the
+    /// settings they suggest in [`Syntax::Library`] (`friction`).
     pub fn warnings(&self) -> Vec<String> {
+        self.warnings_in(Syntax::Library)
+    }
+
+    /// [`Fit::warnings`] with the settings they suggest in a front end's
+    /// syntax: the CLI names `--friction`, Python `friction`.
+    pub fn warnings_in(&self, syntax: Syntax) -> Vec<String> {
         let mut w: Vec<String> = Vec::new();
         let ff = self.missing_feed_forward.filter(|f| f.likely);
         for s in self.residual_structure.iter().filter(|s| s.structured) {
@@ -199,19 +206,24 @@ impl GreyboxFit {
                 100.0 * s.predictable_share,
                 s.lag1_correlation,
                 if ff.is_some() {
-                    "feed-forward, see below"
+                    "feed-forward, see below".to_string()
                 } else {
-                    "friction? --friction"
+                    format!("friction? {}", Hint::Option { key: "friction" }.phrase(syntax))
                 }
             ));
         }
         if let Some(f) = ff {
             let set: Vec<&str> = self.estimates.iter().map(|e| e.name).collect();
             w.push(format!(
-                "feed-forward may be missing: velocity and acceleration feed-forward would explain {:.0} % of the position residual the estimated parameters leave (velocity feed-forward alone {:.0} %); the axis probably runs feed-forward, which the model lacks, so every estimate is unreliable: estimate it too (--estimate {},Kvff,Kaff) or give its gains ([control] kvff, kaff in --params)",
+                "feed-forward may be missing: velocity and acceleration feed-forward would explain {:.0} % of the position residual the estimated parameters leave (velocity feed-forward alone {:.0} %); the axis probably runs feed-forward, which the model lacks, so every estimate is unreliable: estimate it too ({}) or give its gains ([control] kvff, kaff in {})",
                 100.0 * f.explained_share,
                 100.0 * f.velocity_share,
-                set.join(",")
+                Hint::SetValue {
+                    key: "estimate",
+                    value: format!("{},Kvff,Kaff", set.join(","))
+                }
+                .phrase(syntax),
+                Hint::Option { key: "params" }.phrase(syntax)
             ));
         }
         w.extend(

@@ -201,7 +201,8 @@ mod tests {
         assert_ne!(fit.estimates[0].verdict, Verdict::Identifiable);
         let m = fit.missing_feed_forward.unwrap();
         assert!(m.likely && m.explained_share > 0.6, "{m:?}");
-        let w = fit.warnings().join("\n");
+        assert!(!fit.warnings().join("\n").contains("--"), "{fit:?}");
+        let w = fit.warnings_in(crate::error::Syntax::Cli).join("\n");
         assert!(
             w.contains("feed-forward may be missing") && w.contains("--estimate Kv,Kvff,Kaff"),
             "{w}"

@@ -46,4 +46,4 @@ pub use self::table::{
     cell, write_coefficients_csv, write_predictions_csv, CoefficientRow, PredictionColumns,
 };
 pub use self::text::DECIMAL_COMMA_HINT;
-pub use crate::recording::{recording_info, ChannelStats, RecordingInfo};
+pub use crate::recording::{recording_info, recording_info_in, ChannelStats, RecordingInfo};

@@ -1,5 +1,6 @@
 //! The result of one identification run.
 
+use crate::error::Syntax;
 use crate::ident::{
     ArxOrders, Criterion, EngineConfig, Method, ModelFile, ResidualAnalysis, SlidingResult,
     WindowOutcome,
@@ -56,8 +57,15 @@ pub struct Identification {
 }
 
 impl Identification {
-    /// The summary of this run (`summary.json`, and the text `feedid identify` prints).
+    /// The summary of this run (`summary.json`, and the text `feedid identify` prints),
+    /// its warnings in [`Syntax::Library`].
     pub fn summary(&self) -> IdentifySummary {
+        self.summary_in(Syntax::Library)
+    }
+
+    /// [`Identification::summary`] with the warnings' hints in a front end's
+    /// syntax ([`Warning::phrased`]).
+    pub fn summary_in(&self, syntax: Syntax) -> IdentifySummary {
         let s = &self.sliding;
         let fallback = s
             .windows
@@ -138,7 +146,7 @@ impl Identification {
             simulation_diverged: self
                 .simulation_stats
                 .is_some_and(|x| !(x.rms.is_finite() && x.max_abs.is_finite())),
-            warnings: self.warnings.iter().map(|w| w.to_string()).collect(),
+            warnings: self.warnings.iter().map(|w| w.phrased(syntax)).collect(),
             identification_seconds: s.elapsed.as_secs_f64(),
             per_window_us: s.per_window_us(),
             residuals: self.residuals.clone(),

@@ -4,6 +4,8 @@ use std::fmt;
 
 use serde::{Serialize, Serializer};
 
+use crate::error::{phrase_hints, Hint, Syntax};
+
 /// A warning of an identification run ([`crate::pipeline::Identification::warnings`];
 /// printed on standard error by the CLI). Serialises as its text.
 #[derive(Debug, Clone, PartialEq)]
@@ -84,6 +86,32 @@ pub enum Warning {
     },
 }
 
+impl Warning {
+    /// The settings the text suggests, in the order it names them.
+    pub fn hints(&self) -> Vec<Hint> {
+        let set = |key, value| Hint::SetOption { key, value };
+        match self {
+            Warning::Recording(w) => w.hints.clone(),
+            Warning::NothingPredicted { windows, .. } if *windows > 0 => {
+                vec![set("method", "auto")]
+            }
+            Warning::PaperWindowOrigin => vec![set("time_origin", "window")],
+            Warning::PaperTfFallback { .. } => vec![set("prediction", "polynomial")],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The text with its hints in a front end's syntax (`Display` is
+    /// [`Syntax::Library`]'s): the CLI names `--method auto`, Python
+    /// `method="auto"`.
+    pub fn phrased(&self, syntax: Syntax) -> String {
+        match self {
+            Warning::Recording(w) => w.phrased(syntax),
+            other => phrase_hints(&other.to_string(), &other.hints(), syntax),
+        }
+    }
+}
+
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -113,7 +141,7 @@ impl fmt::Display for Warning {
                         "of {windows} windows, {failed} failed (the method could not fit or \
                          predict them: too little motion, an unstable or non-finite model) and \
                          {withheld} were withheld; try another method, a longer window or \
-                         `--method auto`, which always predicts"
+                         `method = auto`, which always predicts"
                     )
                 }
             }
@@ -151,13 +179,13 @@ impl fmt::Display for Warning {
                 "paper method, time origin window: the output model P5·τ⁵ + P6·τ⁶ + P7·τ⁷ \
                  starts at zero position and velocity in every window, so it cannot represent \
                  an axis away from 0 or moving at a window's start; its predictions are far off \
-                 there (use --time-origin window to study the coefficients, motion to predict)"
+                 there (use time_origin = window to study the coefficients, motion to predict)"
             ),
             Warning::PaperTfFallback { fallbacks, windows } => write!(
                 f,
                 "paper method, prediction tf: the identified transfer function was unstable in \
                  {fallbacks} of {windows} windows ({:.1} %), which were predicted by the \
-                 polynomial instead (as --prediction polynomial)",
+                 polynomial instead (as prediction = polynomial)",
                 100.0 * *fallbacks as f64 / (*windows).max(1) as f64
             ),
         }
@@ -167,5 +195,63 @@ impl fmt::Display for Warning {
 impl Serialize for Warning {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         s.collect_str(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names_a_flag(s: &str) -> bool {
+        s.as_bytes()
+            .windows(3)
+            .any(|w| w[0] == b'-' && w[1] == b'-' && w[2].is_ascii_alphabetic())
+    }
+
+    #[test]
+    fn texts_name_no_command_line_flags_and_the_cli_phrasing_does() {
+        let all = [
+            Warning::PaperCoefficientAccuracy { amplification: 1e9 },
+            Warning::NothingPredicted {
+                windows: 0,
+                failed: 0,
+                withheld: 0,
+            },
+            Warning::NothingPredicted {
+                windows: 10,
+                failed: 4,
+                withheld: 6,
+            },
+            Warning::ImplausibleWithheld {
+                withheld: 2,
+                windows: 10,
+                factor: 10.0,
+            },
+            Warning::DroppedSamples {
+                gaps: 1,
+                missing: 3,
+                first: 300,
+                first_time_s: 0.3,
+                unpredicted: 5,
+                stretch: 200,
+            },
+            Warning::PaperWindowOrigin,
+            Warning::PaperTfFallback {
+                fallbacks: 3,
+                windows: 10,
+            },
+        ];
+        for w in &all {
+            let text = w.to_string();
+            assert!(!names_a_flag(&text), "{text}");
+            assert_eq!(w.phrased(Syntax::Library), text);
+            let cli = w.phrased(Syntax::Cli);
+            assert_eq!(names_a_flag(&cli), !w.hints().is_empty(), "{cli}");
+            assert!(!names_a_flag(&w.phrased(Syntax::Python)), "{w:?}");
+        }
+        let cli = all[6].phrased(Syntax::Cli);
+        assert!(cli.contains("(as --prediction polynomial)"), "{cli}");
+        let py = all[5].phrased(Syntax::Python);
+        assert!(py.contains("(use time_origin=\"window\" to study"), "{py}");
     }
 }

@@ -32,6 +32,7 @@ use std::fmt;
 
 use serde::Serialize;
 
+use crate::error::Syntax;
 use crate::recording::plausibility::check_recording;
 use crate::recording::{Gap, MotionSegment, Recording, MOTION_THRESHOLD};
 
@@ -93,8 +94,14 @@ pub struct RecordingInfo {
     pub warnings: Vec<String>,
 }
 
-/// Summarise a recording.
+/// Summarise a recording (its warnings in [`Syntax::Library`]).
 pub fn recording_info(rec: &Recording) -> RecordingInfo {
+    recording_info_in(rec, Syntax::Library)
+}
+
+/// [`recording_info`] with the warnings' hints in a front end's syntax
+/// ([`crate::plausibility::Warning::phrased`]).
+pub fn recording_info_in(rec: &Recording, syntax: Syntax) -> RecordingInfo {
     let (c, x) = (rec.command(), rec.position());
     let mut channels = vec![stats("command", "m", c), stats("position", "m", x)];
     channels.extend(rec.extra().iter().map(|(n, v)| stats(n, "", v)));
@@ -114,7 +121,7 @@ pub fn recording_info(rec: &Recording) -> RecordingInfo {
 
     let mut warnings: Vec<String> = check_recording(rec)
         .into_iter()
-        .map(|w| w.message)
+        .map(|w| w.phrased(syntax))
         .collect();
     if c.len() >= 2 && (c[1] - c[0]).abs() > MOTION_THRESHOLD {
         warnings.push(

@@ -12,5 +12,6 @@ pub use checked::{
     MAX_GAPS_ANY_LENGTH, MAX_GAP_SHARE, MAX_MAGNITUDE, MIN_INTERVAL, MOTION_THRESHOLD,
 };
 pub use info::{
-    recording_info, ChannelStats, RecordingInfo, SEGMENT_MIN_STANDSTILL_S, SEGMENT_STEP_RELATIVE,
+    recording_info, recording_info_in, ChannelStats, RecordingInfo, SEGMENT_MIN_STANDSTILL_S,
+    SEGMENT_STEP_RELATIVE,
 };

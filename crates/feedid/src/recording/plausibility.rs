@@ -60,6 +60,7 @@
 
 use serde::Serialize;
 
+use crate::error::{phrase_hints, Hint, Syntax};
 use crate::recording::{Recording, MOTION_THRESHOLD};
 
 /// Share of the command's range it must cover while the position stays frozen.
@@ -112,8 +113,29 @@ pub enum WarningKind {
 pub struct Warning {
     /// What it is about.
     pub kind: WarningKind,
-    /// One line for people, with the numbers and what to check.
+    /// One line for people, with the numbers and what to check; the
+    /// settings it suggests are written in [`Syntax::Library`]
+    /// (`unit = mm`), see [`Warning::phrased`].
     pub message: String,
+    /// The settings the message suggests, in the order it names them.
+    #[serde(skip)]
+    pub hints: Vec<Hint>,
+}
+
+impl Warning {
+    /// The message with its hints in a front end's syntax (`Display` is
+    /// [`Syntax::Library`]'s): the CLI names `--unit mm`, Python `unit="mm"`.
+    pub fn phrased(&self, syntax: Syntax) -> String {
+        phrase_hints(&self.message, &self.hints, syntax)
+    }
+}
+
+const fn set(key: &'static str, value: &'static str) -> Hint {
+    Hint::SetOption { key, value }
+}
+
+const fn opt(key: &'static str) -> Hint {
+    Hint::Option { key }
 }
 
 impl std::fmt::Display for Warning {
@@ -126,7 +148,11 @@ impl std::fmt::Display for Warning {
 pub fn check_recording<S: AsRef<[f64]>>(rec: &Recording<S>) -> Vec<Warning> {
     let mut out = Vec::new();
     let (t, c, x) = (rec.time(), rec.command(), rec.position());
-    let warn = |kind, message| Warning { kind, message };
+    let warn = |kind, (message, hints)| Warning {
+        kind,
+        message,
+        hints,
+    };
     let range = |v: &[f64]| {
         let (lo, hi) = v
             .iter()
@@ -140,20 +166,23 @@ pub fn check_recording<S: AsRef<[f64]>>(rec: &Recording<S>) -> Vec<Warning> {
     if !moves {
         out.push(warn(
             WarningKind::CommandStill,
-            "command never moves (range <= 1 nm): there is nothing to identify".to_string(),
+            (
+                "command never moves (range <= 1 nm): there is nothing to identify".to_string(),
+                Vec::new(),
+            ),
         ));
     }
     // the first of these that applies: each makes the later ones meaningless
     let mut tracking_ok = moves;
     if moves {
         if let Some(w) = frozen_position(t, c, x, c_range) {
-            out.push(warn(WarningKind::FrozenPosition, w));
+            out.push(warn(WarningKind::FrozenPosition, (w, Vec::new())));
             tracking_ok = false;
         } else if let Some(w) = unit_mismatch(c, x) {
             out.push(warn(WarningKind::UnitMismatch, w));
             tracking_ok = false;
         } else if let Some(w) = sign_or_offset(c, x, c_range) {
-            out.push(warn(WarningKind::SignOrOffset, w));
+            out.push(warn(WarningKind::SignOrOffset, (w, Vec::new())));
             tracking_ok = false;
         }
     }
@@ -166,7 +195,7 @@ pub fn check_recording<S: AsRef<[f64]>>(rec: &Recording<S>) -> Vec<Warning> {
         }
     }
     for n in rec.notes() {
-        out.push(warn(WarningKind::ReadNote, n.clone()));
+        out.push(warn(WarningKind::ReadNote, (n.clone(), Vec::new())));
     }
     out
 }
@@ -271,7 +300,7 @@ fn std_dev(v: &[f64]) -> f64 {
 }
 
 /// Position and command in different units (see the module doc).
-fn unit_mismatch(c: &[f64], x: &[f64]) -> Option<String> {
+fn unit_mismatch(c: &[f64], x: &[f64]) -> Option<(String, Vec<Hint>)> {
     let (sc, sx) = (std_dev(c), std_dev(x));
     if !(sc > 0.0 && sx > 0.0) {
         return None;
@@ -285,12 +314,12 @@ fn unit_mismatch(c: &[f64], x: &[f64]) -> Option<String> {
         .into_iter()
         .find(|k| (decade - k).abs() < 0.5);
     Some(match near {
-        Some(k) => format!(
-            "the position varies {ratio:.3e} times as much as the command, near 10^{k}: the two are in different units (mm and m? µm and m?); convert one of them (--unit and --scale apply to both)"
-        ),
-        None => format!(
+        Some(k) => (format!(
+            "the position varies {ratio:.3e} times as much as the command, near 10^{k}: the two are in different units (mm and m? µm and m?); convert one of them (unit and scale apply to both)"
+        ), vec![opt("unit"), opt("scale")]),
+        None => (format!(
             "the position varies {ratio:.3e} times as much as the command: are both in the same unit, and is this the command of this axis?"
-        ),
+        ), Vec::new()),
     })
 }
 
@@ -308,7 +337,7 @@ fn sign_or_offset(c: &[f64], x: &[f64], c_range: f64) -> Option<String> {
 }
 
 /// The position faster than a feed drive (see the module doc).
-fn implausible_speed(x: &[f64], dt: f64) -> Option<String> {
+fn implausible_speed(x: &[f64], dt: f64) -> Option<(String, Vec<Hint>)> {
     if x.len() < 3 {
         return None;
     }
@@ -317,9 +346,9 @@ fn implausible_speed(x: &[f64], dt: f64) -> Option<String> {
     let (_, p99, _) = speeds.select_nth_unstable_by(k, f64::total_cmp);
     let v = *p99;
     (v > MAX_PLAUSIBLE_SPEED).then(|| {
-        format!(
-            "the position moves at {v:.3e} m/s (99th percentile), far beyond any feed drive (about 5 m/s at most): are the lengths in mm or µm (--unit mm, --unit um), or the times in another unit (--time-unit)?"
-        )
+        (format!(
+            "the position moves at {v:.3e} m/s (99th percentile), far beyond any feed drive (about 5 m/s at most): are the lengths in mm or µm (unit = mm, unit = um), or the times in another unit (time_unit)?"
+        ), vec![set("unit", "mm"), set("unit", "um"), opt("time_unit")])
     })
 }
 
@@ -354,7 +383,7 @@ pub fn following_lag(c: &[f64], x: &[f64], dt: f64) -> Option<(f64, f64)> {
 }
 
 /// A lag outside the range of feed drives (see the module doc).
-fn implausible_lag(c: &[f64], x: &[f64], dt: f64) -> Option<String> {
+fn implausible_lag(c: &[f64], x: &[f64], dt: f64) -> Option<(String, Vec<Hint>)> {
     let (tau, rho) = following_lag(c, x, dt)?;
     if rho < 0.5 || tau < 0.5 * dt {
         return None;
@@ -363,25 +392,41 @@ fn implausible_lag(c: &[f64], x: &[f64], dt: f64) -> Option<String> {
     let plausible = |t: f64| (lo..=hi).contains(&t);
     let hint = if tau > hi {
         if plausible(tau * 1e-3) {
-            "are the times in ms? (--time-unit ms)"
+            (
+                "are the times in ms? (time_unit = ms)",
+                set("time_unit", "ms"),
+            )
         } else if plausible(tau * 1e-6) {
-            "are the times in µs? (--time-unit us)"
+            (
+                "are the times in µs? (time_unit = us)",
+                set("time_unit", "us"),
+            )
         } else {
-            "check the time unit (--time-unit) and the columns"
+            (
+                "check the time unit (time_unit) and the columns",
+                opt("time_unit"),
+            )
         }
     } else if tau < lo {
         if plausible(tau * 1e3) {
-            "are the times in s or ms rather than the unit given? (--time-unit)"
+            (
+                "are the times in s or ms rather than the unit given? (time_unit)",
+                opt("time_unit"),
+            )
         } else {
-            "check the time unit (--time-unit) and the columns"
+            (
+                "check the time unit (time_unit) and the columns",
+                opt("time_unit"),
+            )
         }
     } else {
         return None;
     };
-    Some(format!(
+    let (hint, h) = hint;
+    Some((format!(
         "the position lags the command by {tau:.3e} s at a sampling rate of {:.4e} Hz; the following lag 1/Kv of a feed drive lies between about 1 ms and 100 ms: {hint}",
         1.0 / dt
-    ))
+    ), vec![h]))
 }
 
 #[cfg(test)]
@@ -547,11 +592,64 @@ mod tests {
         let xm: Vec<f64> = x.iter().map(|v| v * 1e3).collect();
         let rec = Recording::new(t, cm, xm).unwrap();
         let w = check_recording(&rec);
+        let speed = w
+            .iter()
+            .find(|w| w.kind == WarningKind::ImplausibleSpeed)
+            .unwrap_or_else(|| panic!("{w:?}"));
+        assert!(speed.message.contains("unit = mm"), "{speed}");
+        let cli = speed.phrased(Syntax::Cli);
         assert!(
-            w.iter()
-                .any(|w| w.kind == WarningKind::ImplausibleSpeed && w.message.contains("--unit mm")),
-            "{w:?}"
+            cli.contains("(--unit mm, --unit um), or the times in another unit (--time-unit)?"),
+            "{cli}"
         );
+        let py = speed.phrased(Syntax::Python);
+        assert!(
+            py.contains("unit=\"mm\"") && py.contains("(time_unit)"),
+            "{py}"
+        );
+        assert!(!speed.to_string().contains("--"), "{speed}");
+        assert_eq!(speed.phrased(Syntax::Library), speed.to_string());
+    }
+
+    /// No warning's own text names a command-line flag (`--` and a letter):
+    /// the front ends phrase the hints ([`Warning::phrased`]).
+    #[test]
+    fn library_texts_name_no_command_line_flags() {
+        let flag = |s: &str| {
+            s.as_bytes()
+                .windows(3)
+                .any(|w| w[0] == b'-' && w[1] == b'-' && w[2].is_ascii_alphabetic())
+        };
+        let t: Vec<f64> = (0..2000).map(|k| k as f64 * 1e-3).collect();
+        let c: Vec<f64> = t.iter().map(|&t| 0.01 * (2.0 * t).sin()).collect();
+        let mut texts = Vec::new();
+        // lengths in mm, times in ms, position in µm, lagging a lot
+        for (fc, fx, ft, lag) in [
+            (1e3, 1e3, 1.0, 0),
+            (1.0, 1e3, 1.0, 0),
+            (1.0, 1e6, 1.0, 0),
+            (1.0, 1.0, 1e3, 5),
+            (1.0, 1.0, 1e-3, 5),
+            (1.0, 1.0, 1.0, 500),
+        ] {
+            let tt: Vec<f64> = t.iter().map(|v| v * ft).collect();
+            let cc: Vec<f64> = c.iter().map(|v| v * fc).collect();
+            let xx: Vec<f64> = (0..c.len())
+                .map(|k| c[k.saturating_sub(lag)] * fx)
+                .collect();
+            let rec = Recording::new(tt, cc, xx).unwrap();
+            for w in check_recording(&rec) {
+                texts.push(w.to_string());
+                let cli = w.phrased(Syntax::Cli);
+                if !w.hints.is_empty() {
+                    assert!(flag(&cli), "{cli}");
+                }
+            }
+        }
+        assert!(texts.len() >= 4, "{texts:?}");
+        for s in &texts {
+            assert!(!flag(s), "{s}");
+        }
     }
 
     #[test]

@@ -11,6 +11,7 @@
 //! reports a block where the predictions lost ([`HoldLoss`]), with the cause
 //! and the options that change it ([`HoldLoss::advice`]).
 
+use crate::error::{Hint, Syntax};
 use crate::ident::engine::stream::{HorizonCommand, StreamStats};
 
 /// Fewest scored samples in a block.
@@ -32,7 +33,22 @@ pub struct HoldLoss {
 impl HoldLoss {
     /// What makes the predictions lose and what changes it, for a stream
     /// with `command` over a horizon of `horizon` samples at interval `dt`.
+    /// The settings it suggests are in [`Syntax::Library`] (`horizon = 1`);
+    /// [`HoldLoss::advice_in`] phrases them for a front end.
     pub fn advice(&self, command: HorizonCommand, horizon: usize, dt: f64) -> String {
+        self.advice_in(command, horizon, dt, Syntax::Library)
+    }
+
+    /// [`HoldLoss::advice`] with the settings it suggests in a front end's
+    /// syntax: the CLI names `--horizon 1`, Python `horizon=1`.
+    pub fn advice_in(
+        &self,
+        command: HorizonCommand,
+        horizon: usize,
+        dt: f64,
+        syntax: Syntax,
+    ) -> String {
+        let set = |key: &'static str, value: String| Hint::SetValue { key, value }.phrase(syntax);
         let ahead = format!(
             "a horizon of {horizon} samples is {:.3} ms at {:.4} Hz",
             1e3 * horizon as f64 * dt,
@@ -41,25 +57,31 @@ impl HoldLoss {
         // the paper's 2 ms, or one sample where that is shorter
         let paper = (2e-3 / dt).round();
         let shorter = if paper >= 1.0 && paper < horizon as f64 {
-            format!("--horizon 2ms: {paper} samples here")
+            format!("{}: {paper} samples here", set("horizon", "2ms".into()))
         } else {
-            format!("--horizon 1: {:.3} ms here", 1e3 * dt)
+            format!("{}: {:.3} ms here", set("horizon", "1".into()), 1e3 * dt)
         };
+        let lead = Hint::Option {
+            key: "command_lead",
+        }
+        .phrase(syntax);
+        let auto = set("method", "auto".into());
         match command {
             HorizonCommand::Extrapolated { known, .. } => format!(
                 "{ahead}, and the command over {} of them is extrapolated ({command}); \
-                 give the command ahead (--command-lead N, N ≥ {horizon}), a shorter horizon \
-                 ({shorter}), or let each window wait for its command (--extrapolate wait)",
-                horizon - known.min(horizon)
+                 give the command ahead ({lead} N, N ≥ {horizon}), a shorter horizon \
+                 ({shorter}), or let each window wait for its command ({})",
+                horizon - known.min(horizon),
+                set("extrapolate", "wait".into())
             ),
             HorizonCommand::NotRead => format!(
                 "{ahead}, predicted from the window alone (the method does not read the \
                  command); try a shorter horizon ({shorter}) or a method that reads the \
-                 command (--method auto)"
+                 command ({auto})"
             ),
             HorizonCommand::Known { .. } | HorizonCommand::Awaited { .. } => format!(
                 "{ahead}, with its command known: the method's model does not hold here; try \
-                 a shorter horizon ({shorter}) or another method (--method auto)"
+                 a shorter horizon ({shorter}) or another method ({auto})"
             ),
         }
     }
@@ -161,14 +183,19 @@ mod tests {
         assert!((loss.seconds - 2.0).abs() < 1e-12);
         assert!((loss.rms - 3.0).abs() < 1e-12 && (loss.hold_rms - 1.0).abs() < 1e-12);
         assert_eq!(w.blocks(), (2, 1));
-        let text = loss.advice(
-            HorizonCommand::Extrapolated {
-                extrapolation: crate::ident::engine::stream::CommandExtrapolation::Acceleration,
-                known: 0,
-            },
-            10,
-            0.01,
+        let command = HorizonCommand::Extrapolated {
+            extrapolation: crate::ident::engine::stream::CommandExtrapolation::Acceleration,
+            known: 0,
+        };
+        let library = loss.advice(command, 10, 0.01);
+        assert!(!library.contains("--"), "{library}");
+        assert!(library.contains("horizon = 1: 10.000 ms"), "{library}");
+        let py = loss.advice_in(command, 10, 0.01, Syntax::Python);
+        assert!(
+            py.contains("horizon=1: 10.000 ms") && !py.contains("--"),
+            "{py}"
         );
+        let text = loss.advice_in(command, 10, 0.01, Syntax::Cli);
         assert!(
             text.contains("100.000 ms") && text.contains("--command-lead"),
             "{text}"

@@ -32,12 +32,12 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         .options
         .values
         .iter()
-        .map(|(k, _)| format!("--{}", k.replace('_', "-")))
+        .map(|(key, _)| feedid::error::Hint::Option { key }.phrase(feedid::error::Syntax::Cli))
         .collect();
     for (flag, on) in [
         ("--window", w.window.is_some()),
         ("--hop", w.hop.is_some()),
-        ("--horizon", w.horizon.to_string() != "10"),
+        ("--horizon", w.horizon != feedid::ident::Span::Samples(10)),
         ("--interval", a.interval != 95.0),
         ("--extrapolate", a.extrapolate.is_some()),
     ] {

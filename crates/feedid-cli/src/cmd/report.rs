@@ -67,6 +67,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         other => other.into(),
     })?;
     analysis
+        .comparison
         .notes
         .extend(warnings.iter().map(|w| format!("warning: {w}")));
     let page = recording_report(&analysis)?;

@@ -7,10 +7,8 @@ use crate::html::{Figure, HtmlReport, Section};
 use crate::plot::{decimate_minmax, LineChart, Series};
 use feedid::drive::RigParams;
 use feedid::ident::{EngineConfig, Method};
-use feedid::lti::TransferFunction;
 use feedid::pipeline::{CompareOptions, Comparison};
 pub use feedid::pipeline::{GlobalModel, MethodRun};
-use feedid::stats::ErrorStats;
 use feedid::Recording;
 
 /// Palette colours of the methods (0 = measurement, 5 = simulation model, 8 = command).
@@ -34,7 +32,7 @@ pub struct ReportOptions {
     pub params_source: String,
     /// Zoom after the motion start \[s\]; default 0.06 (the paper's figures
     /// 5 and 7). Widened on a coarse or slow-starting recording so that the
-    /// zoom shows data (see [`RecordingAnalysis::zoom_s`]).
+    /// zoom shows data (see [`Comparison::zoom_s`]).
     pub zoom_s: f64,
     /// Points per curve after min/max decimation; default 3000 (coefficient
     /// curves, up to 16 per figure, get a fifth of it).
@@ -65,33 +63,19 @@ impl ReportOptions {
 pub struct RecordingAnalysis {
     /// Display name (file name).
     pub name: String,
-    /// The recording.
-    pub recording: Recording,
-    /// One run per method, in the order given.
-    pub runs: Vec<MethodRun>,
-    /// Nominal model driven by the measured command \[m\].
-    pub simulated: Vec<f64>,
-    /// Errors of the nominal model over the whole recording.
-    pub simulation_stats: ErrorStats,
-    /// Errors of the nominal model over the zoom window.
-    pub simulation_zoom: ErrorStats,
-    /// The nominal closed-loop transfer function.
-    pub nominal: TransferFunction,
-    /// Global models that could be fitted.
-    pub global: Vec<GlobalModel>,
-    /// Why a global model is missing (one line each).
-    pub notes: Vec<String>,
-    /// Motion start \[s\].
-    pub motion_start: f64,
-    /// The zoom after the motion start shown in the figures and the
-    /// summary \[s\]: [`ReportOptions::zoom_s`], widened (to 1, 2 or 5 ×
-    /// 10ⁿ s, at most to the recording's end) when it would hold fewer than
-    /// [`MIN_ZOOM_SAMPLES`](feedid::pipeline::MIN_ZOOM_SAMPLES) samples or miss a method's first predicted
-    /// horizon after the motion start (at 100 Hz, 60 ms are 6 samples and
-    /// lie inside the first window).
-    pub zoom_s: f64,
+    /// Every method on the recording, the nominal and the global models
+    /// (its fields read through this analysis: `a.runs`, `a.zoom_s`, …).
+    pub comparison: Comparison,
     /// Options used.
     pub options: ReportOptions,
+}
+
+impl std::ops::Deref for RecordingAnalysis {
+    type Target = Comparison;
+
+    fn deref(&self) -> &Comparison {
+        &self.comparison
+    }
 }
 
 impl RecordingAnalysis {
@@ -121,19 +105,9 @@ impl RecordingAnalysis {
             max_lag: opts.max_lag,
             global_models: opts.global_models,
         };
-        let c = Comparison::run(recording, &compare, progress)?;
         Ok(Self {
             name: name.to_string(),
-            recording: c.recording,
-            runs: c.runs,
-            simulated: c.simulated,
-            simulation_stats: c.simulation_stats,
-            simulation_zoom: c.simulation_zoom,
-            nominal: c.nominal,
-            global: c.global,
-            notes: c.notes,
-            motion_start: c.motion_start,
-            zoom_s: c.zoom_s,
+            comparison: Comparison::run(recording, &compare, progress)?,
             options: opts.clone(),
         })
     }

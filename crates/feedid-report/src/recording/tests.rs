@@ -288,7 +288,7 @@ fn a_method_that_blows_up_is_cut_at_the_frame_of_the_measurement_and_named() {
     assert!(full.y_range.is_none() && note.is_empty(), "{note}");
     // one method blows up to 1.09 m on one stretch of predictions
     let label = a.runs[1].label.clone();
-    let s = &mut a.runs[1].identification.sliding;
+    let s = &mut a.comparison.runs[1].identification.sliding;
     let k = (500..s.has_prediction.len())
         .find(|&k| s.has_prediction[k])
         .unwrap();

@@ -94,6 +94,12 @@ class Streamer:
         order: Optional[str] = None,
         ridge: Optional[float] = None,
         lambda_: Optional[float] = None,
+        hidden: Optional[int] = None,
+        train_samples: Optional[int] = None,
+        epochs: Optional[int] = None,
+        learning_rate: Optional[float] = None,
+        online_steps: Optional[int] = None,
+        nn_seed: Optional[int] = None,
         # end of method options
     ) -> None: ...
     def push(self, t: float, u: float, y: float) -> List[_Row]: ...
@@ -154,6 +160,12 @@ def identify(
     order: Optional[str] = None,
     ridge: Optional[float] = None,
     lambda_: Optional[float] = None,
+    hidden: Optional[int] = None,
+    train_samples: Optional[int] = None,
+    epochs: Optional[int] = None,
+    learning_rate: Optional[float] = None,
+    online_steps: Optional[int] = None,
+    nn_seed: Optional[int] = None,
     # end of method options
 ) -> Dict[str, Any]: ...
 def simulate(

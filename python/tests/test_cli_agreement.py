@@ -39,7 +39,7 @@ def check(run, pred, coef, summ):
 
 
 @pytest.mark.parametrize("scenario", SCENARIOS)
-@pytest.mark.parametrize("method", ["auto", "arx"])
+@pytest.mark.parametrize("method", ["auto", "arx", "nn"])
 def test_identify_equals_the_cli_on_the_rig_scenarios(cli, tmp_path, scenario, method):
     rec_path = tmp_path / f"{scenario}.csv"
     cli("simulate", "--scenario", scenario, "--seed", 1, "-o", rec_path)
@@ -92,6 +92,10 @@ def test_options_reach_the_method_as_on_the_command_line(cli, tmp_path):
          dict(method="arx", ridge=1e-6, interval=80)),
         (["--method", "paper", "--runaway", "off"], dict(method="paper", runaway=None)),
         (["--method", "oe", "--runaway", "3"], dict(method="oe", runaway=3.0)),
+        (["--method", "nn", "--hidden", "8", "--nn-seed", "3", "--online-steps", "2",
+          "--train-samples", "1000", "--epochs", "5", "--learning-rate", "0.002"],
+         dict(method="nn", hidden=8, nn_seed=3, online_steps=2, train_samples=1000, epochs=5,
+              learning_rate=0.002)),
     ]
     for args, kw in cases:
         pred, coef, summ = cli_identify(cli, tmp_path, rec_path, *args)
@@ -107,7 +111,7 @@ def test_model_equals_feedid_model_json(cli):
 
 def test_identify_equals_the_cli_on_emps(cli, tmp_path, emps):
     args = ["--time", "t", "--command", "qg", "--position", "qm"]
-    for method in ["auto", "arx"]:
+    for method in ["auto", "arx", "nn"]:
         pred, coef, summ = cli_identify(cli, tmp_path, emps, *args, "--method", method)
         rec = feedid.read(emps, time="t", command="qg", position="qm")
         check(feedid.identify(rec, method=method), pred, coef, summ)

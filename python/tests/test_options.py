@@ -19,18 +19,20 @@ def test_the_descriptions_keep_the_python_keywords_and_defaults():
     specs = {s["key"]: s for s in _feedid.method_options()}
     assert {s["python"] for s in specs.values()} == {
         "order", "solver", "time_origin", "prediction", "simplex_start", "lambda_", "ridge",
+        "hidden", "train_samples", "epochs", "learning_rate", "online_steps", "nn_seed",
     }
     assert specs["lambda"]["python"] == "lambda_" and specs["lambda"]["flag"] == "--lambda"
-    assert [m["method"] for m in specs["order"]["methods"]] == ["arx", "rls", "auto"]
+    assert [m["method"] for m in specs["order"]["methods"]] == ["arx", "rls", "nn", "auto"]
+    assert specs["nn_seed"]["flag"] == "--nn-seed" and specs["hidden"]["defaults"] == "16"
     assert specs["lambda"]["defaults"] == "0.999"
     assert specs["solver"]["choices"] == ["qr", "simplex"]
     assert specs["lambda"]["range"]["text"] == "in (0, 1]"
     for s in specs.values():
         assert s["help"].endswith(f"[default: {s['defaults']}]"), s
     names = [m["name"] for m in _feedid.methods()]
-    assert names == ["auto", "paper", "arx", "rls", "oe"]
+    assert names == ["auto", "paper", "arx", "rls", "oe", "nn"]
     windows = {m["name"]: m["default_window"] for m in _feedid.methods()}
-    assert windows == {"auto": 50, "paper": 20, "arx": 100, "rls": 100, "oe": 200}
+    assert windows == {"auto": 50, "paper": 20, "arx": 100, "rls": 100, "oe": 200, "nn": 100}
 
 
 def test_the_stubs_have_every_option_with_its_type_and_default():

@@ -28,7 +28,7 @@ def by_sample(t, rows, column=1):
     return out
 
 
-@pytest.mark.parametrize("method", ["auto", "arx", "paper"])
+@pytest.mark.parametrize("method", ["auto", "arx", "paper", "nn"])
 @pytest.mark.parametrize("scenario", ["multisine", "ramp"])
 def test_streamer_waiting_for_its_command_predicts_what_identify_predicts(method, scenario):
     rec = feedid.simulate(scenario, seed=4)

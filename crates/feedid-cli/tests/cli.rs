@@ -987,7 +987,7 @@ fn order_changes_auto_and_is_refused_by_methods_without_orders() {
             "-o",
             out.to_str().unwrap(),
         ]);
-        common::assert_fails(&o, &["--order", method, "arx, rls, auto"]);
+        common::assert_fails(&o, &["--order", method, "arx, rls, nn, auto"]);
         assert!(!out.exists());
     }
     // so do other options given to a method without them

@@ -11,7 +11,7 @@
 //! `A..=B` or a list `1,5,9`; `--csv FILE` writes one row per member and
 //! method. The summary is printed as a Markdown table.
 //!
-//! Methods: `paper`, `arx`, `rls`, `oe`, `auto` with their default windows
+//! Methods: `paper`, `arx`, `rls`, `oe`, `auto`, `nn` with their default windows
 //! (the library, through [`run_library_methods`] alone), and the baselines,
 //! written here simply and independently of the library:
 //!
@@ -107,7 +107,7 @@ const H: usize = 10;
 /// Fewest shared samples for a pairwise comparison.
 const MIN_SHARED: usize = 50;
 /// The library methods, in table order.
-const LIBRARY: [&str; 5] = ["paper", "arx", "rls", "oe", "auto"];
+const LIBRARY: [&str; 6] = ["paper", "arx", "rls", "oe", "auto", "nn"];
 /// The fixed (non-auto) library methods.
 const FIXED: [&str; 4] = ["paper", "arx", "rls", "oe"];
 /// The baselines.
@@ -140,7 +140,7 @@ type RunOutput = (
     usize,
 );
 
-/// Every use of the identification API: the five library methods with their
+/// Every use of the identification API: the six library methods with their
 /// defaults (window per method, H = 10, hop = H), as `feedid identify` runs
 /// them. Keep the library calls here and nowhere else in this file.
 fn run_library_methods(rec: &Recording) -> Vec<Predictions> {

@@ -265,6 +265,16 @@ pub enum Error {
         poles: String,
     },
 
+    /// The neural network's training or evaluation failed in its tensor
+    /// library (candle).
+    #[error("the neural network's {stage} failed: {message}")]
+    Network {
+        /// `"training"`.
+        stage: &'static str,
+        /// The library's message.
+        message: String,
+    },
+
     /// An iterative algorithm did not converge.
     #[error("{algorithm} did not converge after {iterations} iterations")]
     NotConverged {

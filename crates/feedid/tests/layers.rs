@@ -181,6 +181,7 @@ const IDENT_LAYERS: &[&[&str]] = &[
         "methods/arx",
         "methods/oe",
         "methods/rls.rs",
+        "methods/nn",
     ],
     // auto runs rls updates
     &["methods/auto"],

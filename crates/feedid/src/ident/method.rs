@@ -11,6 +11,7 @@
 //! | `arx` | windowed ARX with exact sliding update ([`ArxConfig`]) | 100 | `na, nb, nk` | ARX with its orders |
 //! | `rls` | recursive least squares with forgetting ([`RlsConfig`]) | 100 | `na, nb, nk` | ARX with its orders |
 //! | `oe` | continuous-time output error over sliding windows ([`OeConfig`]) | 200 | — (poles, zeros) | OE with its poles and zeros |
+//! | `nn` | neural NARX predictor: a two-layer `tanh` network with a linear bypass on `auto`'s unit-gain regressor, trained on the first moving samples ([`NnConfig`]) | 100 | `na, nb, nk` (its lags) | — |
 //!
 //! `auto` takes orders for its long-memory recursive candidate (default
 //! 8,8,0); its other candidates stay as they are. Setting
@@ -60,14 +61,16 @@ use std::str::FromStr;
 use crate::error::{Error, Result, Syntax};
 use crate::ident::engine::{Estimator, Span};
 use crate::ident::global::GlobalModelKind;
-use crate::ident::methods::{ArxConfig, ArxOrders, AutoConfig, OeConfig, PaperConfig, RlsConfig};
+use crate::ident::methods::{
+    ArxConfig, ArxOrders, AutoConfig, NnConfig, OeConfig, PaperConfig, RlsConfig,
+};
 use crate::ident::option::{MethodOption, MethodSettings, OptionInfo, OptionUse};
 
 /// Accepted method names, for messages.
-pub const METHOD_NAMES: &str = "auto, paper, arx, rls, oe";
+pub const METHOD_NAMES: &str = "auto, paper, arx, rls, oe, nn";
 
 /// The methods that take ARX orders, for messages.
-const ORDER_METHODS: &str = "arx, rls, auto";
+pub const ORDER_METHODS: &str = "arx, rls, nn, auto";
 
 /// An identification method and its settings.
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +85,8 @@ pub enum Method {
     Oe(OeConfig),
     /// Validated choice of model, order and memory from the data (the default).
     Auto(AutoConfig),
+    /// Neural NARX predictor.
+    Nn(NnConfig),
 }
 
 impl Default for Method {
@@ -93,13 +98,14 @@ impl Default for Method {
 
 impl Method {
     /// Every method with its default settings, in the order of [`METHOD_NAMES`].
-    pub fn all() -> [Method; 5] {
+    pub fn all() -> [Method; 6] {
         [
             Method::Auto(AutoConfig::default()),
             Method::Paper(PaperConfig::default()),
             Method::Arx(ArxConfig::default()),
             Method::Rls(RlsConfig::default()),
             Method::Oe(OeConfig::default()),
+            Method::Nn(NnConfig::default()),
         ]
     }
 
@@ -111,6 +117,7 @@ impl Method {
             Method::Rls(_) => "rls",
             Method::Oe(_) => "oe",
             Method::Auto(_) => "auto",
+            Method::Nn(_) => "nn",
         }
     }
 
@@ -134,6 +141,10 @@ impl Method {
             }
             Method::Oe(c) => format!("OE {}p/{}z", c.poles, c.zeros),
             Method::Auto(_) => "auto".to_string(),
+            Method::Nn(c) => {
+                let o = c.orders;
+                format!("NN {},{},{} h={}", o.na, o.nb, o.nk, c.hidden)
+            }
         }
     }
 
@@ -148,6 +159,7 @@ impl Method {
             Method::Rls(_) => 100,
             Method::Oe(_) => 200,
             Method::Auto(_) => 50,
+            Method::Nn(_) => 100,
         }
     }
 
@@ -158,7 +170,7 @@ impl Method {
     /// only exists per window).
     pub fn global_model(&self) -> Option<GlobalModelKind> {
         match self {
-            Method::Paper(_) => None,
+            Method::Paper(_) | Method::Nn(_) => None,
             Method::Arx(c) => Some(GlobalModelKind::Arx(c.orders)),
             Method::Rls(c) => Some(GlobalModelKind::Arx(c.orders)),
             Method::Oe(c) => Some(GlobalModelKind::Oe {
@@ -177,6 +189,7 @@ impl Method {
             Method::Arx(c) => Some(c.orders),
             Method::Rls(c) => Some(c.orders),
             Method::Auto(c) => c.orders(),
+            Method::Nn(c) => Some(c.orders),
         }
     }
 
@@ -198,6 +211,12 @@ impl Method {
             Method::Arx(c) => c.orders = orders,
             Method::Rls(c) => c.orders = orders,
             Method::Auto(c) => c.set_orders(orders)?,
+            Method::Nn(c) => {
+                let mut changed = c.clone();
+                changed.orders = orders;
+                changed.validate()?;
+                *c = changed;
+            }
         }
         Ok(())
     }
@@ -210,6 +229,7 @@ impl Method {
             Method::Rls(c) => c.validate(),
             Method::Oe(c) => c.validate(),
             Method::Auto(c) => c.validate(),
+            Method::Nn(c) => c.validate(),
         }
     }
 
@@ -221,6 +241,7 @@ impl Method {
             Method::Rls(c) => Box::new(c.build()?),
             Method::Oe(c) => Box::new(c.clone().build()?),
             Method::Auto(c) => Box::new(c.build()?),
+            Method::Nn(c) => Box::new(c.build()?),
         })
     }
 
@@ -249,6 +270,7 @@ impl Method {
             Method::Rls(_) => "recursive least squares with forgetting",
             Method::Oe(_) => "continuous-time output error over sliding windows",
             Method::Auto(_) => "validated choice of model, order and memory (the default)",
+            Method::Nn(_) => "neural NARX predictor (a tanh network on auto's unit-gain regressor)",
         }
     }
 
@@ -272,6 +294,7 @@ impl Method {
             Method::Rls(c) => c,
             Method::Oe(c) => c,
             Method::Auto(c) => c,
+            Method::Nn(c) => c,
         }
     }
 
@@ -283,6 +306,7 @@ impl Method {
             Method::Rls(c) => c,
             Method::Oe(c) => c,
             Method::Auto(c) => c,
+            Method::Nn(c) => c,
         }
     }
 
@@ -429,7 +453,7 @@ mod tests {
 
     #[test]
     fn every_name_builds_its_estimator() {
-        for name in ["paper", "arx", "rls", "oe", "auto"] {
+        for name in ["paper", "arx", "rls", "oe", "auto", "nn"] {
             let m: Method = name.parse().unwrap();
             assert_eq!(m.name(), name);
             assert_eq!(m.build().unwrap().name(), name);
@@ -445,13 +469,16 @@ mod tests {
     #[test]
     fn unknown_name_lists_the_choices() {
         let e = "magic".parse::<Method>().unwrap_err();
-        assert!(e.to_string().contains("auto, paper, arx, rls, oe"), "{e}");
+        assert!(
+            e.to_string().contains("auto, paper, arx, rls, oe, nn"),
+            "{e}"
+        );
     }
 
     #[test]
     fn orders_apply_to_regressor_methods_and_are_refused_elsewhere() {
         let o = ArxOrders::new(2, 3, 0);
-        for name in ["arx", "rls", "auto"] {
+        for name in ["arx", "rls", "nn", "auto"] {
             let mut m: Method = name.parse().unwrap();
             m.set_orders(o).unwrap();
             assert_eq!(m.orders(), Some(o), "{name}");
@@ -482,7 +509,7 @@ mod tests {
                 matches!(e, Error::NotApplicable { method, .. } if method == name),
                 "{e}"
             );
-            assert!(e.to_string().contains("arx, rls, auto"), "{e}");
+            assert!(e.to_string().contains("arx, rls, nn, auto"), "{e}");
             assert_eq!(m, before);
             assert_eq!(m.orders(), None);
         }
@@ -502,11 +529,12 @@ mod tests {
                 "paper LSM, qr",
                 "ARX 3,3,0",
                 "RLS 8,8,0 λ=0.999",
-                "OE 3p/1z"
+                "OE 3p/1z",
+                "NN 8,8,0 h=16"
             ]
         );
         let windows: Vec<usize> = Method::all().iter().map(Method::default_window).collect();
-        assert_eq!(windows, [50, 20, 100, 100, 200]);
+        assert_eq!(windows, [50, 20, 100, 100, 200, 100]);
         let mut rls: Method = "rls".parse().unwrap();
         rls.set_orders(ArxOrders::new(4, 4, 1)).unwrap();
         assert_eq!(
@@ -533,14 +561,21 @@ mod tests {
                 "simplex_start",
                 "order",
                 "ridge",
-                "lambda"
+                "lambda",
+                "hidden",
+                "train_samples",
+                "epochs",
+                "learning_rate",
+                "online_steps",
+                "nn_seed"
             ]
         );
         let who = |key: &str| {
             let o = infos.iter().find(|o| o.spec.key == key).unwrap();
             o.applies_to(Syntax::Library)
         };
-        assert_eq!(who("order"), "arx, rls, auto");
+        assert_eq!(who("order"), "arx, rls, nn, auto");
+        assert_eq!(who("hidden"), "nn");
         assert_eq!(who("ridge"), "arx, auto");
         assert_eq!(who("lambda"), "rls");
         assert_eq!(who("simplex_start"), "paper (with solver = simplex)");
@@ -562,9 +597,9 @@ mod tests {
         }
         assert_eq!(
             infos[4].help(Syntax::Cli),
-            "arx, rls, auto (its long-memory candidate): ARX orders `na,nb,nk` (poles, input \
-             terms, input delay in samples), or `auto` (chosen from the recording by BIC; \
-             identify only) [default: arx 3,3,0; rls 8,8,0; auto 8,8,0]"
+            "arx, rls, nn, auto (its long-memory candidate): ARX orders `na,nb,nk` (poles, \
+             input terms, input delay in samples), or `auto` (chosen from the recording by BIC; \
+             identify only) [default: arx 3,3,0; rls 8,8,0; nn 8,8,0; auto 8,8,0]"
         );
         let d = Method::default().describe();
         assert_eq!(

@@ -34,13 +34,14 @@ pub use global::{
     fit_global_model, simulation_error, GlobalModelKind, ModelFile, ModelProvenance,
     GLOBAL_FIT_SAMPLES,
 };
-pub use method::{Method, MethodInfo, METHOD_NAMES};
+pub use method::{Method, MethodInfo, METHOD_NAMES, ORDER_METHODS};
 pub use methods::{
     coefficients_from_polynomials, fit_arx, fit_arx_segments, fit_oe, fit_oe_measured,
     polynomials_from_coefficients, ArxConfig, ArxDiagnostics, ArxEstimator, ArxFit, ArxOrders,
-    AutoConfig, AutoEstimator, Candidate, OeConfig, OeEstimator, OeFit, OeJacobian, PaperConfig,
-    PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig, RlsEstimator, SimplexSettings,
-    SimplexStart, Solver, TimeOrigin, MAX_ARX_ORDER, SHIFT_AMPLIFICATION_WARNING,
+    AutoConfig, AutoEstimator, Candidate, NnConfig, NnEstimator, NnTraining, OeConfig, OeEstimator,
+    OeFit, OeJacobian, PaperConfig, PaperDiagnostics, PaperMethod, PredictionMode, RlsConfig,
+    RlsEstimator, SimplexSettings, SimplexStart, Solver, TimeOrigin, MAX_ARX_ORDER,
+    SHIFT_AMPLIFICATION_WARNING,
 };
 pub(crate) use methods::{fold_scale, has_avx2, rls_update};
 pub use model::LinearModel;

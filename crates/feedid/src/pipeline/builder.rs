@@ -297,7 +297,7 @@ impl Pipeline<'_> {
             return Err(Error::NotApplicable {
                 setting: "order selection",
                 method: method.name(),
-                applies_to: "arx, rls, auto",
+                applies_to: crate::ident::ORDER_METHODS,
             });
         }
         // on the stretch without dropped samples where the command moves most

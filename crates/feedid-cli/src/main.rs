@@ -43,7 +43,18 @@ fn main() -> ExitCode {
     install_signal_handlers();
     // `--scale -1e-6`, `--rate -5000`: a negative number is a value (for the
     // validators to judge), not an unknown flag
-    let matches = numbers_take_a_minus(args::Cli::command()).get_matches();
+    let matches = match numbers_take_a_minus(args::Cli::command()).try_get_matches() {
+        Ok(m) => m,
+        // `--help`, `--version`: printed on standard output, whose failure
+        // (`> /dev/full`) is an error like any other output's
+        Err(e) if !e.use_stderr() => {
+            return match e.print().and_then(|()| std::io::stdout().lock().flush()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(err) => stdout_failed(&err),
+            };
+        }
+        Err(e) => e.exit(),
+    };
     let cli = match args::Cli::from_arg_matches(&matches) {
         Ok(c) => c,
         Err(e) => e.exit(),

@@ -709,7 +709,7 @@ fn compensate_succeeds_on_segments_moving_at_their_end_or_from_their_first_sampl
 }
 
 #[test]
-fn a_fall_back_to_a_plain_command_over_a_limit_says_so_with_its_figures() {
+fn a_fall_back_to_a_plain_command_over_a_limit_is_refused_with_its_figures() {
     let dir = tempfile::tempdir().unwrap();
     let prbs = simulate(
         dir.path(),
@@ -741,18 +741,16 @@ fn a_fall_back_to_a_plain_command_over_a_limit_says_so_with_its_figures() {
         "-o",
         p(&out),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    // the limits hold for every command sent: the plain one too
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     let err = stderr(&o);
-    assert!(err.contains("below 100 %"), "{err}");
     assert!(
-        err.contains("peaks at 250.0000 m/s²") && err.contains("above --max-acceleration 30"),
+        err.contains("the plain command, sent because the model's fit is below the minimum"),
         "{err}"
     );
-    // no compensated figures for a command that is not sent
-    let text = stdout(&o);
-    assert!(!text.contains("compensated rms"), "{text}");
     assert!(
-        text.contains("command sent: the plain desired trajectory"),
-        "{text}"
+        err.contains("acceleration of 250.0000 m/s²") && err.contains("beyond the limit 30 m/s²"),
+        "{err}"
     );
+    assert!(!out.exists());
 }

@@ -427,7 +427,7 @@ fn dm_statistic(y: &[f64], a: &Predictions, b: &Predictions, scored: &[bool]) ->
 /// critical value (or there are too few blocks to test).
 fn loses_significantly(y: &[f64], a: &Predictions, b: &Predictions, scored: &[bool]) -> bool {
     shared_rms(y, a, b, scored).is_some_and(|(x, r)| x > r)
-        && dm_statistic(y, a, b, scored).map_or(true, |t| t > Z_95)
+        && dm_statistic(y, a, b, scored).is_none_or(|t| t > Z_95)
 }
 
 /// One method on one member.
@@ -610,7 +610,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
             for b in BASELINES.iter().filter(|&&b| b != p.name) {
                 if let Some((a, r)) = shared_rms(y, p, by_name[b], &scored) {
                     let q = a / r;
-                    if !q.is_nan() && worst.map_or(true, |(_, w)| q > w) {
+                    if !q.is_nan() && worst.is_none_or(|(_, w)| q > w) {
                         worst = Some((b, q));
                     }
                 }

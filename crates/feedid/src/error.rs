@@ -355,6 +355,40 @@ pub enum Error {
         actual: f64,
     },
 
+    /// A smoothing (σ of the Gaussian) longer than a compensation may use:
+    /// its buffers grow with its square.
+    #[error("{what} {} s is {samples:.0} samples at this rate, more than the {max_samples} samples ({} s) a compensation smooths over", short_number(*seconds), short_number(*max_seconds))]
+    SmoothingTooLong {
+        /// `"smoothing"` or `"max smoothing"`.
+        what: &'static str,
+        /// The σ asked for \[s\].
+        seconds: f64,
+        /// The σ in samples.
+        samples: f64,
+        /// The most samples allowed.
+        max_samples: usize,
+        /// The most allowed at this rate \[s\].
+        max_seconds: f64,
+    },
+
+    /// The plain command, sent instead of a compensated one, violates a
+    /// velocity or acceleration limit: the desired trajectory itself does.
+    #[error("the plain command, sent because {because}, has a peak {quantity} of {value:.4} {unit} at t = {time:.4} s, beyond the limit {} {unit}: the desired trajectory itself exceeds it; slow the trajectory down or raise the limit", short_number(*limit))]
+    PlainOverLimit {
+        /// `"velocity"` or `"acceleration"`.
+        quantity: &'static str,
+        /// The peak value (magnitude).
+        value: f64,
+        /// The limit.
+        limit: f64,
+        /// Unit of value and limit.
+        unit: &'static str,
+        /// Time of the peak \[s\].
+        time: f64,
+        /// Why the plain command is sent (`"the model's fit is below the minimum"`).
+        because: &'static str,
+    },
+
     /// A computed command violates a velocity or acceleration limit.
     #[error("{}", self.message(Syntax::Library))]
     LimitExceeded {
@@ -387,13 +421,33 @@ pub enum Error {
         limit: f64,
     },
 
-    /// A stream (FIFO, device, pipe) delivered more than a recording may hold.
-    #[error("{}: more than {limit} bytes from a pipe or device; feedid reads a recording whole: save it to a file first, or use `feedid stream` for live data", path.display())]
+    /// A stream's window, hop, horizon and look-ahead (the command lead)
+    /// together need more samples than a stream may keep.
+    #[error("a stream keeps its window, hop, horizon and look-ahead: {window} + {hop} + {horizon} + {lookahead} samples, more than the {max} it may keep; shorten the command lead or the window")]
+    StreamBufferTooLarge {
+        /// Window \[samples\].
+        window: usize,
+        /// Hop \[samples\].
+        hop: usize,
+        /// Horizon \[samples\].
+        horizon: usize,
+        /// Look-ahead: the command lead or the horizon \[samples\].
+        lookahead: usize,
+        /// The most these may add up to \[samples\].
+        max: usize,
+    },
+
+    /// An input larger than it may be: a stream (FIFO, device, pipe) that
+    /// delivered more than a recording may hold, or a parameter, effects,
+    /// model or history file beyond its bound.
+    #[error("{}", input_too_large(path, *limit, *kind))]
     InputTooLarge {
         /// The input.
         path: PathBuf,
         /// The most bytes read \[bytes\].
         limit: u64,
+        /// What kind of input it is (the message's advice depends on it).
+        kind: InputKind,
     },
 
     /// The mean sampling interval of the time stamps is too short for a
@@ -625,7 +679,13 @@ fn display_in_file_text(path: &std::path::Path, location: &str, source: &str) ->
 
 /// A number for a one-line message: plain when short, else in `e` notation
 /// (`1e300`, not three hundred digits).
-pub(crate) fn short_number(v: f64) -> String {
+///
+/// ```
+/// use feedid::error::short_number;
+/// assert_eq!(short_number(95.0), "95");
+/// assert_eq!(short_number(1e-300), "1e-300");
+/// ```
+pub fn short_number(v: f64) -> String {
     let a = v.abs();
     if !v.is_finite() || a == 0.0 || (1e-4..1e15).contains(&a) {
         v.to_string()
@@ -719,5 +779,29 @@ mod tests {
         assert_eq!(e.to_string(), e.message(Syntax::Library));
         // no flag of the command line in the library's own text
         assert!(!e.to_string().contains("--"));
+    }
+}
+
+/// The kind of an input refused as too large ([`Error::InputTooLarge`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputKind {
+    /// A recording from a pipe, FIFO or device (read whole).
+    Stream,
+    /// A small text file: rig parameters, effects, a model, a learning history.
+    TextFile,
+}
+
+fn input_too_large(path: &std::path::Path, limit: u64, kind: InputKind) -> String {
+    match kind {
+        InputKind::Stream => format!(
+            "{}: more than {limit} bytes from a pipe or device; feedid reads a recording whole: \
+             save it to a file first, or use `feedid stream` for live data",
+            path.display()
+        ),
+        InputKind::TextFile => format!(
+            "{}: larger than {limit} bytes, the most feedid reads from a parameter, effects, \
+             model or history file; is it the right file?",
+            path.display()
+        ),
     }
 }

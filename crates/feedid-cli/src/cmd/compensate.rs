@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use feedid::compensate::{
     compensate_model, compensate_params, verify_on_rig, CompensateConfig, Compensation, Fallback,
     ModelErrorSource, ModelQuality, Smoothing, StartMode, Verification, ZeroHandling,
@@ -98,7 +98,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         (None, Some(path)) => {
             let params = load_model_params(Some(path), a.allow_unstable)?;
             let comp = compensate_params(&params, position_loop, desired, dt, &cfg)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+                .with_context(|| path.display().to_string())?;
             (
                 format!(
                     "{} [physical model, {} position loop]",
@@ -153,7 +153,7 @@ fn from_model(
             };
             let r = read_recording(check, &opts)?;
             ModelQuality::from_recording(&file.model, &r)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", check.display()))?
+                .with_context(|| check.display().to_string())?
         }
         // the fits on the model's own identification recording
         None => ModelQuality {
@@ -166,7 +166,7 @@ fn from_model(
         },
     };
     let comp = compensate_model(&file.model, desired, dt, cfg)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        .with_context(|| path.display().to_string())?;
     let how = match &file.identified_by {
         Some(p) => format!("{} {} (fit {:.2} %)", p.method, p.orders, p.fit_percent),
         None => "model".to_string(),
@@ -193,37 +193,15 @@ fn refuse_runaway(a: &CompensateArgs, rec: &feedid::Recording, comp: &Compensati
     Ok(())
 }
 
-/// The warnings on standard error: a fallback to the plain trajectory (and
-/// where it exceeds a limit), approximated zeros, pre-actuation.
+/// The warnings on standard error: a fallback to the plain trajectory
+/// (which meets the limits: the library refuses one that does not),
+/// approximated zeros, pre-actuation.
 fn warn(a: &CompensateArgs, comp: &Compensation, desired: &[f64]) {
     if let Some(f) = &comp.fallback {
         eprintln!(
             "warning: the plain desired trajectory is sent as the command: {f}; {}",
             fallback_hint(f, a, comp, desired)
         );
-        // the plain trajectory is sent as it is: say where it exceeds a limit
-        for (quantity, peak, at, limit, unit) in [
-            (
-                "velocity",
-                comp.peak_velocity,
-                comp.peak_velocity_time_s,
-                a.max_velocity,
-                "m/s",
-            ),
-            (
-                "acceleration",
-                comp.peak_acceleration,
-                comp.peak_acceleration_time_s,
-                a.max_acceleration,
-                "m/s²",
-            ),
-        ] {
-            if peak > limit * (1.0 + 1e-9) {
-                eprintln!(
-                    "warning: the command sent, the desired trajectory itself, peaks at {peak:.4} {unit} at t = {at:.4} s, above --max-{quantity} {limit} {unit}: the limit is the trajectory's to meet (slow or smooth it)"
-                );
-            }
-        }
     }
     if !comp.exact_inverse {
         eprintln!(

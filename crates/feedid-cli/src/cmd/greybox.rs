@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use feedid::drive::RigEffects;
 use feedid::error::Syntax;
 use feedid::greybox::{
@@ -119,7 +119,7 @@ fn from_model(
         ),
     };
     let fit = fit_coefficients(&num, &den, &st.start, &st.estimate, &st.cfg)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        .with_context(|| path.display().to_string())?;
     let _ = writeln!(
         text,
         "{}: N2…N0, D7…D0 of the identified model, {} coefficient ratios",
@@ -200,7 +200,7 @@ fn from_recording(
     let update = |done: u64, total: u64| bar.update(done, total);
     let fit = fit_greybox_with_progress(&data, &st.start, &st.estimate, &st.cfg, Some(&update));
     bar.finish();
-    let fit = fit.map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    let fit = fit.with_context(|| input.display().to_string())?;
     describe_recording(
         a,
         input,
@@ -548,7 +548,7 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
             &estimate,
             a.restarts,
         )
-        .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+        .with_context(|| input.display().to_string())?;
     // the controller output beside the position: the inverse-dynamics cross-check
     let idim = match &a.current {
         Some(name) => {
@@ -573,7 +573,7 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
                     rec.rate_hz(),
                     &feedid::drive::IdimConfig::default(),
                 )
-                .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?,
+                .with_context(|| input.display().to_string())?,
             )
         }
         None => None,
@@ -584,7 +584,7 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
             let v = fit
                 .structure
                 .validate_on(other.command(), other.position(), other.rate_hz())
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+                .with_context(|| path.display().to_string())?;
             Some((path, v))
         }
         None => None,

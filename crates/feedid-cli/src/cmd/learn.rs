@@ -76,7 +76,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         &cfg,
         history.as_ref(),
     )
-    .map_err(|e| anyhow::anyhow!("{}: {e}", measured_path.display()))?;
+    .with_context(|| measured_path.display().to_string())?;
 
     let how = match &file.identified_by {
         Some(p) => format!("{} {} (fit {:.2} %)", p.method, p.orders, p.fit_percent),

@@ -22,6 +22,8 @@ pub(crate) mod tune;
 pub(crate) mod zoo;
 
 use std::io::Write;
+
+use anyhow::Context;
 use std::path::{Path, PathBuf};
 
 use crate::args::{Cli, Command};
@@ -123,8 +125,7 @@ pub fn load_effects(path: &Path) -> anyhow::Result<feedid::drive::RigEffects> {
     let text = feedid::io::read_small_text(path)?;
     let fx: feedid::drive::RigEffects = toml::from_str(&text)
         .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " ")))?;
-    fx.validate()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    fx.validate().with_context(|| path.display().to_string())?;
     Ok(fx)
 }
 

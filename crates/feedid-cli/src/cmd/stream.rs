@@ -179,6 +179,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
     let mut header = false;
     let mut lines = Lines::default();
     let mut watch = HoldWatch::new(WATCH_SECONDS);
+    let mut probe = Plausibility::default();
     while let Output::Open = output {
         let Some(line) = reader.next_line()? else {
             break;
@@ -190,6 +191,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
         };
         match s.push(t, u, y) {
             Ok(arrival) => {
+                probe.push(t, u, y, &mut err);
                 report_interval(&mut err, &mut lines, no, arrival.interval);
                 if !header {
                     header = true;
@@ -239,6 +241,7 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
             }
         }
     }
+    probe.finish(&mut err);
     let st = s.stats();
     let _ = write!(
         err,
@@ -277,7 +280,74 @@ pub(super) fn run_on<R: BufRead, W: Write, E: Write>(
             lines.skipped
         );
     }
+    if st.samples == 0 && st.unused_positions > 0 {
+        // every position waited for a command that never came
+        bail!(
+            "no sample could be used: with --command-lead {} each position is paired with the \
+             command {} lines later, and the input has {} data lines; the command lead must be \
+             shorter than the input",
+            a.command_lead,
+            a.command_lead,
+            st.lines
+        );
+    }
     Ok(())
+}
+
+/// Samples from the stream's start that the plausibility checks of a
+/// recording (`feedid::plausibility`: a frozen position, a unit mismatch, a
+/// sign or offset, an implausible speed or lag) look at, as `identify` does
+/// on a file: bounded, so a stream of any length keeps at most this many.
+const PLAUSIBILITY_SAMPLES: usize = 20_000;
+
+/// The first [`PLAUSIBILITY_SAMPLES`] samples, checked once when they are
+/// all in or the stream ends, whichever comes first; the warnings go to
+/// standard error, as `identify`'s do.
+#[derive(Default)]
+struct Plausibility {
+    t: Vec<f64>,
+    u: Vec<f64>,
+    y: Vec<f64>,
+    done: bool,
+}
+
+impl Plausibility {
+    fn push<E: Write>(&mut self, t: f64, u: f64, y: f64, err: &mut E) {
+        if self.done {
+            return;
+        }
+        self.t.push(t);
+        self.u.push(u);
+        self.y.push(y);
+        if self.t.len() >= PLAUSIBILITY_SAMPLES {
+            self.finish(err);
+        }
+    }
+
+    fn finish<E: Write>(&mut self, err: &mut E) {
+        if self.done {
+            return;
+        }
+        self.done = true;
+        let n = self.t.len();
+        let (t, u, y) = (
+            std::mem::take(&mut self.t),
+            std::mem::take(&mut self.u),
+            std::mem::take(&mut self.y),
+        );
+        // samples a recording would refuse (a gap, a repeated time) leave
+        // the check to what `identify` says of the saved file
+        let Ok(rec) = feedid::Recording::new(t, u, y) else {
+            return;
+        };
+        for w in feedid::plausibility::check_recording(&rec) {
+            let _ = writeln!(
+                err,
+                "warning: stdin (its first {n} samples): {}",
+                w.phrased(Syntax::Cli)
+            );
+        }
+    }
 }
 
 /// The sample a line carries: `(line number, time, command, position)`;
@@ -430,7 +500,7 @@ fn summary(
         );
         o += &format!(
             "inside the {} % prediction interval: {} of the scored samples ({}); isolated outliers not fitted: {}\n",
-            interval_percent,
+            feedid::error::short_number(interval_percent),
             st.inside_interval,
             percent(st.inside_interval, st.scored.samples),
             st.outliers

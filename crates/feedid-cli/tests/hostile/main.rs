@@ -27,6 +27,7 @@
 mod args;
 #[path = "../common/mod.rs"]
 mod common;
+mod messages;
 mod outputs;
 mod params;
 mod verdicts;
@@ -1325,7 +1326,7 @@ fn arg_catalogue() -> Vec<ArgCase> {
         case(
             "stream: window 2^64-1",
             &["stream", "--window", MAX],
-            Fails(&["too large"]),
+            Fails(&["18446744073709551615", "more than the", "it may keep"]),
         ),
         case(
             "stream: rate -1",

@@ -697,3 +697,134 @@ fn a_failing_member_of_a_set_keeps_the_previous_set_whole() {
     assert_eq!(std::fs::read_to_string(&summary).unwrap(), "old summary");
     assert!(temporaries(tmp.path()).is_empty());
 }
+
+/// `feedid args` with standard output opened on `out` for appending (as
+/// the shell's `>> out`).
+fn run_appending(args: &[String], out: &Path) -> std::process::Output {
+    let file = std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(out)
+        .unwrap();
+    Command::new(env!("CARGO_BIN_EXE_feedid"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::from(file))
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn standard_output_under_another_name_is_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let inp = inputs(dir.path());
+    let good = inp.good.to_str().unwrap().to_string();
+    let base = ["identify", &good, "--method", "arx", "--window", "40"].map(String::from);
+    for alias in ["/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"] {
+        // appended after what the log holds, as `-` is (not written from offset 0)
+        let log = dir.path().join("log.txt");
+        std::fs::write(&log, "first line of the log\n").unwrap();
+        let mut a = base.to_vec();
+        a.extend(["-o".to_string(), alias.to_string()]);
+        let o = run_appending(&a, &log);
+        assert!(o.status.success(), "{alias}: {}", stderr(&o));
+        let text = std::fs::read_to_string(&log).unwrap();
+        assert!(
+            text.starts_with("first line of the log\ntime_s,"),
+            "{alias}: {text:.80}"
+        );
+        // with `-` for another output: the same file twice, refused
+        for (x, y) in [("-", alias), (alias, "-")] {
+            let mut a = base.to_vec();
+            a.extend(["-o", x, "--summary", y].map(String::from));
+            let o = run(&a, None);
+            assert_eq!(o.status.code(), Some(2), "{x} {y}: {}", stderr(&o));
+            assert!(
+                stderr(&o).contains("given for two outputs"),
+                "{}",
+                stderr(&o)
+            );
+            assert!(o.stdout.is_empty(), "{x} {y}: something was written");
+        }
+    }
+}
+
+#[test]
+fn help_and_version_that_cannot_be_written_fail() {
+    if !Path::new("/dev/full").exists() {
+        eprintln!("skipped: no /dev/full on this machine");
+        return;
+    }
+    for args in [
+        &["--help"][..],
+        &["--version"],
+        &["identify", "--help"],
+        &["help"],
+    ] {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_feedid"))
+            .args(args)
+            .stdout(Stdio::from(full))
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(
+            stderr(&o).contains("cannot write to standard output"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+    }
+}
+
+#[test]
+fn two_runs_writing_one_set_at_once_leave_one_whole_set() {
+    // two recordings of different lengths written to the same pair of
+    // outputs at once: whichever wins, its predictions and its summary
+    // are on disk together
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.csv");
+    let b = dir.path().join("b.csv");
+    std::fs::write(&a, csv(&rows(400, 0.0, 1e-3, 1.0))).unwrap();
+    std::fs::write(&b, csv(&rows(700, 0.0, 1e-3, 1.0))).unwrap();
+    let out = dir.path().join("out.csv");
+    let summary = dir.path().join("s.json");
+    let spawn = |rec: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_feedid"))
+            .args([
+                "identify",
+                rec.to_str().unwrap(),
+                "--method",
+                "arx",
+                "--window",
+                "40",
+            ])
+            .args([
+                "-o",
+                out.to_str().unwrap(),
+                "--summary",
+                summary.to_str().unwrap(),
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap()
+    };
+    for round in 0..30 {
+        let (mut x, mut y) = (spawn(&a), spawn(&b));
+        assert!(x.wait().unwrap().success() && y.wait().unwrap().success());
+        let rows = std::fs::read_to_string(&out).unwrap().lines().count() - 1;
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        assert_eq!(
+            s["samples"].as_u64(),
+            Some(rows as u64),
+            "round {round}: predictions of one run beside the summary of the other"
+        );
+        assert!(temporaries(dir.path()).is_empty());
+    }
+}

@@ -259,3 +259,51 @@ fn values_that_overflow_together_are_refused_by_every_command_alike() {
         );
     }
 }
+
+#[test]
+fn an_allowed_unstable_model_leaves_no_placeholder_number_in_any_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = |n: &str| tmp.path().join(n).display().to_string();
+    std::fs::write(p("rig.toml"), "[control]\nkv = 3000.0\n").unwrap();
+    let o = run(
+        &["simulate", "--scenario", "ramp", "-o", &p("ramp.csv")].map(String::from),
+        None,
+    );
+    assert!(o.status.success());
+    let o = run(
+        &[
+            "identify",
+            &p("ramp.csv"),
+            "--method",
+            "arx",
+            "--params",
+            &p("rig.toml"),
+            "--allow-unstable",
+            "-o",
+            &p("pred.csv"),
+            "--summary",
+            &p("s.json"),
+        ]
+        .map(String::from),
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("ran away from t ="), "{}", stderr(&o));
+    // every number in both files is of the recording's scale or a count
+    for f in ["pred.csv", "s.json"] {
+        let text = std::fs::read_to_string(p(f)).unwrap();
+        for tok in text.split(|c: char| ",:[]{}\n ".contains(c)) {
+            if let Ok(v) = tok.trim_matches('"').parse::<f64>() {
+                assert!(v.abs() < 1e9, "{f}: {v}");
+            }
+        }
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(p("s.json")).unwrap()).unwrap();
+    assert!(s.get("nominal_fit_percent").is_none() && s.get("sim_max_abs_error_m").is_none());
+    assert!(
+        s["warnings"].to_string().contains("ran away"),
+        "{}",
+        s["warnings"]
+    );
+}

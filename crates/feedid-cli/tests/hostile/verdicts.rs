@@ -249,3 +249,47 @@ fn restarts_beyond_the_bound_are_refused_at_once_for_every_structure() {
         assert!(stdout(&o).is_empty(), "{extra:?}");
     }
 }
+
+#[test]
+fn a_model_that_explains_nothing_of_a_dead_encoder_determines_nothing() {
+    // the command moves, the position stays at 0: whatever the standard
+    // errors say, no parameter is determined by such data
+    let dir = tempfile::tempdir().unwrap();
+    let rec = simulate(dir.path(), "prbs.csv", &["--scenario", "prbs"]);
+    let text = std::fs::read_to_string(&rec).unwrap();
+    let mut dead = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        if i == 0 {
+            dead += "time_s,command_m,position_m\n";
+        } else {
+            dead += &format!("{},{},0\n", f[0], f[1]);
+        }
+    }
+    let path = dir.path().join("dead.csv");
+    std::fs::write(&path, dead).unwrap();
+    let summary = dir.path().join("g.json");
+    let o = run(
+        &[
+            "greybox",
+            path.to_str().unwrap(),
+            "--estimate",
+            "Kv",
+            "--restarts",
+            "0",
+            "--summary",
+            summary.to_str().unwrap(),
+        ]
+        .map(String::from),
+        None,
+    );
+    if o.status.success() {
+        let v = json(&summary);
+        for e in v["estimates"].as_array().unwrap() {
+            assert_ne!(e["verdict"], "identifiable", "{e}");
+        }
+        assert!(stdout(&o).contains("not identifiable"), "{}", stdout(&o));
+    } else {
+        assert!(stderr(&o).contains("not identifiable"), "{}", stderr(&o));
+    }
+}

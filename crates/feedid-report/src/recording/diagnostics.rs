@@ -321,11 +321,12 @@ impl RecordingAnalysis {
         Table {
             id: format!("{p}-intervals"),
             caption: format!(
-                "The {interval} % prediction intervals: the share of the predicted samples inside \
+                "The {} % prediction intervals: the share of the predicted samples inside \
                  their interval, in all and by the command's regime at the sample (calibrated per \
                  step ahead and per regime from the method's own recent errors), their median \
                  width, and the windows whose prediction left the motion the axis has shown and \
-                 was cut back (their interval spans the hold).{left_out}"
+                 was cut back (their interval spans the hold).{left_out}",
+                feedid::error::short_number(interval)
             ),
             header,
             rows,

@@ -530,7 +530,7 @@ fn off_frame(
             s.x.iter()
                 .zip(&s.y)
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
-                .filter(|(x, _)| chart.x_range.map_or(true, |(a, b)| **x >= a && **x <= b))
+                .filter(|(x, _)| chart.x_range.is_none_or(|(a, b)| **x >= a && **x <= b))
                 .map(|(&x, &y)| (x, y, (y - hi).max(lo - y)))
                 .filter(|&(_, _, beyond)| beyond > 0.0)
                 .max_by(|a, b| a.2.total_cmp(&b.2));

@@ -29,8 +29,8 @@
 //! ```text
 //! e_model    = (1 − fit_e/100)·rms(e_plain)                  (error fit known: --check)
 //!            = (1 − fit_y/100)·rms(y_d − mean(y_d))          (else: the position fit)
-//! e_expected = rms(e_comp) + e_model
-//! benefit    = rms(e_plain) / e_expected
+//! e_expected = max(rms(e_comp) + e_model, rms(e_plain)/1000)
+//! benefit    = rms(e_plain) / e_expected                     (≤ 1000, MAX_BENEFIT)
 //! ```
 //!
 //! The second form scales the model's free-run error on its identification
@@ -50,6 +50,11 @@ use crate::error::{Error, Result};
 use crate::ident::LinearModel;
 use crate::recording::Recording;
 use crate::stats::{error_fit_percent, noise_level_of_run};
+
+/// The largest expected benefit stated (plain rms over expected rms): the
+/// expected compensated error is never below `1/MAX_BENEFIT` of the plain
+/// one.
+pub const MAX_BENEFIT: f64 = 1000.0;
 
 /// How well a model reproduces the axis (free run over a recording).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -231,7 +236,11 @@ impl Benefit {
             (None, Some(f)) => (share(f) * motion_rms, ModelErrorSource::PositionFit),
             (None, None) => (0.0, ModelErrorSource::Unknown),
         };
-        let expected = compensated_rms + model_error;
+        // no model is trusted to cut the error more than MAX_BENEFIT-fold:
+        // beyond that the axis's noise, its encoder and the model's own
+        // rounding decide, and a model of unknown error would otherwise
+        // promise a billion-fold gain
+        let expected = (compensated_rms + model_error).max(plain_rms / MAX_BENEFIT);
         let expected_benefit = if expected > 0.0 {
             plain_rms / expected
         } else if plain_rms > 0.0 {
@@ -309,6 +318,18 @@ impl std::fmt::Display for Fallback {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn no_benefit_beyond_the_bound_is_promised_whatever_the_model_claims() {
+        // a model of unknown error predicting a perfect compensation
+        let b = Benefit::new(70e-6, 3e-14, 1e-3, &ModelQuality::default());
+        assert_eq!(b.model_error_from, ModelErrorSource::Unknown);
+        assert!((b.expected_benefit - MAX_BENEFIT).abs() < 1e-9, "{b:?}");
+        assert!((b.expected_compensated_rms_m - 70e-9).abs() < 1e-20);
+        // below the bound nothing changes
+        let b = Benefit::new(70e-6, 1e-6, 1e-3, &ModelQuality::default());
+        assert!((b.expected_benefit - 70.0).abs() < 1e-9);
+    }
 
     #[test]
     fn a_check_recording_must_have_the_discrete_models_sample_time() {

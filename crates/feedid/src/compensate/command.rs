@@ -195,6 +195,11 @@ impl Default for CompensateConfig {
     }
 }
 
+/// The longest smoothing σ a compensation uses \[samples\] (0.2 s at
+/// 5 kHz, 10 s at 100 Hz): the smoothing keeps a kernel for every ⅛ sample
+/// of σ up to the largest, about 32·σ² numbers (≤ 260 MB here).
+pub const MAX_SMOOTHING_SAMPLES: usize = 1000;
+
 impl CompensateConfig {
     /// Check the settings.
     pub fn validate(&self) -> Result<()> {
@@ -721,7 +726,7 @@ fn search_limits(p: &Problem<'_>, cfg: &CompensateConfig) -> Result<Search> {
         let pk = p.peaks(&c.sent);
         let score =
             |q: &Peaks| (q.velocity / cfg.max_velocity).max(q.acceleration / cfg.max_acceleration);
-        let better = best.as_ref().map_or(true, |b| score(&pk) < score(b));
+        let better = best.as_ref().is_none_or(|b| score(&pk) < score(b));
         if better {
             best = Some(pk);
         }
@@ -820,10 +825,22 @@ fn compensate_with(
     let g = model_dc_gain * out_scale;
     let y0 = desired[0];
     let e: Vec<f64> = desired.iter().map(|v| v - y0).collect();
-    let sigma_max = match cfg.smoothing {
-        Smoothing::Auto => cfg.max_smoothing / dt,
-        Smoothing::Fixed(s) => s / dt,
+    let (what, seconds) = match cfg.smoothing {
+        Smoothing::Auto => ("max smoothing", cfg.max_smoothing),
+        Smoothing::Fixed(s) => ("smoothing", s),
     };
+    let sigma_max = seconds / dt;
+    if sigma_max > MAX_SMOOTHING_SAMPLES as f64 {
+        // the kernels of every σ up to the largest are kept: memory grows
+        // with σ², and a σ this long flattens any trajectory anyway
+        return Err(Error::SmoothingTooLong {
+            what,
+            seconds,
+            samples: sigma_max,
+            max_samples: MAX_SMOOTHING_SAMPLES,
+            max_seconds: MAX_SMOOTHING_SAMPLES as f64 * dt,
+        });
+    }
     let h = (4.0 * sigma_max).ceil() as usize + 1;
     let margin = inverse.settle() + inverse.delay() + 2 * h + 8;
     let pre = match cfg.start {
@@ -968,6 +985,42 @@ fn compensate_with(
         0.0
     };
     let peaks = problem.peaks(&sent_rel);
+    if let Some(fb) = fallback {
+        // the plain command is sent: it must meet the limits too
+        let over = |v: f64, lim: f64| v > lim * (1.0 + 1e-9);
+        let because = match fb {
+            Fallback::PoorFit { .. } => "the model's fit is below the minimum",
+            Fallback::SmallBenefit { .. } => "the expected benefit is below the minimum",
+            Fallback::Limits { .. } => "the compensated command cannot meet the limits",
+        };
+        for (quantity, value, at, limit, unit) in [
+            (
+                "velocity",
+                peaks.velocity,
+                peaks.velocity_at,
+                cfg.max_velocity,
+                "m/s",
+            ),
+            (
+                "acceleration",
+                peaks.acceleration,
+                peaks.acceleration_at,
+                cfg.max_acceleration,
+                "m/s²",
+            ),
+        ] {
+            if over(value, limit) {
+                return Err(Error::PlainOverLimit {
+                    quantity,
+                    value,
+                    limit,
+                    unit,
+                    time: at as f64 * dt,
+                    because,
+                });
+            }
+        }
+    }
     let u_rest = y0 / g;
     let command: Vec<f64> = sent_rel[window].iter().map(|v| u_rest + v).collect();
     let predicted: Vec<f64> = predicted_rel.iter().map(|v| y0 + out_scale * v).collect();

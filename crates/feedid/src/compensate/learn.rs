@@ -614,7 +614,7 @@ pub fn learn(
     let better = history
         .best
         .as_ref()
-        .map_or(true, |b| stats.rms < b.measured_rms_m);
+        .is_none_or(|b| stats.rms < b.measured_rms_m);
     let this = BestRun {
         run,
         measured_rms_m: stats.rms,

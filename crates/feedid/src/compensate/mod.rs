@@ -34,10 +34,10 @@ mod smoothing;
 mod step;
 mod verify;
 
-pub use benefit::{Benefit, Fallback, ModelErrorSource, ModelQuality};
+pub use benefit::{Benefit, Fallback, ModelErrorSource, ModelQuality, MAX_BENEFIT};
 pub use command::{
     compensate, compensate_model, compensate_params, CompensateConfig, Compensation, Smoothing,
-    StartMode,
+    StartMode, MAX_SMOOTHING_SAMPLES,
 };
 pub use cosim::{co_simulate, CoSimulation, PassError, SteppedAxis};
 pub use history::{

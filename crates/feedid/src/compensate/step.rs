@@ -106,7 +106,7 @@ pub(super) fn increment(
                 if held <= HOLD_SHARE {
                     return Ok(Some(step));
                 }
-                if best.as_ref().map_or(true, |b| held < b.held_share) {
+                if best.as_ref().is_none_or(|b| held < b.held_share) {
                     best = Some(step);
                 }
             }

@@ -74,7 +74,7 @@ pub fn check_model(params: &RigParams) -> Result<ModelCheck> {
             reason: "non-finite closed-loop coefficient (the values overflow together)",
         });
     }
-    if c.den.first().map_or(true, |d| *d == 0.0) {
+    if c.den.first().is_none_or(|d| *d == 0.0) {
         return Err(Error::InvalidModel {
             reason: "zero leading coefficient of the closed loop",
         });

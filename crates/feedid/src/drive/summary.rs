@@ -184,11 +184,22 @@ impl fmt::Display for ModelSummary {
             )?;
         } else {
             let n = self.poles.iter().filter(|p| p[0] >= 0.0).count();
-            writeln!(
-                f,
-                "Stability                 UNSTABLE: {n} poles with a positive real part; the axis \
-                 would run away, so the bandwidth and following error do not apply"
-            )?;
+            if n > 0 {
+                writeln!(
+                    f,
+                    "Stability                 UNSTABLE: {n} poles with a non-negative real part; \
+                     the axis would run away, so the bandwidth and following error do not apply"
+                )?;
+            } else {
+                // no pole in the right half plane, yet not stable: the poles
+                // could not be computed (gains or masses of absurd sizes)
+                writeln!(
+                    f,
+                    "Stability                 NOT STABLE: the closed loop's poles cannot be \
+                     computed from these parameters (a gain or mass of an absurd size?), so the \
+                     bandwidth and following error do not apply"
+                )?;
+            }
         }
         match (self.stable, self.bandwidth_hz) {
             (false, _) => writeln!(f, "Bandwidth (−3 dB)         none (unstable)")?,
@@ -198,15 +209,31 @@ impl fmt::Display for ModelSummary {
         writeln!(f, "DC gain                   {:.9}", self.dc_gain)?;
         write!(
             f,
-            "Following error           {:.4} ms × velocity ({:.1} µm at 50 mm/s){}",
-            1e3 * self.following_error_s,
-            0.05 * self.following_error_s * 1e6,
-            if self.stable {
-                ""
-            } else {
+            "Following error           {} ms × velocity ({} µm at 50 mm/s){}",
+            fixed_or_e(1e3 * self.following_error_s, 4),
+            fixed_or_e(0.05 * self.following_error_s * 1e6, 1),
+            if !self.stable {
                 " — not reached: unstable"
+            } else if self.following_error_s > SLOW_FOLLOWING_S {
+                " — the axis barely follows its command: a gain far too small?"
+            } else {
+                ""
             }
         )
+    }
+}
+
+/// A following error beyond this many seconds per m/s (the axis lags a
+/// 50 mm/s move by more than 50 mm) marks a loop too slow to be meant.
+const SLOW_FOLLOWING_S: f64 = 1.0;
+
+/// `v` with `decimals` decimals when its magnitude is within [1e-3, 1e6),
+/// else in e-notation (`1e300`, not three hundred digits).
+fn fixed_or_e(v: f64, decimals: usize) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-3..1e6).contains(&v.abs()) {
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.3e}")
     }
 }
 

@@ -45,7 +45,8 @@
 use serde::Serialize;
 
 use super::identifiability::{
-    analyse, Identifiability, IdentifiabilityThresholds, NullDirection, Verdict,
+    analyse, restart_verdicts, verdict_at_fit, Identifiability, IdentifiabilityThresholds,
+    NullDirection, Verdict, RESTART_TOLERANCE_SE,
 };
 use super::model::{Dynamics, LoopModel, PhysicalModel};
 use super::names::PhysicalParameter;
@@ -103,10 +104,6 @@ pub const RESTART_STEP: f64 = 0.2;
 /// Residual rms, relative to the signal's, below which a fit counts as
 /// exact and its residuals are not tested for structure (1e-5).
 pub const EXACT_FIT: f64 = 1e-5;
-
-/// How far (in standard errors) a restarted fit may end from the estimate
-/// before the parameter is not identifiable.
-pub const RESTART_TOLERANCE_SE: f64 = 3.0;
 
 /// One estimated parameter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -631,8 +628,11 @@ pub fn fit_greybox_with_progress(
     let (structure, missing) = residual_checks(&prob, &r, &jac, start, &scales, rms_y, rms_i)?;
     let structured = structure.iter().any(|s| s.structured) || missing.is_some_and(|f| f.likely);
     let spread = restart_verdicts(&mut analysis, &restart_ends, &theta, structured);
-    let (ests, params, effects, fit_percent) =
+    let (mut ests, params, effects, fit_percent) =
         estimates_at(&prob, start, cfg, &theta, &analysis, &spread);
+    for e in &mut ests {
+        e.verdict = verdict_at_fit(e.verdict, fit_percent);
+    }
     Ok(GreyboxFit {
         source: "recording",
         estimates: ests,
@@ -916,41 +916,6 @@ fn residual_checks(
         None
     };
     Ok((structure, missing))
-}
-
-/// The spread of the restarts per parameter in log-parameters (`None`
-/// without restarts); a parameter that moved beyond its standard error is
-/// not identifiable, and with structured residuals the others unreliable.
-fn restart_verdicts(
-    analysis: &mut Identifiability,
-    ends: &[Vec<f64>],
-    theta: &[f64],
-    structured: bool,
-) -> Vec<Option<f64>> {
-    let spread: Vec<Option<f64>> = (0..theta.len())
-        .map(|j| {
-            (!ends.is_empty()).then(|| {
-                ends.iter()
-                    .map(|t| (t[j] - theta[j]).abs())
-                    .fold(0.0_f64, f64::max)
-                    .exp_m1()
-            })
-        })
-        .collect();
-    for (j, v) in analysis.verdicts.iter_mut().enumerate() {
-        let moved = match (spread[j], analysis.relative_std_errors[j]) {
-            // beyond the standard error, and beyond what the LM tolerance leaves
-            (Some(s), Some(se)) => s > RESTART_TOLERANCE_SE * se && s > 1e-4,
-            (Some(s), None) => s > 1e-4,
-            _ => false,
-        };
-        if moved {
-            *v = Verdict::NotIdentifiable;
-        } else if structured && *v != Verdict::NotIdentifiable {
-            *v = Verdict::Unreliable;
-        }
-    }
-    spread
 }
 
 /// Lengths, finiteness, sample time.

@@ -283,6 +283,57 @@ pub fn analyse(
     })
 }
 
+/// How far (in standard errors) a restarted fit may end from the estimate
+/// before the parameter is not identifiable.
+pub const RESTART_TOLERANCE_SE: f64 = 3.0;
+
+/// The spread of the restarts per parameter in log-parameters (`None`
+/// without restarts); a parameter that moved beyond its standard error is
+/// not identifiable, and with structured residuals the others unreliable.
+pub(crate) fn restart_verdicts(
+    analysis: &mut Identifiability,
+    ends: &[Vec<f64>],
+    theta: &[f64],
+    structured: bool,
+) -> Vec<Option<f64>> {
+    let spread: Vec<Option<f64>> = (0..theta.len())
+        .map(|j| {
+            (!ends.is_empty()).then(|| {
+                ends.iter()
+                    .map(|t| (t[j] - theta[j]).abs())
+                    .fold(0.0_f64, f64::max)
+                    .exp_m1()
+            })
+        })
+        .collect();
+    for (j, v) in analysis.verdicts.iter_mut().enumerate() {
+        let moved = match (spread[j], analysis.relative_std_errors[j]) {
+            // beyond the standard error, and beyond what the LM tolerance leaves
+            (Some(s), Some(se)) => s > RESTART_TOLERANCE_SE * se && s > 1e-4,
+            (Some(s), None) => s > 1e-4,
+            _ => false,
+        };
+        if moved {
+            *v = Verdict::NotIdentifiable;
+        } else if structured && *v != Verdict::NotIdentifiable {
+            *v = Verdict::Unreliable;
+        }
+    }
+    spread
+}
+
+/// A verdict of a fit whose simulated position fits the measured one by
+/// `fit_percent`: a model that explains none of it (worse than its mean: a
+/// dead encoder, the wrong column) determines nothing, however small the
+/// standard errors of its parameters look.
+pub(crate) fn verdict_at_fit(verdict: Verdict, fit_percent: f64) -> Verdict {
+    if fit_percent.is_nan() || fit_percent <= 0.0 {
+        Verdict::NotIdentifiable
+    } else {
+        verdict
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

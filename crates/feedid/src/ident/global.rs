@@ -305,8 +305,45 @@ pub fn fit_global_model<S: AsRef<[f64]>>(
 
 /// [`fit_global_model`] without the cap.
 fn fit_kind<S: AsRef<[f64]>>(rec: &Recording<S>, kind: &GlobalModelKind) -> Result<ModelFile> {
-    let grid = Grid::of(rec)?;
-    fit_data(&Data::of(rec, grid.as_ref()), kind)
+    let d = Deviations::of(rec)?;
+    fit_data(&d.data(rec), kind)
+}
+
+/// Command and position in deviations from the first command sample (and
+/// their grid through any gaps): a global model is fitted and simulated
+/// from rest there, so an offset of the recording (machine coordinates far
+/// from 0) changes nothing — as for the sliding methods.
+struct Deviations {
+    command: Vec<f64>,
+    position: Vec<f64>,
+    grid: Option<Grid>,
+}
+
+impl Deviations {
+    fn of<S: AsRef<[f64]>>(rec: &Recording<S>) -> Result<Self> {
+        let r = rec.command().first().copied().unwrap_or(0.0);
+        let shift = |v: &[f64]| v.iter().map(|x| x - r).collect::<Vec<f64>>();
+        let grid = Grid::of(rec)?.map(|g| Grid {
+            command: shift(&g.command),
+            position: shift(&g.position),
+            measured: g.measured,
+        });
+        Ok(Self {
+            command: shift(rec.command()),
+            position: shift(rec.position()),
+            grid,
+        })
+    }
+
+    fn data<'a, S: AsRef<[f64]>>(&'a self, rec: &Recording<S>) -> Data<'a> {
+        Data {
+            command: &self.command,
+            position: &self.position,
+            dt: rec.dt(),
+            segments: rec.segments(),
+            grid: self.grid.as_ref(),
+        }
+    }
 }
 
 /// The free-run simulation error of `model` over the recording: simulated
@@ -329,8 +366,8 @@ pub fn simulation_error<S: AsRef<[f64]>>(
     model: &LinearModel,
     rec: &Recording<S>,
 ) -> Result<ErrorStats> {
-    let grid = Grid::of(rec)?;
-    simulated(model, &Data::of(rec, grid.as_ref()))
+    let d = Deviations::of(rec)?;
+    simulated(model, &d.data(rec))
 }
 
 /// The free-run simulation of `model` on the data's command (through the
@@ -399,19 +436,6 @@ impl Grid {
             position: rec.fill_gaps(rec.position())?,
             measured: rec.grid_indices(),
         }))
-    }
-}
-
-impl<'a> Data<'a> {
-    /// The recording's samples, with its `grid` ([`Grid::of`]).
-    fn of<S: AsRef<[f64]>>(rec: &'a Recording<S>, grid: Option<&'a Grid>) -> Self {
-        Data {
-            command: rec.command(),
-            position: rec.position(),
-            dt: rec.dt(),
-            segments: rec.segments(),
-            grid,
-        }
     }
 }
 
@@ -538,6 +562,38 @@ mod tests {
         assert_eq!(p.orders, "8,8,1");
         assert!(p.fit_percent > 99.9, "{}", p.fit_percent);
         assert_eq!(f.model.dt(), Some(2e-4));
+    }
+
+    #[test]
+    fn an_offset_of_the_recording_changes_no_global_fit() {
+        // machine coordinates: the same motion 1000 m (and 1e6 m) from the origin
+        let u = Scenario::Ramp.command(5000.0, 0.4, 1).unwrap();
+        let y = simulate_nominal(&RigParams::default(), &u, 2e-4).unwrap();
+        let fit = |off: f64| {
+            let rec = Recording::from_rate(
+                5000.0,
+                u.iter().map(|v| v + off).collect(),
+                y.iter().map(|v| v + off).collect(),
+            )
+            .unwrap();
+            let mut out = Vec::new();
+            for kind in [
+                GlobalModelKind::default_for("arx").unwrap(),
+                GlobalModelKind::Oe { poles: 3, zeros: 1 },
+            ] {
+                let f = fit_global_model(&rec, &kind).unwrap();
+                out.push(f.identified_by.unwrap().fit_percent);
+                out.push(simulation_error(&f.model, &rec).unwrap().fit_percent);
+            }
+            out
+        };
+        let base = fit(0.0);
+        assert!(base[0] > 99.0, "{base:?}");
+        for off in [1000.0, 1e6] {
+            for (a, b) in base.iter().zip(fit(off)) {
+                assert!((a - b).abs() < 0.05, "offset {off}: {a} vs {b}");
+            }
+        }
     }
 
     #[test]

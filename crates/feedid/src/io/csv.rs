@@ -172,6 +172,7 @@ fn parse_text<R: BufRead>(
                 (!used && !opts.signals_only).then(Vec::new)
             })
             .collect(),
+        dropped: Vec::new(),
         row_lines: RowLines::default(),
     };
     for line in data_head {
@@ -187,6 +188,7 @@ fn parse_text<R: BufRead>(
         command,
         position,
         extras,
+        dropped,
         row_lines,
         ..
     } = rows;
@@ -239,6 +241,14 @@ fn parse_text<R: BufRead>(
             rec = rec.with_channel(&name, v)?;
         }
     }
+    // an extra column left out says so (`info` lists it among the warnings)
+    for (c, line, cell) in dropped {
+        rec = rec.with_note(format!(
+            "column {} (`{}`) is not kept as a channel: line {line} holds `{cell}`, not a finite number",
+            c + 1,
+            name_of(c)
+        ));
+    }
     Ok(rec)
 }
 
@@ -251,6 +261,9 @@ struct Rows<'p, 'l> {
     command: Vec<f64>,
     position: Vec<f64>,
     extras: Vec<Option<Vec<f64>>>,
+    /// Extra columns left out: `(column, line, the cell)` of the first
+    /// cell that is not a finite number.
+    dropped: Vec<(usize, usize, String)>,
     row_lines: RowLines,
 }
 
@@ -321,7 +334,16 @@ impl Rows<'_, '_> {
                 if let Some(v) = slot {
                     match fields.get(c).and_then(|s| parse_number(s)) {
                         Some(x) if crate::recording::is_usable(x) => v.push(x),
-                        _ => *slot = None,
+                        _ => {
+                            let cell: String = fields
+                                .get(c)
+                                .map_or("", |s| s.trim())
+                                .chars()
+                                .take(40)
+                                .collect();
+                            self.dropped.push((c, line.no, cell));
+                            *slot = None;
+                        }
                     }
                 }
             }
@@ -339,6 +361,22 @@ mod tests {
 
     fn read(text: &str) -> Result<Recording> {
         read_csv_from_str(text, Path::new("t.csv"), &ReadOptions::default())
+    }
+
+    #[test]
+    fn an_extra_column_left_out_says_where_and_why() {
+        let r = read(
+            "time_s,command_m,position_m,extra,ok\n0,0,0,1,1\n0.001,0,0,nan,2\n0.002,0,0,3,3\n",
+        )
+        .unwrap();
+        let names: Vec<&str> = r.extra().iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["ok"]);
+        assert_eq!(r.notes().len(), 1, "{:?}", r.notes());
+        let n = &r.notes()[0];
+        assert!(
+            n.contains("column 4 (`extra`)") && n.contains("line 3") && n.contains("`nan`"),
+            "{n}"
+        );
     }
 
     fn read_with(text: &str, opts: ReadOptions) -> Result<Recording> {

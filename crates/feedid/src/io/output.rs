@@ -11,7 +11,10 @@
 //! - **a stream** — `-` (standard output), a FIFO, a character device
 //!   (`/dev/null`, `/dev/full`, a terminal) or an open descriptor
 //!   (`/dev/stdout`, `/dev/fd/N`, `/proc/self/fd/N`, e.g. `>(gzip > x.gz)`) —
-//!   is opened and written directly; it is never replaced, and what was sent
+//!   is opened and written directly (a descriptor path that is the
+//!   process's own standard output is written through its descriptor, as
+//!   `-`: appended where the shell appends, and the same output as `-`);
+//!   it is never replaced, and what was sent
 //!   into it cannot be taken back. A reader that closes it early (`| head`)
 //!   ends that output quietly.
 //! - a directory, a block device or a socket is refused.
@@ -22,7 +25,10 @@
 //! succeeded are the temporary files renamed, in the order they were added
 //! (commands add their summary last: a new summary on disk means every file
 //! of its set is new too). On any error every temporary file is removed and
-//! nothing is renamed. Renames of one set happen under a process-wide lock
+//! nothing is renamed. Renames of one set happen under an advisory lock of
+//! each target directory (so two processes writing the same set at once
+//! leave one whole set, never one's file beside the other's summary) and
+//! under a process-wide lock
 //! that [`abandon_pending_outputs`] (the binary's SIGINT/SIGTERM/SIGHUP
 //! handler) also takes: a signal removes the temporary files and ends the
 //! process either before the first rename or after the last one.
@@ -83,6 +89,26 @@ fn is_descriptor_path(path: &Path) -> bool {
     )
 }
 
+/// Whether `path` is the file this process's standard output is open on
+/// (the same device and inode; the same pipe or terminal).
+#[cfg(unix)]
+fn is_stdout(path: &Path) -> bool {
+    use std::os::fd::AsFd;
+    use std::os::unix::fs::MetadataExt;
+    let Ok(fd) = std::io::stdout().as_fd().try_clone_to_owned() else {
+        return false;
+    };
+    match (File::from(fd).metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn is_stdout(_path: &Path) -> bool {
+    false
+}
+
 /// Decide where an output path goes (see the module doc). Errors:
 /// [`Error::Io`] for a directory, a block device, a socket, a link loop or
 /// an unreadable path.
@@ -103,7 +129,15 @@ pub fn destination(path: &Path) -> Result<Destination> {
     let mut p = path.to_path_buf();
     for _ in 0..=MAX_LINK_HOPS {
         if is_descriptor_path(&p) {
-            return Ok(stream());
+            // the process's own standard output under another name
+            // (`/dev/stdout`, `/dev/fd/1`, `/proc/self/fd/1`) is written
+            // through its descriptor, as `-` is: reopening it would start
+            // at offset 0 of a file the shell opened for appending
+            return Ok(if is_stdout(&p) {
+                Destination::Stdout
+            } else {
+                stream()
+            });
         }
         let meta = match std::fs::symlink_metadata(&p) {
             Ok(m) => m,
@@ -354,6 +388,9 @@ impl<'a> OutputSet<'a> {
                 return Err(output_error(&item.path, e));
             }
         }
+        // another process committing into the same directories waits here:
+        // two runs writing one set at once leave one run's whole set
+        let _locks = lock_directories(&temps);
         let mut g = pending();
         let mut dirs: Vec<PathBuf> = Vec::new();
         for (i, (tmp, target)) in temps.iter().enumerate() {
@@ -387,6 +424,33 @@ impl<'a> OutputSet<'a> {
         }
         Ok(())
     }
+}
+
+/// Exclusive advisory locks (`flock`) on the directories of `temps`'
+/// targets, taken in one order (canonical paths, sorted) by every process
+/// so that none waits on another in a cycle; released when dropped. Best
+/// effort: a directory that cannot be opened or locked (a file system
+/// without locks) is renamed into unlocked, as before.
+fn lock_directories(temps: &[(PathBuf, PathBuf)]) -> Vec<File> {
+    let mut dirs: Vec<PathBuf> = temps
+        .iter()
+        .map(|(_, target)| {
+            let d = target
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or_else(|| Path::new("."));
+            std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf())
+        })
+        .collect();
+    dirs.sort();
+    dirs.dedup();
+    dirs.into_iter()
+        .filter_map(|d| {
+            let f = File::open(&d).ok()?;
+            f.lock().ok()?;
+            Some(f)
+        })
+        .collect()
 }
 
 /// Write `body` into a new temporary file beside `target`, flush and fsync it.

@@ -19,7 +19,7 @@ use std::fs::File;
 use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, InputKind, Result};
 
 /// Longest line of a text file \[bytes\] (1 MiB).
 pub const MAX_LINE_BYTES: usize = 1 << 20;
@@ -73,6 +73,7 @@ pub(crate) fn read_to_end_bounded<R: Read>(
                 return Err(Error::InputTooLarge {
                     path: path.to_path_buf(),
                     limit,
+                    kind: InputKind::Stream,
                 });
             }
         }
@@ -96,7 +97,14 @@ pub fn read_small_text(path: &Path) -> Result<String> {
 /// learning history, which holds a command and an error per sample.
 pub fn read_text_up_to(path: &Path, limit: u64) -> Result<String> {
     let (file, _) = open_input(path)?;
-    let bytes = read_to_end_bounded(file, Some(limit), path)?;
+    let bytes = read_to_end_bounded(file, Some(limit), path).map_err(|e| match e {
+        Error::InputTooLarge { path, limit, .. } => Error::InputTooLarge {
+            path,
+            limit,
+            kind: InputKind::TextFile,
+        },
+        e => e,
+    })?;
     if let Some(i) = bytes.iter().position(|&b| b == 0) {
         return Err(Error::Malformed {
             path: path.to_path_buf(),
@@ -161,6 +169,7 @@ impl<R: BufRead> LineReader<R> {
             Some(limit) if self.total > limit => Err(Error::InputTooLarge {
                 path: self.path.clone(),
                 limit,
+                kind: InputKind::Stream,
             }),
             _ => Ok(()),
         }

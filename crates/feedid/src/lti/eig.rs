@@ -150,7 +150,7 @@ fn hqr(a: &mut [f64], n: usize, wr: &mut [f64], wi: &mut [f64]) -> Result<()> {
                     iterations: total_its,
                 });
             }
-            if its > 0 && its % 10 == 0 {
+            if its > 0 && its.is_multiple_of(10) {
                 // Exceptional shift.
                 t += x;
                 for i in 1..=nn {

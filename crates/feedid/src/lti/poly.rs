@@ -107,7 +107,7 @@ pub fn poly_from_roots(roots: &[Complex<f64>]) -> Vec<f64> {
                 continue;
             }
             let dist = (rj - target).norm();
-            if best.map_or(true, |(_, d)| dist < d) {
+            if best.is_none_or(|(_, d)| dist < d) {
                 best = Some((j, dist));
             }
         }

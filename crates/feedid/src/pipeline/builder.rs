@@ -2,7 +2,7 @@
 
 use crate::drive::{simulate_nominal_recording, RigParams};
 use crate::error::{Error, Result};
-use crate::ident::engine::{run_with, Progress};
+use crate::ident::engine::{range, run_with, Progress};
 use crate::ident::{
     fit_global_model, prediction_residuals, select_order, EngineConfig, GlobalModelKind,
     GuardConfig, Method, ModelFile, OrderSearch, PredictionMode, Signals, SlidingResult, Span,
@@ -226,7 +226,10 @@ impl<'a> Pipeline<'a> {
         let mut warnings = setup_warnings(&method, recording, &signals, &config);
         let sliding = self.slide(&method, &signals, &config, &mut warnings)?;
         self.sliding_warnings(recording, &sliding, &mut warnings);
-        let (simulated, simulation_stats) = self.simulate(recording, &sliding)?;
+        let (simulated, simulation_stats, diverged) = self.simulate(recording, &sliding)?;
+        if let Some(from_s) = diverged {
+            warnings.push(Warning::NominalDiverged { from_s });
+        }
         let residuals = self.residual_lags.and_then(|lags| {
             prediction_residuals(
                 &sliding,
@@ -256,6 +259,16 @@ impl<'a> Pipeline<'a> {
         })
     }
 }
+
+/// The nominal simulation, its error figures, and the time from which it
+/// ran away (see [`DIVERGED_SPAN`]).
+type NominalRun = (Option<Vec<f64>>, Option<ErrorStats>, Option<f64>);
+
+/// How far the nominal simulation may leave the measured position, in
+/// multiples of the motion the recording spans (the larger of the
+/// position's and the command's range), before it counts as run away
+/// ([`Warning::NominalDiverged`]).
+pub const DIVERGED_SPAN: f64 = 1e3;
 
 /// The recording's plausibility warnings and the paper method's warnings
 /// about its coefficients, known before the run.
@@ -404,7 +417,7 @@ impl Pipeline<'_> {
         &self,
         recording: &Recording<S>,
         sliding: &SlidingResult,
-    ) -> Result<(Option<Vec<f64>>, Option<ErrorStats>)> {
+    ) -> Result<NominalRun> {
         let simulated = match &self.nominal {
             Some(p) => {
                 Some(
@@ -416,7 +429,30 @@ impl Pipeline<'_> {
             }
             None => None,
         };
+        let mut simulated = simulated;
+        let mut diverged = None;
+        if let Some(sim) = simulated.as_mut() {
+            // a run-away simulation (unstable parameters allowed) is left out
+            // from where it leaves the recording's scale: no 1e189 in a file
+            let (y, u) = (recording.position(), recording.command());
+            let span = range(y).max(range(u));
+            let bound = DIVERGED_SPAN * if span > 0.0 { span } else { 1.0 };
+            if let Some(k) = (0..y.len())
+                .find(|&k| (sim[k] - y[k]).abs().is_nan() || (sim[k] - y[k]).abs() > bound)
+            {
+                sim[k..].fill(f64::NAN);
+                diverged = Some(recording.time()[k]);
+            }
+        }
         let simulation_stats = simulated.as_ref().map(|sim| {
+            if diverged.is_some() {
+                return ErrorStats {
+                    samples: 0,
+                    rms: f64::NAN,
+                    max_abs: f64::NAN,
+                    fit_percent: f64::NAN,
+                };
+            }
             let y = recording.position();
             let any = sliding.stats.samples > 0;
             ErrorStats::from_pairs(
@@ -425,7 +461,7 @@ impl Pipeline<'_> {
                     .map(|k| (y[k], sim[k])),
             )
         });
-        Ok((simulated, simulation_stats))
+        Ok((simulated, simulation_stats, diverged))
     }
 
     /// Global models of the whole recording (through any gaps): the

@@ -45,7 +45,7 @@ mod run;
 mod summary;
 mod warning;
 
-pub use builder::Pipeline;
+pub use builder::{Pipeline, DIVERGED_SPAN};
 pub use compare::{CompareOptions, Comparison, GlobalModel, MethodRun, MIN_ZOOM_SAMPLES};
 pub use run::{Identification, OrderChoice};
 pub use summary::{IdentifySummary, RegimeInterval};

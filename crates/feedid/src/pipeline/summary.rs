@@ -191,7 +191,7 @@ impl fmt::Display for IdentifySummary {
                 match self.interval_coverage_percent {
                     Some(c) => format!(
                         ", {c:.1} % inside the {} % interval",
-                        self.interval_percent
+                        crate::error::short_number(self.interval_percent)
                     ),
                     None => String::new(),
                 },
@@ -224,7 +224,7 @@ impl fmt::Display for IdentifySummary {
             writeln!(
                 f,
                 "  {} % intervals: median width {:.3} µm; inside by command regime: {}",
-                self.interval_percent,
+                crate::error::short_number(self.interval_percent),
                 1e6 * w,
                 parts.join(", ")
             )?;

@@ -84,6 +84,15 @@ pub enum Warning {
         /// Windows predicted.
         windows: usize,
     },
+    /// The nominal simulation model (unstable parameters, allowed) ran away:
+    /// from `from_s` on it is farther from the measured position than
+    /// [`DIVERGED_SPAN`](crate::pipeline::DIVERGED_SPAN) times the motion
+    /// the recording spans; its error figures and its simulated positions
+    /// from there are left out of every output.
+    NominalDiverged {
+        /// Time of the first sample left out \[s\].
+        from_s: f64,
+    },
 }
 
 impl Warning {
@@ -181,6 +190,12 @@ impl fmt::Display for Warning {
                  an axis away from 0 or moving at a window's start; its predictions are far off \
                  there (use time_origin = window to study the coefficients, motion to predict)"
             ),
+            Warning::NominalDiverged { from_s } => write!(
+                f,
+                "the nominal simulation model ran away from t = {from_s:.4} s (unstable \
+                 parameters); its simulated positions from there and its error figures are left \
+                 out"
+            ),
             Warning::PaperTfFallback { fallbacks, windows } => write!(
                 f,
                 "paper method, prediction tf: the identified transfer function was unstable in \
@@ -240,6 +255,7 @@ mod tests {
                 fallbacks: 3,
                 windows: 10,
             },
+            Warning::NominalDiverged { from_s: 0.25 },
         ];
         for w in &all {
             let text = w.to_string();

@@ -434,7 +434,7 @@ impl<S: AsRef<[f64]>> Recording<S> {
             let r = range(&s);
             let better = best
                 .as_ref()
-                .map_or(true, |(b, br)| r > *br || (r == *br && s.len() > b.len()));
+                .is_none_or(|(b, br)| r > *br || (r == *br && s.len() > b.len()));
             if better {
                 best = Some((s, r));
             }

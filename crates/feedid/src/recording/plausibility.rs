@@ -235,8 +235,7 @@ fn frozen_position(t: &[f64], c: &[f64], x: &[f64], c_range: f64) -> Option<Stri
             continue;
         }
         let r = hi - lo;
-        if best.map_or(true, |b| r > b.2)
-            && !(suspect(r) && catches_up(c, x, start, k - 1, r, step))
+        if best.is_none_or(|b| r > b.2) && !(suspect(r) && catches_up(c, x, start, k - 1, r, step))
         {
             best = Some((start, k - 1, r));
         }

@@ -202,7 +202,7 @@ impl Zoo {
         };
         // coarse encoders alternate between servo and rig axes (servo
         // actuators are where low rates and coarse counts are common)
-        let servo_turn = (d / 3) % 2 == 0;
+        let servo_turn = (d / 3).is_multiple_of(2);
         let candidates: Vec<usize> = self
             .regular()
             .filter(|&i| match kind {

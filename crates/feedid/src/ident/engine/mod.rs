@@ -18,9 +18,9 @@ pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcom
 pub use guard::{Guard, GuardConfig, MIN_HISTORY};
 pub use regime::{Regime, RegimeClassifier, MOVING_SHARE};
 pub use signals::{Samples, Signals};
-pub(crate) use sliding::fit_and_predict;
 #[cfg(test)]
 pub(crate) use sliding::run_as_made;
+pub(crate) use sliding::{fit_and_predict, range};
 pub use sliding::{
     run, run_with, run_with_progress, EngineConfig, Progress, RegimeCoverage, SlidingResult,
     WindowIter, WindowRecord,

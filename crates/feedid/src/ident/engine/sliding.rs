@@ -661,7 +661,7 @@ mod tests {
         fn fit(&mut self, _: &Signals<'_>, _: Range<usize>, coef: &mut [f64]) -> Result<WindowFit> {
             self.k += 1;
             coef[0] = f64::NAN;
-            if self.k % 2 == 0 {
+            if self.k.is_multiple_of(2) {
                 Err(Error::Singular { context: "test" })
             } else {
                 Ok(WindowFit::identified(0.0, 0, Termination::Exact))

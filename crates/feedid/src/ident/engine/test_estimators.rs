@@ -128,7 +128,7 @@ impl Estimator for Follow {
     }
     fn fit(&mut self, s: &Signals<'_>, w: Range<usize>, c: &mut [f64]) -> Result<WindowFit> {
         self.k += 1;
-        if self.fail > 0 && self.k % self.fail == 0 {
+        if self.fail > 0 && self.k.is_multiple_of(self.fail) {
             return Err(Error::Singular { context: "test" });
         }
         let u = s.window(w.start - 1..w.end, 0, "test").unwrap().command;

@@ -447,7 +447,7 @@ pub fn order_table(u: &[f64], y: &[f64], dt: f64, search: &OrderSearch) -> Resul
         let mut arg: Option<(f64, ArxOrders)> = None;
         for r in &rows {
             if let Some(v) = c.value(r) {
-                if v.is_finite() && arg.map_or(true, |(b, _)| v < b) {
+                if v.is_finite() && arg.is_none_or(|(b, _)| v < b) {
                     arg = Some((v, r.orders));
                 }
             }
@@ -525,7 +525,7 @@ pub fn frols(u: &[f64], y: &[f64], cfg: &FrolsConfig) -> Result<FrolsResult> {
             }
             let wy: f64 = c.iter().zip(&target).map(|(a, b)| a * b).sum();
             let err = wy * wy / (ww * sigma);
-            if best.map_or(true, |(_, e)| err > e) {
+            if best.is_none_or(|(_, e)| err > e) {
                 best = Some((i, err));
             }
         }

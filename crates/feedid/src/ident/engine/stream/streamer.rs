@@ -281,10 +281,12 @@ impl<E: Estimator> Streamer<E> {
             .and_then(|v| v.checked_add(1))
             .filter(|&v| v <= MAX_CAPACITY / 2);
         let (Some(back), Some(span)) = (back, span) else {
-            return Err(Error::InvalidParameter {
-                name: "window + horizon + hop + look-ahead",
-                value: f64::INFINITY,
-                reason: "too large for a stream buffer",
+            return Err(Error::StreamBufferTooLarge {
+                window: config.window,
+                hop,
+                horizon: config.horizon,
+                lookahead,
+                max: MAX_CAPACITY / 2 - (estimator.warm_up() + history + 1).min(MAX_CAPACITY / 2),
             });
         };
         let cap = 2 * span;

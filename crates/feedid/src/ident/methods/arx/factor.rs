@@ -213,7 +213,7 @@ impl SlidingFactor {
             let hop = rows.start - old.start;
             let j = (rows.start - self.first) / hop.max(1);
             let stacked = hop == self.hop
-                && (rows.start - self.first) % hop == 0
+                && (rows.start - self.first).is_multiple_of(hop)
                 && j < self.count
                 && rows.end > self.back_end
                 && self.age + 1 < refactor_every;

@@ -1117,7 +1117,7 @@ mod tests {
             let mut row_of = |k: usize| -> Vec<f64> {
                 (0..m)
                     .map(|j| {
-                        if (k + j) % 7 == 0 {
+                        if (k + j).is_multiple_of(7) {
                             0.0
                         } else {
                             rng.random_range(-0.5..0.5)

@@ -127,7 +127,7 @@ impl AutoConfig {
         let mut best: Option<(usize, (i32, f64))> = None;
         for (i, c) in self.candidates.iter().enumerate() {
             if let Some(m) = memory(c) {
-                if best.map_or(true, |(_, b)| m.0 > b.0 || (m.0 == b.0 && m.1 > b.1)) {
+                if best.is_none_or(|(_, b)| m.0 > b.0 || (m.0 == b.0 && m.1 > b.1)) {
                     best = Some((i, m));
                 }
             }

@@ -426,7 +426,7 @@ impl AutoEstimator {
                 continue;
             }
             let s = m.score_in(r);
-            if choice.map_or(true, |(_, b)| beats(s, b)) {
+            if choice.is_none_or(|(_, b)| beats(s, b)) {
                 choice = Some((i, s));
             }
         }
@@ -720,7 +720,7 @@ impl Estimator for AutoEstimator {
                 let mut best: Option<(usize, Option<f64>)> = None;
                 for (i, m) in self.members.iter().enumerate().filter(|&(i, _)| usable(i)) {
                     let s = m.score_in(r);
-                    if best.map_or(true, |(_, b)| beats(s, b)) {
+                    if best.is_none_or(|(_, b)| beats(s, b)) {
                         best = Some((i, s));
                     }
                 }

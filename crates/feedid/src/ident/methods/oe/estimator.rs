@@ -674,7 +674,7 @@ impl Estimator for OeEstimator {
                 let ok = self.theta.iter().all(|v| v.is_finite()) && is_hurwitz(&self.theta[..n]);
                 match rep {
                     Ok(rep) if ok => {
-                        if best.as_ref().map_or(true, |b| rep.residual_norm < b.0) {
+                        if best.as_ref().is_none_or(|b| rep.residual_norm < b.0) {
                             if starts.len() > 1 {
                                 self.theta_best.copy_from_slice(&self.theta);
                             }
@@ -795,7 +795,7 @@ mod tests {
         let mut level = 0.0;
         (0..len)
             .map(|k| {
-                if k >= rest && (k - rest) % hold == 0 {
+                if k >= rest && (k - rest).is_multiple_of(hold) {
                     level = if coin.sample(&mut rng) { amp } else { -amp };
                 }
                 if k < rest {

@@ -192,7 +192,7 @@ fn fit_rows(
         let stable = is_hurwitz(&theta[..st.n]) && theta.iter().all(|v| v.is_finite());
         let better = best
             .as_ref()
-            .map_or(true, |b| report.residual_norm < b.2.residual_norm);
+            .is_none_or(|b| report.residual_norm < b.2.residual_norm);
         if stable && better {
             best = Some((st, theta, report, lm));
         }

@@ -1,9 +1,11 @@
 //! The TOML parameter readers on arbitrary text: never panic; accepted rig
 //! parameters give a model summary (or a clean error) and survive a TOML
-//! round trip; accepted rig effects validate or fail cleanly.
+//! round trip; accepted rig effects validate or fail cleanly; an accepted
+//! drive structure gives its closed loop (or a clean error) with finite
+//! figures.
 #![no_main]
 
-use feedid::drive::{D1Variant, ModelSummary, RigEffects, RigParams};
+use feedid::drive::{D1Variant, DriveStructure, ModelSummary, RigEffects, RigParams};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -23,5 +25,11 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Ok(fx) = toml::from_str::<RigEffects>(text) {
         let _ = fx.validate();
+    }
+    if let Ok(s) = DriveStructure::from_toml_str(text, Some("fuzz.toml".as_ref())) {
+        if let Ok(summary) = s.closed_loop() {
+            let text = format!("{summary:?}");
+            assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+        }
     }
 });

@@ -137,6 +137,22 @@ fn simulate_rig(
         1e3 * peak,
         if a.linear { "off (linear)" } else { "on" }
     );
+    // a loop far too slow for the command (a gain of 1e-6): the axis
+    // barely moves, which no table shows at a glance
+    let span = |v: &[f64]| {
+        v.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+            - v.iter().fold(f64::INFINITY, |m, &x| m.min(x))
+    };
+    let (moved, asked) = (span(&out.true_position), span(&out.command));
+    if asked > 0.0 && moved < 0.01 * asked {
+        eprintln!(
+            "warning: the axis covers {moved:.3e} m of the command's {} m ({:.2} %): the closed \
+             loop is far too slow for this command (see `feedid model` for its following error; a \
+             gain too small?)",
+            feedid::error::short_number(asked),
+            100.0 * moved / asked
+        );
+    }
     Ok(())
 }
 

@@ -307,3 +307,58 @@ fn an_allowed_unstable_model_leaves_no_placeholder_number_in_any_output() {
         s["warnings"]
     );
 }
+
+#[test]
+fn gains_of_absurd_sizes_are_named_not_printed_as_long_numbers() {
+    let tmp = tempfile::tempdir().unwrap();
+    let rig = tmp.path().join("rig.toml");
+    let r = rig.display().to_string();
+    let model = |text: &str| {
+        std::fs::write(&rig, text).unwrap();
+        run(&["model", "--params", &r].map(String::from), None)
+    };
+    // a velocity gain a million times too small: stable, but the axis
+    // barely follows; no line of digits
+    for kv in ["1e-6", "1e-300"] {
+        let o = model(&format!("[control]\nkv = {kv}\n"));
+        let out = crate::common::stdout(&o);
+        assert!(
+            out.contains("the axis barely follows its command"),
+            "{kv}: {out}"
+        );
+        assert!(out.lines().all(|l| l.len() < 200), "{kv}: {out}");
+    }
+    // a current-loop gain of 1e-300: the axis never moves, whatever the
+    // position loop's following error says
+    let o = model("[control]\nkpi = 1e-300\n");
+    let out = crate::common::stdout(&o);
+    assert!(
+        out.contains("the axis barely follows its command"),
+        "kpi: {out}"
+    );
+    // poles that cannot be computed are not "0 poles with a positive real part"
+    let o = model("[control]\nkp = 1e-300\n");
+    let out = crate::common::stdout(&o) + &stderr(&o);
+    assert!(!out.contains("UNSTABLE: 0 poles"), "{out}");
+    // simulate says the axis did not follow
+    std::fs::write(&rig, "[control]\nkv = 1e-6\n").unwrap();
+    let o = run(
+        &[
+            "simulate",
+            "--scenario",
+            "ramp",
+            "--params",
+            &r,
+            "-o",
+            &tmp.path().join("s.csv").display().to_string(),
+        ]
+        .map(String::from),
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("far too slow for this command"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -1064,6 +1064,47 @@ const LIMIT_HINT: &[crate::error::Hint] = crate::error::SMOOTHING_HINTS;
 mod tests {
     use super::*;
     use crate::compensate::ModelQuality;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(48))]
+
+        /// Any options and trajectory: an error or a finite command within
+        /// the limits it was given (the plain one sent instead too), never a
+        /// panic and never an unbounded buffer (the fuzz target
+        /// `compensate_options` runs the same property on arbitrary bytes).
+        #[test]
+        fn every_command_sent_meets_its_limits_whatever_the_options(
+            fixed in proptest::bool::ANY,
+            moving in proptest::bool::ANY,
+            smooth in -1e-3..5.0f64,
+            max_smoothing in -1e-3..5.0f64,
+            vmax in -0.1..2.0f64,
+            amax in -1.0..400.0f64,
+            min_benefit in 0.0..1e4f64,
+            steps in proptest::collection::vec(-2e-3..2e-3f64, 2..60),
+        ) {
+            let mut desired = vec![0.0; 40];
+            for (i, s) in steps.iter().enumerate() {
+                let last = *desired.last().unwrap_or(&0.0);
+                desired.extend((0..10).map(|k| last + s * (k + 1) as f64 / 10.0 * (i % 3) as f64));
+            }
+            let cfg = CompensateConfig {
+                smoothing: if fixed { Smoothing::Fixed(smooth) } else { Smoothing::Auto },
+                max_smoothing,
+                max_velocity: vmax,
+                max_acceleration: amax,
+                min_benefit,
+                start: if moving { StartMode::Moving } else { StartMode::Rest },
+                ..CompensateConfig::default()
+            };
+            let model = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+            if let Ok(c) = compensate_model(&model, &desired, 1e-3, &cfg) {
+                proptest::prop_assert!(c.command.iter().all(|v| v.is_finite()));
+                proptest::prop_assert!(c.peak_velocity <= vmax * (1.0 + 1e-6));
+                proptest::prop_assert!(c.peak_acceleration <= amax * (1.0 + 1e-6));
+            }
+        }
+    }
     use crate::drive::{closed_loop_coefficients, simulate_nominal, D1Variant};
     use crate::signal::{Ramp, Scenario, Scurve};
 

@@ -74,6 +74,15 @@ pub struct ModelSummary {
 }
 
 impl ModelSummary {
+    /// The time constant of the slowest pole, `1/|Re p|` \[s\] (∞ for a pole
+    /// at 0, 0 without poles).
+    pub fn slowest_pole_s(&self) -> f64 {
+        self.pole_details
+            .iter()
+            .map(|p| 1.0 / p.re.abs())
+            .fold(0.0, f64::max)
+    }
+
     /// Summarise the nominal model of `params`.
     pub fn new(params: &RigParams, variant: D1Variant) -> Result<Self> {
         let stable = crate::drive::check_model(params)?.stable;
@@ -214,7 +223,9 @@ impl fmt::Display for ModelSummary {
             fixed_or_e(0.05 * self.following_error_s * 1e6, 1),
             if !self.stable {
                 " — not reached: unstable"
-            } else if self.following_error_s > SLOW_FOLLOWING_S {
+            } else if self.following_error_s > SLOW_FOLLOWING_S
+                || self.slowest_pole_s() > SLOW_POLE_S
+            {
                 " — the axis barely follows its command: a gain far too small?"
             } else {
                 ""
@@ -222,6 +233,11 @@ impl fmt::Display for ModelSummary {
         )
     }
 }
+
+/// A pole slower than this time constant \[s\] (a current or velocity
+/// loop gain of an absurd size) marks a loop whose axis barely moves,
+/// whatever the position loop's following error says.
+const SLOW_POLE_S: f64 = 100.0;
 
 /// A following error beyond this many seconds per m/s (the axis lags a
 /// 50 mm/s move by more than 50 mm) marks a loop too slow to be meant.

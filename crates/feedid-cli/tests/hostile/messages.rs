@@ -119,9 +119,9 @@ fn a_plain_command_sent_instead_must_meet_the_limits_too() {
         None,
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    // --min-fit 100: the plain command is sent; the ramp's start asks 250 m/s²
-    let o = run(
-        &strings(&[
+    // `compensate` of the ramp's command with the model, and `extra` options
+    let compensate = |extra: &[&str]| {
+        let mut a = strings(&[
             "compensate",
             "--desired",
             &p("ramp.csv"),
@@ -129,15 +129,14 @@ fn a_plain_command_sent_instead_must_meet_the_limits_too() {
             "command_m",
             "--model",
             &p("m.json"),
-            "--min-fit",
-            "100",
-            "--max-acceleration",
-            "30",
             "-o",
             &p("cmd.csv"),
-        ]),
-        None,
-    );
+        ]);
+        a.extend(strings(extra));
+        run(&a, None)
+    };
+    // --min-fit 100: the plain command is sent; the ramp's start asks 250 m/s²
+    let o = compensate(&["--min-fit", "100", "--max-acceleration", "30"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(
@@ -154,22 +153,7 @@ fn a_plain_command_sent_instead_must_meet_the_limits_too() {
         ("--smooth", "1e9"),
         ("--max-smoothing", "1e3"),
     ] {
-        let o = run(
-            &strings(&[
-                "compensate",
-                "--desired",
-                &p("ramp.csv"),
-                "--desired-column",
-                "command_m",
-                "--model",
-                &p("m.json"),
-                flag,
-                v,
-                "-o",
-                &p("cmd.csv"),
-            ]),
-            None,
-        );
+        let o = compensate(&[flag, v]);
         assert_eq!(o.status.code(), Some(2), "{flag} {v}: {}", stderr(&o));
         let e = stderr(&o);
         assert!(e.contains("more than the 1000 samples (0.2 s)"), "{e}");

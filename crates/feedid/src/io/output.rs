@@ -230,10 +230,7 @@ pub fn pending_output_count() -> usize {
 
 /// A new temporary file beside `target`, registered for removal.
 fn create_temp(target: &Path) -> std::io::Result<(PathBuf, File)> {
-    let dir = match target.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    let dir = directory_of(target);
     let pid = std::process::id();
     for _ in 0..1000 {
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -406,11 +403,7 @@ impl<'a> OutputSet<'a> {
                 return Err(output_error(target, e));
             }
             g.files.retain(|f| f != tmp);
-            let dir = target
-                .parent()
-                .filter(|d| !d.as_os_str().is_empty())
-                .unwrap_or_else(|| Path::new("."))
-                .to_path_buf();
+            let dir = directory_of(target).to_path_buf();
             if !dirs.contains(&dir) {
                 dirs.push(dir);
             }
@@ -426,6 +419,14 @@ impl<'a> OutputSet<'a> {
     }
 }
 
+/// The directory a target is renamed into (`.` for a bare file name).
+fn directory_of(target: &Path) -> &Path {
+    target
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or_else(|| Path::new("."))
+}
+
 /// Exclusive advisory locks (`flock`) on the directories of `temps`'
 /// targets, taken in one order (canonical paths, sorted) by every process
 /// so that none waits on another in a cycle; released when dropped. Best
@@ -435,10 +436,7 @@ fn lock_directories(temps: &[(PathBuf, PathBuf)]) -> Vec<File> {
     let mut dirs: Vec<PathBuf> = temps
         .iter()
         .map(|(_, target)| {
-            let d = target
-                .parent()
-                .filter(|d| !d.as_os_str().is_empty())
-                .unwrap_or_else(|| Path::new("."));
+            let d = directory_of(target);
             std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf())
         })
         .collect();

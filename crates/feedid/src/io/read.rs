@@ -84,6 +84,7 @@ pub fn read_recording_with_progress(
             reader,
             limit.map(|l| l.saturating_sub(head.len() as u64)),
             path,
+            crate::error::InputKind::Stream,
         )?;
         head.extend_from_slice(&rest);
         read_mat_from_bytes(&head, path, opts)

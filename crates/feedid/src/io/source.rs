@@ -53,11 +53,13 @@ pub(crate) fn open_input(path: &Path) -> Result<(File, Option<u64>)> {
     Ok((file, limit))
 }
 
-/// Read everything from `r`, refusing more than `limit` bytes ([`Error::InputTooLarge`]).
+/// Read everything from `r`, refusing more than `limit` bytes
+/// ([`Error::InputTooLarge`] of `kind`).
 pub(crate) fn read_to_end_bounded<R: Read>(
     r: R,
     limit: Option<u64>,
     path: &Path,
+    kind: InputKind,
 ) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
     match limit {
@@ -73,7 +75,7 @@ pub(crate) fn read_to_end_bounded<R: Read>(
                 return Err(Error::InputTooLarge {
                     path: path.to_path_buf(),
                     limit,
-                    kind: InputKind::Stream,
+                    kind,
                 });
             }
         }
@@ -84,7 +86,7 @@ pub(crate) fn read_to_end_bounded<R: Read>(
 /// Read a whole input file (a stream at most [`MAX_STREAM_BYTES`]).
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
     let (file, limit) = open_input(path)?;
-    read_to_end_bounded(file, limit, path)
+    read_to_end_bounded(file, limit, path, InputKind::Stream)
 }
 
 /// Read a small text file (rig parameters, effects, a model): at most
@@ -97,14 +99,7 @@ pub fn read_small_text(path: &Path) -> Result<String> {
 /// learning history, which holds a command and an error per sample.
 pub fn read_text_up_to(path: &Path, limit: u64) -> Result<String> {
     let (file, _) = open_input(path)?;
-    let bytes = read_to_end_bounded(file, Some(limit), path).map_err(|e| match e {
-        Error::InputTooLarge { path, limit, .. } => Error::InputTooLarge {
-            path,
-            limit,
-            kind: InputKind::TextFile,
-        },
-        e => e,
-    })?;
+    let bytes = read_to_end_bounded(file, Some(limit), path, InputKind::TextFile)?;
     if let Some(i) = bytes.iter().position(|&b| b == 0) {
         return Err(Error::Malformed {
             path: path.to_path_buf(),
@@ -470,10 +465,16 @@ mod tests {
             }
         };
         assert!(matches!(e, Error::InputTooLarge { limit: 1000, .. }), "{e}");
-        let e = read_to_end_bounded(std::io::repeat(1), Some(10), Path::new("d")).unwrap_err();
+        let e = read_to_end_bounded(
+            std::io::repeat(1),
+            Some(10),
+            Path::new("d"),
+            InputKind::Stream,
+        )
+        .unwrap_err();
         assert!(matches!(e, Error::InputTooLarge { .. }), "{e}");
         assert_eq!(
-            read_to_end_bounded(&b"abc"[..], Some(3), Path::new("d")).unwrap(),
+            read_to_end_bounded(&b"abc"[..], Some(3), Path::new("d"), InputKind::Stream).unwrap(),
             b"abc"
         );
     }

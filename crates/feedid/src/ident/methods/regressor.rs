@@ -292,3 +292,16 @@ pub(crate) fn predict_horizon(
         }),
     }
 }
+
+/// An error naming the first non-finite value of `v` (`channel`, absolute
+/// index `offset + i`), if any.
+pub(crate) fn first_non_finite(v: &[f64], offset: usize, channel: &str) -> Result<()> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(Error::NonFinite {
+            channel: channel.to_string(),
+            index: offset + i,
+            value: v[i],
+        }),
+        None => Ok(()),
+    }
+}

@@ -13,6 +13,7 @@ use super::net::{add_squared_error_gradient, forward, Adam, Scratch, Shape};
 use super::train::{train, TrainReport, TrainSettings};
 use crate::error::{Error, Result};
 use crate::ident::engine::{rate_changed, Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::methods::regressor::{first_non_finite, ArxOrders};
 use crate::solve::Termination;
 
 /// Samples per mini-batch of the batch training.
@@ -118,20 +119,6 @@ impl NnEstimator {
     /// one-step errors before and after.
     pub fn last_training(&self) -> Option<TrainReport> {
         self.last
-    }
-
-    /// Raw inputs of sample `k` (local index into `y`, `u`, `k ≥ lag`) into
-    /// `raw`; returns the target `y[k] − y[k−1]`.
-    fn inputs(&self, y: &[f64], u: &[f64], k: usize, raw: &mut [f64]) -> f64 {
-        let o = self.config.orders;
-        let r = y[k - 1];
-        for i in 2..=o.na {
-            raw[i - 2] = y[k - i] - r;
-        }
-        for j in 0..o.nb {
-            raw[o.na - 1 + j] = u[k - o.nk - j] - r;
-        }
-        y[k] - r
     }
 
     /// Whether sample `k` is one to learn from: every sample from the
@@ -254,15 +241,13 @@ impl NnEstimator {
         let from = from.max(to.saturating_sub(ONLINE_SAMPLES));
         self.online_x.clear();
         self.online_t.clear();
-        let mut raw = std::mem::take(&mut self.raw);
         for k in from..to {
-            let t = self.inputs(y, u, k, &mut raw);
+            let t = inputs(self.config.orders, y, u, k, &mut self.raw);
             let start = self.online_x.len();
             self.online_x.resize(start + f, 0.0);
-            Self::scale(&self.sx, &raw, &mut self.online_x[start..]);
+            Self::scale(&self.sx, &self.raw, &mut self.online_x[start..]);
             self.online_t.push(t / self.st);
         }
-        self.raw = raw;
         let m = self.online_t.len();
         if m == 0 {
             return 0;
@@ -288,23 +273,32 @@ impl NnEstimator {
 
     /// One-step rms error of the network over the samples `from..to` (local) \[m\].
     fn one_step_rms(&mut self, y: &[f64], u: &[f64], from: usize, to: usize) -> f64 {
-        let mut raw = std::mem::take(&mut self.raw);
-        let mut z = std::mem::take(&mut self.z);
         let mut sse = 0.0;
         for k in from..to {
-            let t = self.inputs(y, u, k, &mut raw);
-            Self::scale(&self.sx, &raw, &mut z);
-            let e = self.st * forward(self.shape, &self.p, &z, &mut self.scratch) - t;
+            let t = inputs(self.config.orders, y, u, k, &mut self.raw);
+            Self::scale(&self.sx, &self.raw, &mut self.z);
+            let e = self.st * forward(self.shape, &self.p, &self.z, &mut self.scratch) - t;
             sse += e * e;
         }
-        self.raw = raw;
-        self.z = z;
         if to > from {
             (sse / (to - from) as f64).sqrt()
         } else {
             0.0
         }
     }
+}
+
+/// Raw inputs of sample `k` (local index into `y`, `u`, `k ≥ lag`) into
+/// `raw` for lags `o`; returns the target `y[k] − y[k−1]`.
+fn inputs(o: ArxOrders, y: &[f64], u: &[f64], k: usize, raw: &mut [f64]) -> f64 {
+    let r = y[k - 1];
+    for i in 2..=o.na {
+        raw[i - 2] = y[k - i] - r;
+    }
+    for j in 0..o.nb {
+        raw[o.na - 1 + j] = u[k - o.nk - j] - r;
+    }
+    y[k] - r
 }
 
 impl Estimator for NnEstimator {
@@ -365,28 +359,20 @@ impl Estimator for NnEstimator {
             "nn window (past samples + window)",
         )?;
         let (y, u) = (w.position, w.command);
-        if let Some(i) = y.iter().chain(u).position(|v| !v.is_finite()) {
-            let ch = if i < y.len() { "position" } else { "command" };
-            return Err(Error::NonFinite {
-                channel: ch.to_string(),
-                index: base + i % y.len(),
-                value: f64::NAN,
-            });
-        }
+        first_non_finite(y, base, "position")?;
+        first_non_finite(u, base, "command")?;
         // gather the new learning samples
         let cap = self.config.train_samples;
-        let mut raw = std::mem::take(&mut self.raw);
         for k in (cursor - base)..(window.end - base) {
             if self.ts.len() >= cap {
                 break;
             }
             if self.learning(u, k) {
-                let t = self.inputs(y, u, k, &mut raw);
-                self.xs.extend_from_slice(&raw);
+                let t = inputs(self.config.orders, y, u, k, &mut self.raw);
+                self.xs.extend_from_slice(&self.raw);
                 self.ts.push(t);
             }
         }
-        self.raw = raw;
         self.cursor = Some(window.end);
         let mut status = None;
         if self.ts.len() >= self.next_train {

@@ -13,6 +13,7 @@ use super::projection::{LegendreTables, Projection};
 use super::simplex::{simplex_fit, Reduced};
 use crate::error::{Error, Result};
 use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowFit};
+use crate::ident::methods::regressor::first_non_finite;
 use crate::lti::TransferFunction;
 use crate::solve::{lstsq_fixed, LstsqInfo, NelderMead, QrWorkspace, Termination};
 
@@ -189,17 +190,6 @@ impl PaperMethod {
         let l2 = 1.5 * s * s - 0.5;
         let w = (tau / fit.t_scale).powi(5);
         w * (fit.out[0] + fit.out[1] * l1 + fit.out[2] * l2)
-    }
-}
-
-pub(super) fn first_non_finite(v: &[f64], offset: usize, channel: &str) -> Result<()> {
-    match v.iter().position(|x| !x.is_finite()) {
-        Some(i) => Err(Error::NonFinite {
-            channel: channel.to_string(),
-            index: offset + i,
-            value: v[i],
-        }),
-        None => Ok(()),
     }
 }
 

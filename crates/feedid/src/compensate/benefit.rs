@@ -151,6 +151,8 @@ impl ModelQuality {
             });
         }
         let (u0, y0) = (grid[0], position[0]);
+        let (model, _) = model.without_negligible_pairs(dt * grid.len() as f64)?;
+        let model = &model;
         let dev: Vec<f64> = grid.iter().map(|u| u - u0).collect();
         let mut yd = model.simulate_at(&dev, dt)?;
         // as the compensation uses it: rescaled to unit DC gain

@@ -10,7 +10,10 @@
 //! * [`compensate`], [`compensate_model`], [`compensate_params`]: the
 //!   command (plain trajectory plus the correction the axis needs), smoothed
 //!   only where the command's velocity and acceleration limits need it,
-//!   segments moving at either end, and the model's prediction.
+//!   segments moving at either end, and the model's prediction; where no
+//!   smoothing meets the limits, the correction held back locally or the
+//!   command slewed at the limits until it has caught up (`slew`), whichever
+//!   the model expects to track better.
 //! * [`Benefit`], [`ModelQuality`], [`Fallback`]: "never worse" — the plain
 //!   command is sent when the model expects little benefit or fits poorly.
 //! * [`learn`]: iterative learning control from measured runs of a repeated
@@ -30,6 +33,7 @@ mod inverse;
 mod learn;
 mod online;
 mod online_stream;
+mod slew;
 mod smoothing;
 mod step;
 mod verify;

@@ -175,6 +175,11 @@ pub struct ModelProvenance {
     /// simulated through them and not compared there); 0 without gaps.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub missing_samples: usize,
+    /// Pole–zero pairs of the fit cancelled because they change nothing
+    /// over the recording ([`LinearModel::without_negligible_pairs`]); 0
+    /// when none.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub cancelled_pairs: usize,
     /// Sample time of the recording \[s\].
     pub sample_time_s: f64,
     /// Free-run simulation fit over the recording \[%\] (NRMSE).
@@ -521,6 +526,10 @@ fn fit_one(data: &Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
         }
         (GlobalModelKind::Auto, _) => return fit_data(data, kind),
     };
+    // a pair the recording cannot tell apart (a differentiator behind a
+    // pole at 1e-11 rad/s) would leave a model of zero steady-state gain
+    let span = dt * data.grid.map_or(u.len(), |g| g.command.len()) as f64;
+    let (model, cancelled_pairs) = model.without_negligible_pairs(span)?;
     let (stats, error_fit) = simulated_with_fit(&model, data)?;
     if !(stats.rms.is_finite()) {
         return Err(Error::InvalidModel {
@@ -534,6 +543,7 @@ fn fit_one(data: &Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
             orders: kind.orders(),
             samples: u.len(),
             missing_samples: data.grid.map_or(0, |g| g.command.len() - u.len()),
+            cancelled_pairs,
             sample_time_s: dt,
             fit_percent: stats.fit_percent,
             simulation_rms_m: stats.rms,

@@ -44,7 +44,7 @@ pub use methods::{
     SHIFT_AMPLIFICATION_WARNING,
 };
 pub(crate) use methods::{fold_scale, has_avx2, rls_update};
-pub use model::LinearModel;
+pub use model::{LinearModel, NEGLIGIBLE_PAIR};
 pub use option::{
     MethodOption, OptionInfo, OptionKind, OptionRange, OptionSpec, OptionUse, OptionValue,
 };

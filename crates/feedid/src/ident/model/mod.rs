@@ -3,5 +3,7 @@
 //! `ident/global.rs`, a layer above the methods).
 
 mod linear;
+mod reduce;
 
 pub use linear::LinearModel;
+pub use reduce::NEGLIGIBLE_PAIR;

@@ -51,7 +51,7 @@ use nalgebra::Complex;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::lti::{poly_roots, DiscreteStateSpace, StateSpace};
+use crate::lti::{poly_roots, DiscreteStateSpace};
 
 /// Causal sections are run until their transient is below this fraction.
 const SETTLE: f64 = 1e-17;
@@ -306,11 +306,10 @@ impl StableInverse {
 
     /// From a discrete state-space model (its transfer function in `z`).
     pub fn from_state_space(sys: &DiscreteStateSpace, margin: f64) -> Result<Self> {
-        let tf = StateSpace::new(sys.a.clone(), sys.b.clone(), sys.c.clone(), sys.d)?.to_tf()?;
-        let (num, den) = (tf.num(), tf.den());
-        let delay = den.len().saturating_sub(num.len());
-        let lead = den.first().copied().unwrap_or(0.0);
-        Self::from_roots(num[0] / lead, delay, &tf.zeros()?, &tf.poles()?, margin)
+        // zeros from the zero dynamics, poles from A: never the roots of a
+        // polynomial, whose roots near z = 1 a fast-sampled model loses
+        let (gain, delay, zeros) = sys.zeros()?;
+        Self::from_roots(gain, delay, &zeros, &sys.poles()?, margin)
     }
 
     /// The model's zeros and how each is inverted.

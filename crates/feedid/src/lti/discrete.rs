@@ -169,6 +169,89 @@ impl DiscreteStateSpace {
         Ok(p)
     }
 
+    /// Zeros, relative degree and gain: `(g, r, zeros)` with `g` the first
+    /// non-zero Markov parameter (`D`, or `C·A^{r−1}·B`), `r` the delay in
+    /// samples, and the `n − r` transmission zeros as the eigenvalues of the
+    /// zero dynamics
+    ///
+    /// ```text
+    /// N = A − B·(C·A^r)/(C·A^{r−1}·B)     (D = 0),     N = A − B·C/D   (D ≠ 0)
+    /// ```
+    ///
+    /// without the `r` eigenvalues of `N` at 0 (the input that holds the
+    /// output at zero leaves exactly the zero dynamics). Unlike the roots
+    /// of the numerator polynomial, this keeps the zeros of a fast-sampled
+    /// model, clustered near `z = 1`, accurate. A Markov parameter below
+    /// 1e-10 of the largest of the first `n + 1` counts as zero; no non-zero
+    /// one is an error.
+    ///
+    /// ```
+    /// use feedid::lti::TransferFunction;
+    /// // 1/(s + 1) sampled at 0.1 s: no zero, one sample of delay
+    /// let sys = TransferFunction::new(vec![1.0], vec![1.0, 1.0]).unwrap()
+    ///     .to_state_space().unwrap().discretize_zoh(0.1).unwrap();
+    /// let (g, r, z) = sys.zeros().unwrap();
+    /// assert_eq!((r, z.len()), (1, 0));
+    /// assert!((g - (1.0 - (-0.1f64).exp())).abs() < 1e-12);
+    /// ```
+    pub fn zeros(&self) -> Result<(f64, usize, Vec<Complex<f64>>)> {
+        let n = self.order();
+        let sys =
+            StateSpace::new(self.a.clone(), self.b.clone(), self.c.clone(), self.d)?.balance();
+        let (a, b, c) = (&sys.a, &sys.b, &sys.c);
+        // Markov parameters C·A^{k−1}·B, k = 1 … n + 1
+        let mut v = b.clone();
+        let mut markov = Vec::with_capacity(n + 1);
+        for _ in 0..=n {
+            markov.push((c * &v)[(0, 0)]);
+            v = a * &v;
+        }
+        let largest = markov.iter().fold(self.d.abs(), |m, h| m.max(h.abs()));
+        if !(largest.is_finite() && largest > 0.0) {
+            return Err(Error::InvalidModel {
+                reason: "the model's output does not depend on its input",
+            });
+        }
+        if self.d.abs() > 1e-10 * largest {
+            let nz = a - (b * c) / self.d;
+            let mut z = eigenvalues(&nz)?;
+            sort_roots(&mut z);
+            return Ok((self.d, 0, z));
+        }
+        let Some(r) = markov
+            .iter()
+            .position(|h| h.abs() > 1e-10 * largest)
+            .map(|k| k + 1)
+        else {
+            return Err(Error::InvalidModel {
+                reason: "the model's output does not depend on its input",
+            });
+        };
+        if r > n {
+            return Ok((markov[r - 1], r, Vec::new()));
+        }
+        let g = markov[r - 1];
+        // C·A^r
+        let mut car = c.clone();
+        for _ in 0..r {
+            car = &car * a;
+        }
+        let nz = a - (b * car) / g;
+        let mut z = eigenvalues(&nz)?;
+        sort_roots(&mut z);
+        // the r smallest are the zero dynamics' eigenvalues at 0; rounding
+        // may have paired one of them with a small real zero: a root whose
+        // conjugate went with them is real
+        let mut z = z.split_off(r.min(z.len()));
+        let unpaired: Vec<usize> = (0..z.len())
+            .filter(|&i| z[i].im != 0.0 && !z.iter().any(|w| *w == z[i].conj()))
+            .collect();
+        for i in unpaired {
+            z[i].im = 0.0;
+        }
+        Ok((g, r, z))
+    }
+
     /// True if the spectral radius of A is < 1.
     pub fn is_stable(&self) -> Result<bool> {
         Ok(self.poles()?.iter().all(|p| p.norm() < 1.0))
@@ -205,6 +288,90 @@ impl DiscreteStateSpace {
 mod tests {
     use super::*;
     use crate::lti::TransferFunction;
+
+    /// `g·∏(1 − zᵢ)/∏(1 − pⱼ)`: the DC gain the factors say.
+    fn factored_dc_gain(sys: &DiscreteStateSpace) -> f64 {
+        let (g, _, z) = sys.zeros().unwrap();
+        let num: Complex<f64> = z.iter().map(|z| Complex::new(1.0, 0.0) - z).product();
+        let den: Complex<f64> = sys
+            .poles()
+            .unwrap()
+            .iter()
+            .map(|p| Complex::new(1.0, 0.0) - p)
+            .product();
+        g * (num / den).re
+    }
+
+    #[test]
+    fn zeros_agree_with_the_numerator_roots_where_those_are_well_conditioned() {
+        // (s + 2)·(s + 30) / ((s + 1)(s + 3)(s + 10)(s + 40)) at 10 ms
+        let tf = TransferFunction::new(
+            crate::lti::poly_from_roots(&[Complex::new(-2.0, 0.0), Complex::new(-30.0, 0.0)])
+                .iter()
+                .map(|c| 1200.0 * c)
+                .collect(),
+            crate::lti::poly_from_roots(&[-1.0, -3.0, -10.0, -40.0].map(|p| Complex::new(p, 0.0))),
+        )
+        .unwrap();
+        let sys = tf.to_state_space().unwrap().discretize_zoh(0.01).unwrap();
+        let (g, r, z) = sys.zeros().unwrap();
+        let back = StateSpace::new(sys.a.clone(), sys.b.clone(), sys.c.clone(), sys.d)
+            .unwrap()
+            .to_tf()
+            .unwrap();
+        let reference = back.zeros().unwrap();
+        assert_eq!((r, z.len()), (1, reference.len()));
+        for (a, b) in z.iter().zip(&reference) {
+            assert!((a - b).norm() < 1e-9, "{z:?} vs {reference:?}");
+        }
+        assert!((g - back.num()[0] / back.den()[0]).abs() < 1e-12 * g.abs());
+        assert!((factored_dc_gain(&sys) - sys.dc_gain().unwrap()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_factors_of_a_fast_sampled_high_order_model_keep_its_dc_gain() {
+        // an output-error fit of a slow axis (7 poles from 1.9 to 1243 rad/s,
+        // two zeros) sampled at 13.2 kHz: the poles and zeros crowd z = 1,
+        // where the numerator's roots gave a DC gain of −0.05
+        let tf = TransferFunction::new(
+            vec![3594667572854.316, 56815387265393.02, 94095757796106.55],
+            vec![
+                1.0,
+                894.5450795478295,
+                1630848.715726167,
+                1386501114.0666509,
+                131310823668.99641,
+                5554847665363.559,
+                59974223135411.414,
+                94128731501930.4,
+            ],
+        )
+        .unwrap();
+        let sys = tf
+            .to_state_space()
+            .unwrap()
+            .discretize_zoh(7.578106011685905e-05)
+            .unwrap();
+        let want = tf.dc_gain();
+        assert!((sys.dc_gain().unwrap() - want).abs() < 1e-9);
+        let got = factored_dc_gain(&sys);
+        assert!((got - want).abs() < 1e-5, "{got} vs {want}");
+        let (_, r, z) = sys.zeros().unwrap();
+        assert_eq!((r, z.len()), (1, 6));
+    }
+
+    #[test]
+    fn a_model_whose_output_ignores_its_input_has_no_zeros() {
+        let sys = DiscreteStateSpace::from_parts(
+            DMatrix::from_row_slice(1, 1, &[0.5]),
+            DVector::from_row_slice(&[0.0]),
+            RowDVector::from_row_slice(&[1.0]),
+            0.0,
+            1e-3,
+        )
+        .unwrap();
+        assert!(sys.zeros().is_err());
+    }
 
     fn first_order(dt: f64) -> DiscreteStateSpace {
         // 2/(0.01 s + 1)

@@ -1,26 +1,31 @@
 //! Compensation on the drive zoo: for every regular zoo member
 //! whose command is a ramp, an S-curve, a point-to-point program or a
-//! contour axis, identify a global model from a **chirp** run on the same
-//! axis, compensate the member's command with it (library defaults: smoothing
-//! only where the limits need it, "never worse" fall-back with the model's
-//! fits measured on the chirp run) and run both commands on the axis.
+//! contour axis, identify a global model from a **first run of the
+//! member's own program** (or, with `--ident chirp`, a chirp run) on the
+//! same axis, compensate the member's command with it (library defaults:
+//! smoothing only where the limits need it, held back or slewed where it
+//! does not suffice, "never worse" fall-back with the model's fits) and run
+//! both commands on the axis.
 //!
 //! ```sh
 //! cargo run --release -p feedid --example zoo_compensate
+//! cargo run --release -p feedid --example zoo_compensate -- --ident chirp
 //! cargo run --release -p feedid --example zoo_compensate -- --limit 20 --csv comp.csv
 //! ```
 //!
 //! Per member:
 //!
-//! * the identification run: [`feedid::zoo::MemberSpec::identification_chirp`]
-//!   (a logarithmic sine sweep from `f_max/100` to
-//!   `f_max = min(rate/8, max(6·Kv/2π, 5 Hz))`, amplitude
-//!   `0.8·min(A, 10 mm, v/(2π·f_max), a/(2π·f_max)²)`; `A`, `v`, `a`: the
-//!   member's amplitude, command speed and acceleration — for a ramp
-//!   `a = v·Kv`), as long as the member's recording, noise seed + 1;
+//! * the identification run (noise seed + 1, as long as the member's
+//!   recording): `--ident program` (default) the member's program itself —
+//!   record the program once, identify, compensate; `--ident chirp`
+//!   [`feedid::zoo::MemberSpec::identification_chirp`] (a logarithmic sine
+//!   sweep from `f_max/100` to `f_max = min(rate/8, max(6·Kv/2π, 5 Hz))`,
+//!   amplitude `0.8·min(A, 10 mm, v/(2π·f_max), a/(2π·f_max)²)`; `A`, `v`,
+//!   `a`: the member's amplitude, command speed and acceleration — for a
+//!   ramp `a = v·Kv`);
 //! * the model: `fit_global_model(.., Auto)` (the best of arx 8,8,1, oe 7,2
 //!   and oe 5,1 by free-run error) and its free-run position fit on the
-//!   chirp run; the share of the following error it explains
+//!   identification run; the share of the following error it explains
 //!   ([`ModelQuality::from_run`]) on the member's own recording — the plain
 //!   program run once, with its noise and glitches, as `compensate --check`
 //!   uses it;
@@ -34,7 +39,10 @@
 //!   sends (compensated or, on a fall-back, the plain one), same noise seed.
 //!
 //! The summary is printed as a Markdown table; `--csv FILE` writes one row
-//! per member.
+//! per member. The expected benefit agrees with the achieved one when
+//! within a factor 2, or when both are at least
+//! [`feedid::compensate::MAX_BENEFIT`] (an expectation at that cap says
+//! "at least").
 //!
 //! **Learning from runs** (`--runs R`, R ≥ 2): the command sent (run 1) and
 //! then R − 1 learning steps ([`feedid::compensate::learn`], library

@@ -754,3 +754,52 @@ fn a_fall_back_to_a_plain_command_over_a_limit_is_refused_with_its_figures() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn compensate_slews_a_slow_axis_to_its_lead_within_the_limits_and_says_so() {
+    // a lag of 50 ms (Kv = 20 1/s) on a 0.1 m/s ramp at 1 kHz; limits twice
+    // the ramp's velocity: no smoothing of ≤ 20 ms builds the 5 mm lead
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("slow.json");
+    std::fs::write(
+        &model,
+        r#"{"model": {"kind": "continuous", "num": [1.0], "den": [0.05, 1.0]}}"#,
+    )
+    .unwrap();
+    let des = dir.path().join("ramp.csv");
+    let mut text = String::from("time_s,position_m\n");
+    for k in 0..2000 {
+        let t = k as f64 * 1e-3;
+        text.push_str(&format!(
+            "{t},{}\n",
+            1e-4 * (k as f64 - 200.0).clamp(0.0, 1000.0)
+        ));
+    }
+    std::fs::write(&des, text).unwrap();
+    let cmd = dir.path().join("cmd.csv");
+    let summary = dir.path().join("s.json");
+    let out = run_ok(&[
+        "compensate",
+        "--desired",
+        p(&des),
+        "--model",
+        p(&model),
+        "--max-velocity",
+        "0.2",
+        "--max-acceleration",
+        "150",
+        "-o",
+        p(&cmd),
+        "--summary",
+        p(&summary),
+    ]);
+    assert!(out.contains("command sent: compensated"), "{out}");
+    assert!(out.contains("the command slewed at the limits on"), "{out}");
+    let s = json(&summary);
+    assert_eq!(s["slewed"], serde_json::Value::Bool(true), "{s}");
+    let held = s["held_back_share"].as_f64().unwrap();
+    assert!(held > 0.0 && held < 0.3, "{held}");
+    assert!(s["peak_velocity"].as_f64().unwrap() <= 0.2 * (1.0 + 1e-9));
+    let benefit = s["benefit"]["expected_benefit"].as_f64().unwrap();
+    assert!(benefit > 4.0, "{benefit}");
+}

@@ -426,7 +426,12 @@ fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checked: bool) {
                 } else {
                     String::new()
                 },
-                if c.held_back_share > 0.0 {
+                if c.held_back_share > 0.0 && c.slewed {
+                    format!(
+                        "; the command slewed at the limits on {:.1} % of the samples (off the compensated one until it has caught up), where no smoothing up to --max-smoothing meets them",
+                        100.0 * c.held_back_share
+                    )
+                } else if c.held_back_share > 0.0 {
                     format!(
                         "; the correction held back on {:.1} % of the samples, where no smoothing up to --max-smoothing meets the limits",
                         100.0 * c.held_back_share

@@ -41,7 +41,11 @@
 //! where it still exceeds a limit (`plain + (1 − W)·(u − plain)`, `W` one
 //! around those samples and easing to zero over as many on each side,
 //! widened until the limits hold; [`Compensation::held_back_share`]): the
-//! axis is compensated everywhere else. Only when even that fails is the
+//! axis is compensated everywhere else. The smoothest command is also
+//! **slewed** at the limits until it has caught up (`compensate/slew.rs`;
+//! what a slow axis needs to build its following error's lead at a ramp's
+//! corner) and the one of the two the model expects to track better is
+//! sent ([`Compensation::slewed`]). Only when neither meets them is the
 //! plain command sent (a [`Fallback::Limits`]); when the plain command
 //! itself exceeds a limit, [`Error::LimitUnreachable`] quotes the smallest
 //! peak reached, its time and the trajectory's own peak.
@@ -285,6 +289,11 @@ pub struct Compensation {
     /// plain command because no smoothing up to
     /// [`CompensateConfig::max_smoothing`] meets a limit there (0: nowhere).
     pub held_back_share: f64,
+    /// The command slews at the limits where it is off the compensated one
+    /// (until it has caught up, `compensate/slew.rs`) instead of holding the
+    /// correction back; [`Compensation::held_back_share`] is then the share
+    /// of the samples where it is off.
+    pub slewed: bool,
     /// Peak velocity of the command sent \[m/s\].
     pub peak_velocity: f64,
     /// Time of that peak \[s\] (from the first sample).
@@ -466,6 +475,8 @@ struct Candidate {
     /// Share of the desired samples where the correction is held back
     /// (limits no smoothing could meet).
     held_share: f64,
+    /// Off the compensated command by slewing rather than holding back.
+    slewed: bool,
 }
 
 impl Problem<'_> {
@@ -499,6 +510,7 @@ impl Problem<'_> {
             sent,
             plain,
             held_share: 0.0,
+            slewed: false,
         })
     }
 
@@ -604,6 +616,7 @@ impl Problem<'_> {
             sent,
             plain: c.plain.clone(),
             held_share: off as f64 / self.n as f64,
+            slewed: true,
         };
         (candidate, sigma.clone(), sigma_p.clone(), *tau)
     }
@@ -986,6 +999,7 @@ fn compensate_with(
     let (mut sent_rel, mut smoothing_s, mut smoothed_share, mut pre_actuation) =
         (plain_sent.clone(), 0.0, 0.0, 0.0);
     let mut held_back_share = 0.0;
+    let mut slewed = false;
     let mut predicted_rel = yp.clone();
     let mean = desired.iter().sum::<f64>() / n as f64;
     let motion_rms = (desired.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
@@ -1030,6 +1044,7 @@ fn compensate_with(
         }
         if fallback.is_none() {
             held_back_share = c.held_share;
+            slewed = c.slewed;
             sent_rel = c.sent;
             predicted_rel = yc;
         } else {
@@ -1095,6 +1110,7 @@ fn compensate_with(
         smoothing_s,
         smoothed_share,
         held_back_share,
+        slewed,
         peak_velocity: peaks.velocity,
         peak_velocity_time_s: peaks.velocity_at as f64 * dt,
         peak_acceleration: peaks.acceleration,
@@ -1553,6 +1569,7 @@ mod tests {
             "{} vs {plain}",
             c.predicted_error.rms
         );
+        assert!(c.slewed);
         assert!(
             c.held_back_share > 0.0 && c.held_back_share < 0.3,
             "{}",

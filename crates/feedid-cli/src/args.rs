@@ -583,8 +583,9 @@ pub struct GreyboxArgs {
     /// Summary JSON.
     #[arg(long, value_name = "gb.json")]
     pub summary: Option<PathBuf>,
-    /// Drive structures: simulate the estimated structure on another recording of
-    /// the axis (read with the same column options) and report how it fits.
+    /// Simulate the estimated model (the paper's rig, or a drive structure) on
+    /// another recording of the axis (read with the same column options) and
+    /// report how it fits.
     #[arg(long, value_name = "rec.csv")]
     pub validate: Option<PathBuf>,
     /// Write the rig parameters with the estimates in place (TOML), e.g. for `feedid compensate --params`.

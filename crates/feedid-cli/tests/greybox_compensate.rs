@@ -114,6 +114,56 @@ fn greybox_recovers_five_parameters_from_a_noise_free_linear_recording() {
 }
 
 #[test]
+fn greybox_validates_the_estimated_rig_on_another_recording() {
+    // fitted on a PRBS, checked on an S-curve of the same (linear) rig
+    let dir = tempfile::tempdir().unwrap();
+    let rec = simulate(dir.path(), "prbs.csv", &["--scenario", "prbs", "--linear"]);
+    let other = simulate(
+        dir.path(),
+        "scurve.csv",
+        &["--scenario", "scurve", "--linear"],
+    );
+    let summary = dir.path().join("gb.json");
+    let out = run_ok(&[
+        "greybox",
+        p(&rec),
+        "--params",
+        p(&wrong_rig(dir.path())),
+        "--estimate",
+        "Kv,Kp,Ki,C2,M",
+        "--position-loop",
+        "continuous",
+        "--validate",
+        p(&other),
+        "--summary",
+        p(&summary),
+    ]);
+    assert!(out.contains("validation on"), "{out}");
+    let v = &json(&summary)["validation"];
+    let (rms, fit, tracking) = (
+        v["rms"].as_f64().unwrap(),
+        v["fit_percent"].as_f64().unwrap(),
+        v["tracking_rms"].as_f64().unwrap(),
+    );
+    // the rig integrates with RK4: the exact model is within ~1e-9 m
+    assert!(rms < 1e-8, "{rms}");
+    assert!(fit > 99.999, "{fit}");
+    assert!(tracking > 1e-5, "{tracking}");
+    assert_eq!(v["samples"].as_u64().unwrap() as usize, csv(&other).1.len());
+    // a recording that is not there: exit 2 naming it
+    let missing = dir.path().join("missing.csv");
+    let o = feedid(&[
+        "greybox",
+        p(&rec),
+        "--estimate",
+        "Kv",
+        "--validate",
+        p(&missing),
+    ]);
+    assert_fails(&o, &["missing.csv"]);
+}
+
+#[test]
 fn greybox_with_friction_and_current_recovers_the_rig_from_a_noisy_recording() {
     // the full nonlinear rig with noise; the nonlinear model and the current
     let dir = tempfile::tempdir().unwrap();

@@ -35,9 +35,6 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     if let Some(structure) = crate::cmd::load_structure(a.params.as_deref())? {
         return fit_structure(a, &structure);
     }
-    if a.validate.is_some() {
-        bail!("--validate simulates a drive structure (--params structure.toml); for the paper's rig it is not there yet");
-    }
     let settings = settings(a)?;
 
     let mut text = String::new();
@@ -51,6 +48,28 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
     report(&mut text, &fit);
     if let Some(rows) = &track {
         report_track(&mut text, &settings.estimate, rows);
+    }
+    if let Some(path) = &a.validate {
+        let other = recording::load(path, &a.recording)?;
+        let v = fit
+            .validate_on(
+                &settings.cfg,
+                other.command(),
+                other.position(),
+                other.rate_hz(),
+            )
+            .with_context(|| path.display().to_string())?;
+        let _ = writeln!(
+            text,
+            "validation on {} ({} samples): rms error {:.3} µm, max {:.3} µm, fit {:.3} % (tracking error there {:.3} µm rms)",
+            path.display(),
+            v.samples,
+            1e6 * v.rms,
+            1e6 * v.max,
+            v.fit_percent,
+            1e6 * v.tracking_rms
+        );
+        context.insert("validation".into(), serde_json::to_value(v)?);
     }
     write_outputs(a, &fit, track.as_deref(), &settings.estimate, context)?;
     print!("{text}");

@@ -437,7 +437,8 @@ impl DriveStructure {
     }
 }
 
-/// How a structure's simulation matches a recording it was not fitted on.
+/// How a fitted model's simulation (a drive structure's, or the paper's
+/// rig's from `greybox`) matches a recording it was not fitted on.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct StructureValidation {
     /// Samples compared.

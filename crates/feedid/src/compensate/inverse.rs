@@ -8,7 +8,9 @@
 //! ```
 //!
 //! with gain `g` (first non-zero Markov parameter), delay `d ≥ 0`, zeros `zᵢ`
-//! and poles `pⱼ`. The inverse `u = G⁻¹·y` is applied as a cascade of first-
+//! and poles `pⱼ` (from a state-space model: the eigenvalues of its zero
+//! dynamics and of `A`, [`DiscreteStateSpace::zeros`] — never the roots of
+//! its numerator polynomial, which fast sampling makes ill-conditioned). The inverse `u = G⁻¹·y` is applied as a cascade of first-
 //! and second-order sections (real roots, conjugate pairs), never as one
 //! high-order polynomial, so the poles of a fast-sampled model clustered near
 //! `z = 1` cost no accuracy:

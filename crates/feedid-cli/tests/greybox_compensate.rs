@@ -62,26 +62,35 @@ fn wrong_rig(dir: &Path) -> PathBuf {
     f
 }
 
+/// `greybox` of Kv, Kp, Ki, C2 and M on `rec` from the wrong rig (continuous
+/// position loop), with `extra` arguments; its standard output.
+fn five_from_the_wrong_rig(dir: &Path, rec: &Path, extra: &[&str]) -> String {
+    let rig = wrong_rig(dir);
+    let mut args = vec![
+        "greybox",
+        p(rec),
+        "--params",
+        p(&rig),
+        "--estimate",
+        "Kv,Kp,Ki,C2,M",
+        "--position-loop",
+        "continuous",
+    ];
+    args.extend_from_slice(extra);
+    run_ok(&args)
+}
+
 #[test]
 fn greybox_recovers_five_parameters_from_a_noise_free_linear_recording() {
     let dir = tempfile::tempdir().unwrap();
     let rec = simulate(dir.path(), "prbs.csv", &["--scenario", "prbs", "--linear"]);
     let summary = dir.path().join("gb.json");
     let est = dir.path().join("est.toml");
-    let out = run_ok(&[
-        "greybox",
-        p(&rec),
-        "--params",
-        p(&wrong_rig(dir.path())),
-        "--estimate",
-        "Kv,Kp,Ki,C2,M",
-        "--position-loop",
-        "continuous",
-        "--summary",
-        p(&summary),
-        "--params-out",
-        p(&est),
-    ]);
+    let out = five_from_the_wrong_rig(
+        dir.path(),
+        &rec,
+        &["--summary", p(&summary), "--params-out", p(&est)],
+    );
     assert!(
         out.contains("identifiable") && out.contains("correlation"),
         "{out}"
@@ -124,20 +133,11 @@ fn greybox_validates_the_estimated_rig_on_another_recording() {
         &["--scenario", "scurve", "--linear"],
     );
     let summary = dir.path().join("gb.json");
-    let out = run_ok(&[
-        "greybox",
-        p(&rec),
-        "--params",
-        p(&wrong_rig(dir.path())),
-        "--estimate",
-        "Kv,Kp,Ki,C2,M",
-        "--position-loop",
-        "continuous",
-        "--validate",
-        p(&other),
-        "--summary",
-        p(&summary),
-    ]);
+    let out = five_from_the_wrong_rig(
+        dir.path(),
+        &rec,
+        &["--validate", p(&other), "--summary", p(&summary)],
+    );
     assert!(out.contains("validation on"), "{out}");
     let v = &json(&summary)["validation"];
     let (rms, fit, tracking) = (

@@ -178,51 +178,6 @@ pub struct GreyboxFit {
 }
 
 impl GreyboxFit {
-    /// Simulate the fitted model (its parameters and effects, with the
-    /// dynamics and position loop of `cfg`, as fitted) on another
-    /// recording's `command` sampled at `rate_hz` \[Hz\] and compare with its
-    /// measured `position`, as [`crate::drive::DriveStructure::validate_on`]
-    /// does for a drive structure.
-    pub fn validate_on(
-        &self,
-        cfg: &GreyboxConfig,
-        command: &[f64],
-        position: &[f64],
-        rate_hz: f64,
-    ) -> Result<crate::drive::StructureValidation> {
-        if command.len() != position.len() {
-            return Err(Error::LengthMismatch {
-                what: "command and position",
-                expected: command.len(),
-                actual: position.len(),
-            });
-        }
-        if !(rate_hz.is_finite() && rate_hz > 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "rate",
-                value: rate_hz,
-                reason: "must be finite and > 0 (Hz)",
-            });
-        }
-        let model = PhysicalModel {
-            params: self.params,
-            effects: self.effects,
-            dynamics: cfg.dynamics,
-            position_loop: cfg.position_loop,
-        };
-        let simulated = model.simulate(command, 1.0 / rate_hz)?;
-        let error = ErrorStats::from_pairs(position.iter().copied().zip(simulated));
-        let tracking =
-            ErrorStats::from_pairs(position.iter().copied().zip(command.iter().copied()));
-        Ok(crate::drive::StructureValidation {
-            samples: error.samples,
-            rms: error.rms,
-            max: error.max_abs,
-            fit_percent: error.fit_percent,
-            tracking_rms: tracking.rms,
-        })
-    }
-
     /// True when every estimate is identifiable or poor (no null direction).
     pub fn all_identifiable(&self) -> bool {
         self.estimates

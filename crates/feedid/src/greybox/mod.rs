@@ -12,6 +12,8 @@
 //!   coefficients N2 … N0, D7 … D0, where that map is invertible.
 //! * [`track_greybox`]: a fit per sliding window, e.g. the stiffness along
 //!   the move against the nut position.
+//! * [`GreyboxFit::validate_on`]: the fitted model simulated on another
+//!   recording of the axis.
 //!
 //! Parameter names are those a user types: [`PhysicalParameter`]
 //! (`Kv, Kp, Ki, Kvff, Kaff, Kpi, Kii, Kt, Ke, R, L, C1, C2, M, J, K, Fc, Tc`).
@@ -23,6 +25,7 @@ mod model;
 mod names;
 pub mod omitted;
 mod track;
+mod validate;
 pub mod whiteness;
 
 pub use coefficients::fit_coefficients;

@@ -825,6 +825,68 @@ mod tests {
     }
 
     #[test]
+    fn a_step_the_inverse_would_amplify_into_noise_is_smoothed_first() {
+        // no noise filter: the measured error carries its noise into the
+        // step, and the axis's inverse multiplies noise at Nyquist by
+        // |A(−1)/B(−1)| ≈ 150; a smoothed step that stays within 3× the
+        // error (`step::MAX_AMPLIFICATION`) is taken instead
+        let a = axis();
+        let desired = program();
+        // no limits either: nothing else asks for a smoother step
+        let cfg = LearnConfig {
+            noise_filter: NoiseFilter::Fixed(0.0),
+            compensate: CompensateConfig {
+                max_velocity: f64::INFINITY,
+                max_acceleration: f64::INFINITY,
+                ..CompensateConfig::default()
+            },
+            ..LearnConfig::default()
+        };
+        let y = a.simulate(&desired).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let noisy: Vec<f64> = y
+            .iter()
+            .map(|v| v + 2e-6 * (rng.random::<f64>() - 0.5) * 12f64.sqrt())
+            .collect();
+        let error: Vec<f64> = desired.iter().zip(&noisy).map(|(d, y)| d - y).collect();
+        // the unsmoothed inverse of this error is more than 3× its size,
+        // most of it amplified noise
+        let exact = CompensateConfig {
+            smoothing: super::super::Smoothing::Fixed(0.0),
+            max_velocity: f64::INFINITY,
+            max_acceleration: f64::INFINITY,
+            fallback: false,
+            ..CompensateConfig::default()
+        };
+        let raw = super::super::compensate_model(&a, &error, DT, &exact).unwrap();
+        assert!(
+            rms(&raw.command) > 3.0 * rms(&error),
+            "{} {}",
+            rms(&raw.command),
+            rms(&error)
+        );
+        let s = learn(&a, &desired, &desired, &noisy, DT, &cfg, None).unwrap();
+        assert!(s.step_smoothing_s > 0.0, "{}", s.step_smoothing_s);
+        let step: Vec<f64> = s.command.iter().zip(&desired).map(|(u, d)| u - d).collect();
+        assert!(
+            rms(&step) <= 3.0 * rms(&error),
+            "{} vs {}",
+            rms(&step),
+            rms(&error)
+        );
+        // and the next run is better for it
+        let next = a.simulate(&s.command).unwrap();
+        let after: Vec<f64> = desired.iter().zip(&next).map(|(d, y)| d - y).collect();
+        let before: Vec<f64> = desired.iter().zip(&y).map(|(d, y)| d - y).collect();
+        assert!(
+            rms(&after) < 0.5 * rms(&before),
+            "{} vs {}",
+            rms(&after),
+            rms(&before)
+        );
+    }
+
+    #[test]
     fn half_the_gain_halves_the_error_each_run() {
         // exact model, α = ½: ε_{j+1} = ½·ε_j (closed form)
         let a = axis();

@@ -76,43 +76,51 @@ pub(super) fn increment(
     };
     let base_peaks = CommandPeaks::of(base, dt, comp.start);
     let mut deltas: Vec<Option<Vec<f64>>> = vec![None; sigmas.len()];
+    let error_rms = rms(error);
     let mut g = gain;
     for _ in 0..=cfg.max_halvings {
-        let mut best: Option<Step> = None;
-        for (i, &sigma) in sigmas.iter().enumerate() {
-            if deltas[i].is_none() {
-                let inc_cfg = CompensateConfig {
-                    smoothing: Smoothing::Fixed(sigma * dt),
-                    max_velocity: f64::INFINITY,
-                    max_acceleration: f64::INFINITY,
-                    fallback: false,
-                    ..*comp
-                };
-                let eased = if cfg.ease_start {
-                    ease_in(error, moves, sigma, comp.start)
-                } else {
-                    error.to_vec()
-                };
-                deltas[i] = Some(compensate_model(model, &eased, dt, &inc_cfg)?.command);
-            }
-            let delta = deltas[i].as_deref().unwrap_or(&[]);
-            if let Some((command, held)) = held_back(base, delta, g, dt, comp, &base_peaks) {
-                let step = Step {
-                    command,
-                    gain: g,
-                    sigma,
-                    held_share: held,
-                };
-                if held <= HOLD_SHARE {
-                    return Ok(Some(step));
+        // first the steps the inverse does not amplify beyond
+        // MAX_AMPLIFICATION, then, if none of those meets the limits, any
+        for any in [false, true] {
+            let mut best: Option<Step> = None;
+            for (i, &sigma) in sigmas.iter().enumerate() {
+                if deltas[i].is_none() {
+                    let inc_cfg = CompensateConfig {
+                        smoothing: Smoothing::Fixed(sigma * dt),
+                        max_velocity: f64::INFINITY,
+                        max_acceleration: f64::INFINITY,
+                        fallback: false,
+                        ..*comp
+                    };
+                    let eased = if cfg.ease_start {
+                        ease_in(error, moves, sigma, comp.start)
+                    } else {
+                        error.to_vec()
+                    };
+                    deltas[i] = Some(compensate_model(model, &eased, dt, &inc_cfg)?.command);
                 }
-                if best.as_ref().is_none_or(|b| held < b.held_share) {
-                    best = Some(step);
+                let delta = deltas[i].as_deref().unwrap_or(&[]);
+                if !any && rms(delta) > MAX_AMPLIFICATION * error_rms {
+                    continue;
+                }
+                if let Some((command, held)) = held_back(base, delta, g, dt, comp, &base_peaks) {
+                    let step = Step {
+                        command,
+                        gain: g,
+                        sigma,
+                        held_share: held,
+                    };
+                    if held <= HOLD_SHARE {
+                        return Ok(Some(step));
+                    }
+                    if best.as_ref().is_none_or(|b| held < b.held_share) {
+                        best = Some(step);
+                    }
                 }
             }
-        }
-        if best.is_some() {
-            return Ok(best);
+            if best.is_some() {
+                return Ok(best);
+            }
         }
         g *= 0.5;
     }
@@ -140,6 +148,21 @@ fn ease_in(e: &[f64], moves: usize, sigma: f64, start: StartMode) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// Largest rms of a step `G⁻¹·e` relative to the rms of the error `e` it
+/// corrects that is taken while a smoother step meets the limits as well:
+/// a unit-gain servo's inverse needs about the error itself plus its lead
+/// (1–2×); far more is the inverse's high-frequency gain acting on what is
+/// left of the noise, which the axis does not answer as the model says.
+const MAX_AMPLIFICATION: f64 = 3.0;
+
+/// Root mean square (0 for no samples).
+fn rms(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
 /// Most rounds of widening where a step is held back.

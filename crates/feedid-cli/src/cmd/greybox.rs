@@ -59,16 +59,7 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
                 other.rate_hz(),
             )
             .with_context(|| path.display().to_string())?;
-        let _ = writeln!(
-            text,
-            "validation on {} ({} samples): rms error {:.3} µm, max {:.3} µm, fit {:.3} % (tracking error there {:.3} µm rms)",
-            path.display(),
-            v.samples,
-            1e6 * v.rms,
-            1e6 * v.max,
-            v.fit_percent,
-            1e6 * v.tracking_rms
-        );
+        let _ = writeln!(text, "{}", validation_line(path, &v));
         context.insert("validation".into(), serde_json::to_value(v)?);
     }
     write_outputs(a, &fit, track.as_deref(), &settings.estimate, context)?;
@@ -77,6 +68,19 @@ pub fn run(a: &GreyboxArgs) -> Result<()> {
         eprintln!("warning: {w}");
     }
     Ok(())
+}
+
+/// The printed line of a validation on the recording at `path`.
+fn validation_line(path: &Path, v: &feedid::drive::StructureValidation) -> String {
+    format!(
+        "validation on {} ({} samples): rms error {:.3} µm, max {:.3} µm, fit {:.3} % (tracking error there {:.3} µm rms)",
+        path.display(),
+        v.samples,
+        1e6 * v.rms,
+        1e6 * v.max,
+        v.fit_percent,
+        1e6 * v.tracking_rms
+    )
 }
 
 /// What to estimate, from where, with which model.
@@ -634,15 +638,7 @@ fn fit_structure(a: &GreyboxArgs, structure: &feedid::drive::DriveStructure) -> 
     );
     print!("{fit}");
     if let Some((path, v)) = &validation {
-        println!(
-            "validation on {} ({} samples): rms error {:.3} µm, max {:.3} µm, fit {:.3} % (tracking error there {:.3} µm rms)",
-            path.display(),
-            v.samples,
-            1e6 * v.rms,
-            1e6 * v.max,
-            v.fit_percent,
-            1e6 * v.tracking_rms
-        );
+        println!("{}", validation_line(path, v));
     }
     if let Some(i) = idim {
         println!(

@@ -6,7 +6,6 @@ use super::fit::{GreyboxConfig, GreyboxFit};
 use super::model::PhysicalModel;
 use crate::drive::StructureValidation;
 use crate::error::{Error, Result};
-use crate::stats::ErrorStats;
 
 impl GreyboxFit {
     /// Simulate the fitted model (its parameters and effects, with the
@@ -21,13 +20,6 @@ impl GreyboxFit {
         position: &[f64],
         rate_hz: f64,
     ) -> Result<StructureValidation> {
-        if command.len() != position.len() {
-            return Err(Error::LengthMismatch {
-                what: "command and position",
-                expected: command.len(),
-                actual: position.len(),
-            });
-        }
         if !(rate_hz.is_finite() && rate_hz > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "rate",
@@ -42,15 +34,6 @@ impl GreyboxFit {
             position_loop: cfg.position_loop,
         };
         let simulated = model.simulate(command, 1.0 / rate_hz)?;
-        let error = ErrorStats::from_pairs(position.iter().copied().zip(simulated));
-        let tracking =
-            ErrorStats::from_pairs(position.iter().copied().zip(command.iter().copied()));
-        Ok(StructureValidation {
-            samples: error.samples,
-            rms: error.rms,
-            max: error.max_abs,
-            fit_percent: error.fit_percent,
-            tracking_rms: tracking.rms,
-        })
+        StructureValidation::compare(command, position, &simulated)
     }
 }

@@ -453,6 +453,36 @@ pub struct StructureValidation {
     pub tracking_rms: f64,
 }
 
+impl StructureValidation {
+    /// A model's simulation `simulated` of a recording's `command` compared
+    /// with its measured `position` (all the same length), beside the
+    /// tracking error `command − position`.
+    pub fn compare(command: &[f64], position: &[f64], simulated: &[f64]) -> Result<Self> {
+        for (what, len) in [
+            ("command and position", position.len()),
+            ("command and simulated position", simulated.len()),
+        ] {
+            if len != command.len() {
+                return Err(Error::LengthMismatch {
+                    what,
+                    expected: command.len(),
+                    actual: len,
+                });
+            }
+        }
+        let error = ErrorStats::from_pairs(position.iter().copied().zip(simulated.iter().copied()));
+        let tracking =
+            ErrorStats::from_pairs(position.iter().copied().zip(command.iter().copied()));
+        Ok(Self {
+            samples: error.samples,
+            rms: error.rms,
+            max: error.max_abs,
+            fit_percent: error.fit_percent,
+            tracking_rms: tracking.rms,
+        })
+    }
+}
+
 impl DriveStructure {
     /// Simulate the structure on another recording's `command` (from its
     /// measured first position) and compare with its measured `position`.
@@ -462,26 +492,9 @@ impl DriveStructure {
         position: &[f64],
         rate_hz: f64,
     ) -> Result<StructureValidation> {
-        if command.len() != position.len() {
-            return Err(Error::LengthMismatch {
-                what: "command and position",
-                expected: command.len(),
-                actual: position.len(),
-            });
-        }
         let first = position.first().copied().unwrap_or(0.0);
         let run = self.simulate(command, rate_hz, first)?;
-        let simulated =
-            ErrorStats::from_pairs(position.iter().copied().zip(run.position.iter().copied()));
-        let tracking =
-            ErrorStats::from_pairs(position.iter().copied().zip(command.iter().copied()));
-        Ok(StructureValidation {
-            samples: simulated.samples,
-            rms: simulated.rms,
-            max: simulated.max_abs,
-            fit_percent: simulated.fit_percent,
-            tracking_rms: tracking.rms,
-        })
+        StructureValidation::compare(command, position, &run.position)
     }
 }
 

@@ -25,10 +25,12 @@
 //!   ramp `a = v·Kv`);
 //! * the model: `fit_global_model(.., Auto)` (the best of arx 8,8,1, oe 7,2
 //!   and oe 5,1 by free-run error) and its free-run position fit on the
-//!   identification run; the share of the following error it explains
-//!   ([`ModelQuality::from_run`]) on the member's own recording — the plain
-//!   program run once, with its noise and glitches, as `compensate --check`
-//!   uses it;
+//!   identification run; the share of the following error it explains on
+//!   the member's own recording — the plain program run once more, with its
+//!   noise and glitches: with `--ident program` from the two runs of the
+//!   program ([`ModelQuality::from_two_runs`], the noise taken out by their
+//!   cross-products), with `--ident chirp` from the recording alone
+//!   ([`ModelQuality::from_run`], as `compensate --check` uses it);
 //! * limits: velocity `max(2·v, 1.5·v_plain)`, acceleration
 //!   `max(1.5·a, 1.5·a_plain)` (`v_plain`, `a_plain`: the plain command's own
 //!   finite-difference peaks — limits the axis already accepts; a ramp's
@@ -39,7 +41,9 @@
 //!   sends (compensated or, on a fall-back, the plain one), same noise seed.
 //!
 //! The summary is printed as a Markdown table; `--csv FILE` writes one row
-//! per member. The expected benefit agrees with the achieved one when
+//! per member, with the model's predicted error for the command sent, the
+//! error it assumed for itself, and its true error (true position minus the
+//! model's) on the plain program and on the command sent. The expected benefit agrees with the achieved one when
 //! within a factor 2, or when both are at least
 //! [`feedid::compensate::MAX_BENEFIT`] (an expectation at that cap says
 //! "at least").
@@ -53,7 +57,10 @@
 //! against the plain command's measured rms. A member reaches the target
 //! when within the runs its measured rms is ≤ 3× the noise floor or ≥ 20×
 //! below the plain command's; it grows when one run's rms exceeds the run
-//! before by more than the noise floor.
+//! before by more than the noise floor. The axis's own repeatability is
+//! the spread of the measured rms of the command sent run three times with
+//! fresh noise (seeds `+1000`, `+2000`, `+2001`); growth beyond the noise
+//! floor plus that spread is counted beside it.
 //!
 //! **Wrong models** (`--wrong gain|delay|pole`): the identified model,
 //! written as a discrete `B(q)/A(q)` at the member's rate, is spoiled before
@@ -95,8 +102,20 @@ struct Row {
     plain_measured: f64,
     /// Noise floor √(σ² + q²/12).
     floor: f64,
+    /// Spread (largest − smallest) of the measured rms of the command sent
+    /// run three times with fresh noise: the axis's own repeatability
+    /// (learning only; 0 otherwise).
+    repeat_spread: f64,
     /// Why the learning ended early, if it did.
     learn_note: String,
+    /// The model's predicted rms error of the command sent \[m\].
+    predicted_sent_rms: f64,
+    /// The model's own error the expectation assumed \[m\].
+    model_error_assumed: f64,
+    /// rms of the true position minus the model's, plain command \[m\].
+    model_error_plain: f64,
+    /// rms of the true position minus the model's, command sent \[m\].
+    model_error_sent: f64,
 }
 
 /// What the model is identified from (`--ident`).
@@ -207,6 +226,7 @@ fn run(
     let ident = spec
         .run_plant(&command, spec.noise_seed.wrapping_add(1))
         .map_err(|e| e.to_string())?;
+    let ident_position = ident.position.clone();
     let rec = Recording::from_rate(rate, command, ident.position).map_err(|e| e.to_string())?;
     let mut file = fit_global_model(&rec, &GlobalModelKind::Auto).map_err(|e| e.to_string())?;
     file.model = spoil(&file.model, dt, wrong)?;
@@ -223,8 +243,18 @@ fn run(
             measured[g.index] = measured[g.index - 1];
         }
     }
-    let on_plain =
-        ModelQuality::from_run(&file.model, desired, &measured, dt).map_err(|e| e.to_string())?;
+    // with the program as identification run, its two runs take the noise
+    // out by their cross-products (`ModelQuality::from_two_runs`)
+    let on_plain = match ident_run {
+        IdentRun::Program => ModelQuality::from_two_runs(
+            &file.model,
+            (rec.command(), &ident_position),
+            (desired, &measured),
+            dt,
+        ),
+        IdentRun::Chirp => ModelQuality::from_run(&file.model, desired, &measured, dt),
+    }
+    .map_err(|e| e.to_string())?;
     let quality = ModelQuality {
         position_fit_percent: on_chirp.position_fit_percent,
         error_fit_percent: on_plain.error_fit_percent,
@@ -241,23 +271,34 @@ fn run(
         unit_dc_gain: wrong != Wrong::Gain,
         ..CompensateConfig::default()
     };
-    let (command, sent, predicted_benefit) = match compensate_model(&file.model, desired, dt, &cfg)
-    {
-        Ok(c) => {
-            let sent = match &c.fallback {
-                None => "compensated".to_string(),
-                Some(f) => format!("plain: {f}"),
-            };
-            (c.command, sent, c.benefit.expected_benefit)
-        }
-        Err(e) => (desired.clone(), format!("refused: {e}"), f64::NAN),
-    };
+    let (command, sent, predicted_benefit, outcome) =
+        match compensate_model(&file.model, desired, dt, &cfg) {
+            Ok(c) => {
+                let sent = match &c.fallback {
+                    None => "compensated".to_string(),
+                    Some(f) => format!("plain: {f}"),
+                };
+                let b = c.benefit.expected_benefit;
+                (c.command.clone(), sent, b, Some(c))
+            }
+            Err(e) => (desired.clone(), format!("refused: {e}"), f64::NAN, None),
+        };
     let plain = spec
         .run_plant(desired, spec.noise_seed)
         .map_err(|e| e.to_string())?;
     let comp = spec
         .run_plant(&command, spec.noise_seed)
         .map_err(|e| e.to_string())?;
+    let (predicted_sent_rms, model_error_assumed, model_error_plain, model_error_sent) =
+        match &outcome {
+            Some(c) => (
+                c.predicted_error.rms,
+                c.benefit.model_error_rms_m,
+                rms_against(&plain.truth, &c.predicted_plain),
+                rms_against(&comp.truth, &c.predicted),
+            ),
+            None => (f64::NAN, f64::NAN, f64::NAN, f64::NAN),
+        };
     // learning from runs: run 1 is the command sent, each run fresh noise
     let measured_rms = |p: &[f64]| rms_against(p, desired);
     let mut sent_cmd = command.clone();
@@ -316,6 +357,22 @@ fn run(
         }
     }
     let floor = (spec.noise_std_m.powi(2) + spec.resolution_m.powi(2) / 12.0).sqrt();
+    // the same command run again with fresh noise: how much the measured rms
+    // of one run varies by itself
+    let mut repeat_spread = 0.0;
+    if runs > 1 {
+        let mut v = vec![run_rms[0]];
+        for s in [2000, 2001] {
+            let r = spec
+                .run_plant(&command, spec.noise_seed.wrapping_add(s))
+                .map_err(|e| e.to_string())?;
+            v.push(measured_rms(&r.position));
+        }
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(l, h), x| (l.min(*x), h.max(*x)));
+        repeat_spread = hi - lo;
+    }
     let prov = file.identified_by.as_ref();
     Ok(Row {
         index,
@@ -332,7 +389,12 @@ fn run(
         runs: run_rms,
         plain_measured: measured_rms(&plain.position),
         floor,
+        repeat_spread,
         learn_note,
+        predicted_sent_rms,
+        model_error_assumed,
+        model_error_plain,
+        model_error_sent,
     })
 }
 
@@ -344,6 +406,11 @@ fn learning_summary(rows: &[Row], runs: usize) {
             .any(|&v| v <= 3.0 * r.floor || v <= r.plain_measured / 20.0)
     };
     let grows = |r: &Row| r.runs.windows(2).any(|w| w[1] > w[0] + r.floor);
+    let grows_beyond_repeat = |r: &Row| {
+        r.runs
+            .windows(2)
+            .any(|w| w[1] > w[0] + r.floor + r.repeat_spread)
+    };
     println!("\nlearning from runs (measured rms, with the noise):\n");
     println!("| run | median rms / noise floor | median plain / rms | at target by this run | grew since the run before |");
     println!("|---:|---:|---:|---:|---:|");
@@ -397,16 +464,21 @@ fn learning_summary(rows: &[Row], runs: usize) {
         rows.len(),
         rows.iter().filter(|r| grows(r)).count()
     );
+    println!(
+        "{} grew by more than the noise and the axis's own repeatability (the spread of the measured rms of the first command run three times)",
+        rows.iter().filter(|r| grows_beyond_repeat(r)).count()
+    );
     for r in missed
         .iter()
         .chain(rows.iter().filter(|r| grows(r)).collect::<Vec<_>>().iter())
     {
         println!(
-            "  #{} {} ({}): floor {:.3} µm, plain {:.3} µm, runs {} µm{}",
+            "  #{} {} ({}): floor {:.3} µm, repeatability {:.3} µm, plain {:.3} µm, runs {} µm{}",
             r.index,
             r.label,
             r.model,
             1e6 * r.floor,
+            1e6 * r.repeat_spread,
             1e6 * r.plain_measured,
             r.runs
                 .iter()
@@ -629,11 +701,11 @@ fn main() {
     }
     if let Some(path) = csv {
         let mut text = String::from(
-            "index,kind,feed_forward,model,fit_percent,error_fit_percent,plain_rms_m,sent_rms_m,reduction,predicted_benefit,sent,label\n",
+            "index,kind,feed_forward,model,fit_percent,error_fit_percent,plain_rms_m,sent_rms_m,reduction,predicted_benefit,predicted_sent_rms_m,model_error_assumed_m,model_error_plain_m,model_error_sent_m,sent,label\n",
         );
         for r in &rows {
             text.push_str(&format!(
-                "{},{},{},\"{}\",{:.3},{:.3},{:e},{:e},{:.4},{:.4},\"{}\",\"{}\"\n",
+                "{},{},{},\"{}\",{:.3},{:.3},{:e},{:e},{:.4},{:.4},{:e},{:e},{:e},{:e},\"{}\",\"{}\"\n",
                 r.index,
                 r.kind,
                 r.feed_forward,
@@ -644,6 +716,10 @@ fn main() {
                 r.sent_rms,
                 r.plain_rms / r.sent_rms,
                 r.predicted_benefit,
+                r.predicted_sent_rms,
+                r.model_error_assumed,
+                r.model_error_plain,
+                r.model_error_sent,
                 r.sent.replace('"', "'"),
                 r.label.replace('"', "'")
             ));

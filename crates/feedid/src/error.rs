@@ -355,6 +355,17 @@ pub enum Error {
         actual: f64,
     },
 
+    /// Two runs that should be of the same program have different commands.
+    #[error("the two check runs are not of the same program: their commands differ at sample {sample} ({} m against {} m); two runs of one program are needed", short_number(*first), short_number(*second))]
+    DifferentPrograms {
+        /// First sample where they differ.
+        sample: usize,
+        /// The first run's command there \[m\].
+        first: f64,
+        /// The second run's \[m\].
+        second: f64,
+    },
+
     /// A smoothing (σ of the Gaussian) longer than a compensation may use:
     /// its buffers grow with its square.
     #[error("{what} {} s is {samples:.0} samples at this rate, more than the {max_samples} samples ({} s) a compensation smooths over", short_number(*seconds), short_number(*max_seconds))]

@@ -29,9 +29,20 @@
 //! ```text
 //! e_model    = (1 − fit_e/100)·rms(e_plain)                  (error fit known: --check)
 //!            = (1 − fit_y/100)·rms(y_d − mean(y_d))          (else: the position fit)
-//! e_expected = max(rms(e_comp) + e_model, rms(e_plain)/1000)
+//! e_expected = max(√(rms(e_comp)² + e_model²), rms(e_plain)/1000)
 //! benefit    = rms(e_plain) / e_expected                     (≤ 1000, MAX_BENEFIT)
 //! ```
+//!
+//! The model's error and the residual it predicts add in quadrature: what
+//! the model misses is uncorrelated with what it predicts (their plain sum
+//! would double the expectation where the two are of one size).
+//!
+//! With **two runs of the same program** ([`ModelQuality::from_two_runs`]:
+//! the identification run and a check run) the noise is taken out by the
+//! cross-products of the two runs' residuals instead of an estimate of its
+//! level: independent between the runs, it leaves `Σ r₁·r₂` the noise-free
+//! squared error in expectation, whatever its spectrum (an encoder's
+//! rounding, constant at rest, is invisible to second differences).
 //!
 //! The second form scales the model's free-run error on its identification
 //! recording (a share `1 − fit_y` of that recording's motion) to the motion
@@ -143,6 +154,123 @@ impl ModelQuality {
         rows: &[usize],
         dt: f64,
     ) -> Result<Self> {
+        let run = FreeRun::of(model, grid, command, position, rows, dt)?;
+        // the measurement noise is in the residual and in the following
+        // error alike, and no model explains it: both without it
+        let noise = noise_level_of_run(&run.residual, position);
+        Ok(Self {
+            position_fit_percent: run.position_fit(noise),
+            error_fit_percent: error_fit_percent(&run.residual, &run.following, noise),
+            noise_rms_m: Some(noise),
+        })
+    }
+
+    /// Both fits of `model` from **two runs of the same command** on the
+    /// axis (`first` and `second`: command and measured position, equal
+    /// lengths, at interval `dt` \[s\]), with the noise taken out by
+    /// their cross-products instead of an estimate of its level: the
+    /// measurement noise of two runs is independent, what the model does
+    /// not explain is the same in both, so
+    ///
+    /// ```text
+    /// ‖y − ŷ‖²_sys = Σ r₁·r₂,   ‖f − f̄‖²_sys = Σ (f₁ − f̄₁)·(f₂ − f̄₂)   (r = y − ŷ, f = y − u)
+    /// ```
+    ///
+    /// are the noise-free squared norms in expectation, whatever the noise's
+    /// spectrum — an encoder's rounding, constant at rest and slowly varying
+    /// in slow motion, escapes the second differences a single run's noise
+    /// level is estimated from ([`ModelQuality::from_run`]) and would count
+    /// as the model's error. The position fit and the noise level are the
+    /// second run's ([`ModelQuality::from_run`]). The commands must agree
+    /// (to a millionth of their range; else [`Error::DifferentPrograms`]).
+    ///
+    /// ```
+    /// use feedid::compensate::ModelQuality;
+    /// use feedid::ident::LinearModel;
+    /// let m = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+    /// let u: Vec<f64> = (0..2000).map(|k| ((k / 200) % 2) as f64).collect();
+    /// let y = m.simulate(&u).unwrap();
+    /// // two runs with independent "noise" of ±0.01
+    /// let y1: Vec<f64> = y.iter().enumerate().map(|(k, v)| v + 0.01 * ((k * 7 % 13) as f64 - 6.0) / 6.0).collect();
+    /// let y2: Vec<f64> = y.iter().enumerate().map(|(k, v)| v + 0.01 * ((k * 5 % 11) as f64 - 5.0) / 5.0).collect();
+    /// let q = ModelQuality::from_two_runs(&m, (&u, &y1), (&u, &y2), 1e-3).unwrap();
+    /// assert!(q.error_fit_percent.unwrap() > 95.0);
+    /// ```
+    pub fn from_two_runs(
+        model: &LinearModel,
+        first: (&[f64], &[f64]),
+        second: (&[f64], &[f64]),
+        dt: f64,
+    ) -> Result<Self> {
+        let (u1, y1) = first;
+        let (u2, y2) = second;
+        for (what, u, y) in [
+            ("command and position of the first model check run", u1, y1),
+            ("command and position of the second model check run", u2, y2),
+            ("commands of the two model check runs", u1, u2),
+        ] {
+            if u.len() != y.len() {
+                return Err(Error::LengthMismatch {
+                    what,
+                    expected: u.len(),
+                    actual: y.len(),
+                });
+            }
+        }
+        let range = u1.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v))
+            - u1.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+        if let Some(k) = (0..u1.len()).find(|&k| (u1[k] - u2[k]).abs() > 1e-6 * range.max(0.0)) {
+            return Err(Error::DifferentPrograms {
+                sample: k,
+                first: u1[k],
+                second: u2[k],
+            });
+        }
+        let rows: Vec<usize> = (0..u1.len()).collect();
+        let a = FreeRun::of(model, u1, u1, y1, &rows, dt)?;
+        let b = FreeRun::of(model, u2, u2, y2, &rows, dt)?;
+        let noise = noise_level_of_run(&b.residual, y2);
+        let n = a.following.len() as f64;
+        let (mf1, mf2) = (
+            a.following.iter().sum::<f64>() / n,
+            b.following.iter().sum::<f64>() / n,
+        );
+        let (mut rr, mut ff) = (0.0, 0.0);
+        for k in 0..a.residual.len() {
+            rr += a.residual[k] * b.residual[k];
+            ff += (a.following[k] - mf1) * (b.following[k] - mf2);
+        }
+        let error_fit =
+            (ff > 0.0 && rr.is_finite()).then(|| 100.0 * (1.0 - (rr.max(0.0) / ff).sqrt()));
+        Ok(Self {
+            position_fit_percent: b.position_fit(noise),
+            error_fit_percent: error_fit,
+            noise_rms_m: Some(noise),
+        })
+    }
+}
+
+/// A model run free on a recording of the axis: its residual `y − ŷ` and
+/// the following error `y − u` at the measured samples.
+struct FreeRun {
+    residual: Vec<f64>,
+    following: Vec<f64>,
+    /// `Σ (y − ȳ)²`.
+    ssy: f64,
+}
+
+impl FreeRun {
+    /// The model (deviations from the first sample, rescaled to unit DC
+    /// gain as the compensation uses it) run on `grid`, compared at grid
+    /// index `rows[j]` with `command[j]`, `position[j]`.
+    fn of(
+        model: &LinearModel,
+        grid: &[f64],
+        command: &[f64],
+        position: &[f64],
+        rows: &[usize],
+        dt: f64,
+    ) -> Result<Self> {
         if command.len() < 10 {
             return Err(Error::TooFewSamples {
                 what: "a model check",
@@ -150,7 +278,17 @@ impl ModelQuality {
                 actual: command.len(),
             });
         }
-        let (u0, y0) = (grid[0], position[0]);
+        // the model starts from rest at the first sample's position: the
+        // mean over the rest before the command moves, so that one sample's
+        // noise does not offset the whole residual
+        let u0 = grid[0];
+        let scale = command.iter().fold(0.0_f64, |m, v| m.max((v - u0).abs()));
+        let rest = command
+            .iter()
+            .position(|v| (v - u0).abs() > 1e-12 * scale)
+            .unwrap_or(command.len())
+            .max(1);
+        let y0 = position[..rest].iter().sum::<f64>() / rest as f64;
         let (model, _) = model.without_negligible_pairs(dt * grid.len() as f64)?;
         let model = &model;
         let dev: Vec<f64> = grid.iter().map(|u| u - u0).collect();
@@ -164,30 +302,26 @@ impl ModelQuality {
         }
         let n = command.len() as f64;
         let mean_y = position.iter().sum::<f64>() / n;
-        let (mut sse, mut ssy) = (0.0, 0.0);
+        let mut ssy = 0.0;
         let mut residual = Vec::with_capacity(rows.len());
         let mut following = Vec::with_capacity(rows.len());
         for (k, &i) in rows.iter().enumerate() {
-            let yhat = y0 + yd[i];
-            residual.push(position[k] - yhat);
+            residual.push(position[k] - (y0 + yd[i]));
             following.push(position[k] - command[k]);
-            sse += (position[k] - yhat).powi(2);
             ssy += (position[k] - mean_y).powi(2);
         }
-        // the measurement noise is in the residual and in the following
-        // error alike, and no model explains it: both without it
-        let noise = noise_level_of_run(&residual, position);
-        let sse = (sse - noise * noise * rows.len() as f64).max(0.0);
-        let position_fit = if ssy > 0.0 && sse.is_finite() {
-            Some(100.0 * (1.0 - (sse / ssy).sqrt()))
-        } else {
-            None
-        };
         Ok(Self {
-            position_fit_percent: position_fit,
-            error_fit_percent: error_fit_percent(&residual, &following, noise),
-            noise_rms_m: Some(noise),
+            residual,
+            following,
+            ssy,
         })
+    }
+
+    /// Free-run position fit \[%\] without a noise of `noise` per sample.
+    fn position_fit(&self, noise: f64) -> Option<f64> {
+        let sse = self.residual.iter().map(|r| r * r).sum::<f64>();
+        let sse = (sse - noise * noise * self.residual.len() as f64).max(0.0);
+        (self.ssy > 0.0 && sse.is_finite()).then(|| 100.0 * (1.0 - (sse / self.ssy).sqrt()))
     }
 }
 
@@ -242,7 +376,9 @@ impl Benefit {
         // beyond that the axis's noise, its encoder and the model's own
         // rounding decide, and a model of unknown error would otherwise
         // promise a billion-fold gain
-        let expected = (compensated_rms + model_error).max(plain_rms / MAX_BENEFIT);
+        let expected = compensated_rms
+            .hypot(model_error)
+            .max(plain_rms / MAX_BENEFIT);
         let expected_benefit = if expected > 0.0 {
             plain_rms / expected
         } else if plain_rms > 0.0 {
@@ -394,15 +530,17 @@ mod tests {
     }
 
     #[test]
-    fn benefit_adds_the_unexplained_share() {
+    fn benefit_adds_the_unexplained_share_in_quadrature() {
         let q = ModelQuality {
             position_fit_percent: Some(99.0),
             error_fit_percent: Some(90.0),
             noise_rms_m: None,
         };
+        // 0.5 predicted, 10 % of 10 unexplained: √(0.5² + 1²)
         let b = Benefit::new(10.0, 0.5, 1000.0, &q);
-        assert!((b.expected_compensated_rms_m - 1.5).abs() < 1e-12);
-        assert!((b.expected_benefit - 10.0 / 1.5).abs() < 1e-12);
+        let want = (0.25_f64 + 1.0).sqrt();
+        assert!((b.expected_compensated_rms_m - want).abs() < 1e-12);
+        assert!((b.expected_benefit - 10.0 / want).abs() < 1e-12);
         assert_eq!(b.model_error_from, ModelErrorSource::ErrorFit);
         let b = Benefit::new(10.0, 0.5, 1000.0, &ModelQuality::default());
         assert!((b.expected_benefit - 20.0).abs() < 1e-12);
@@ -422,7 +560,8 @@ mod tests {
         let b = Benefit::new(109e-6, 0.01e-6, 7e-3, &q);
         assert_eq!(b.model_error_from, ModelErrorSource::PositionFit);
         assert!((b.model_error_rms_m - 4.9e-6).abs() < 1e-12, "{b:?}");
-        assert!((b.expected_benefit - 109.0 / 4.91).abs() < 1e-9, "{b:?}");
+        let want = 109.0 / 0.01_f64.hypot(4.9);
+        assert!((b.expected_benefit - want).abs() < 1e-9, "{b:?}");
         // a fit above 100 % or below 0 is clamped to a share in [0, 1]
         let q = ModelQuality {
             position_fit_percent: Some(-50.0),
@@ -430,5 +569,83 @@ mod tests {
             noise_rms_m: None,
         };
         assert!((Benefit::new(1.0, 0.0, 2.0, &q).model_error_rms_m - 2.0).abs() < 1e-15);
+    }
+
+    /// A lag, an axis 10 % slower, and two runs with independent noise of
+    /// `noise` rms (seeded), slowly varying (a moving average over 50
+    /// samples: as an encoder's rounding in slow motion) when `slow`.
+    fn two_noisy_runs(
+        noise: f64,
+        slow: bool,
+    ) -> (LinearModel, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        use rand::{Rng, SeedableRng};
+        let model = LinearModel::discrete(vec![0.0, 0.2], vec![1.0, -0.8], 1e-3).unwrap();
+        let axis = LinearModel::discrete(vec![0.0, 0.18], vec![1.0, -0.82], 1e-3).unwrap();
+        let u: Vec<f64> = (0..4000)
+            .map(|k| 1e-3 * ((k as f64 - 200.0) / 800.0).clamp(0.0, 1.0))
+            .collect();
+        let y = axis.simulate(&u).unwrap();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        let mut noisy = || -> Vec<f64> {
+            let w: Vec<f64> = (0..y.len() + 50)
+                .map(|_| 3.0_f64.sqrt() * (2.0 * rng.random::<f64>() - 1.0))
+                .collect();
+            y.iter()
+                .enumerate()
+                .map(|(k, v)| {
+                    let n = if slow {
+                        w[k..k + 50].iter().sum::<f64>() / 50.0_f64.sqrt()
+                    } else {
+                        w[k]
+                    };
+                    v + noise * n
+                })
+                .collect()
+        };
+        let (y1, y2) = (noisy(), noisy());
+        (model, u, y, y1, y2)
+    }
+
+    #[test]
+    fn two_runs_take_out_slowly_varying_noise_one_run_cannot() {
+        // the noise-free share of the following error the model misses
+        let (model, u, y, _, _) = two_noisy_runs(0.0, false);
+        let missed = |q: ModelQuality| 1.0 - q.error_fit_percent.unwrap() / 100.0;
+        let exact = missed(ModelQuality::from_run(&model, &u, &y, 1e-3).unwrap());
+        assert!(exact > 0.05 && exact < 0.3, "{exact}");
+        // white noise up to a third of the following error (6.2 µm at the
+        // ramp's speed), or slowly varying noise (fewer independent samples)
+        // up to a tenth of it: the cross-products find that share to within
+        // 1.5×
+        for (slow, levels) in [(false, [1e-7, 1e-6, 2e-6]), (true, [1e-7, 3e-7, 5e-7])] {
+            for noise in levels {
+                let (model, u, _, y1, y2) = two_noisy_runs(noise, slow);
+                let q = ModelQuality::from_two_runs(&model, (&u, &y1), (&u, &y2), 1e-3).unwrap();
+                let m = missed(q);
+                assert!(
+                    m < 1.5 * exact && m > exact / 1.5,
+                    "noise {noise} (slow: {slow}): {m} against {exact}"
+                );
+            }
+        }
+        // one run cannot tell slowly varying noise from the model's error
+        let (model, u, _, _, y2) = two_noisy_runs(5e-7, true);
+        let one = missed(ModelQuality::from_run(&model, &u, &y2, 1e-3).unwrap());
+        assert!(one > 1.5 * exact, "{one} against {exact}");
+    }
+
+    #[test]
+    fn two_runs_of_different_programs_are_refused() {
+        let (model, u, _, y1, y2) = two_noisy_runs(1e-7, false);
+        let mut other = u.clone();
+        other[1000] += 1e-4;
+        let e = ModelQuality::from_two_runs(&model, (&u, &y1), (&other, &y2), 1e-3).unwrap_err();
+        assert!(
+            matches!(e, Error::DifferentPrograms { sample: 1000, .. }),
+            "{e}"
+        );
+        let e = ModelQuality::from_two_runs(&model, (&u, &y1), (&u[..10], &y2[..10]), 1e-3)
+            .unwrap_err();
+        assert!(matches!(e, Error::LengthMismatch { .. }), "{e}");
     }
 }

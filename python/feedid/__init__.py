@@ -793,6 +793,8 @@ def compensate(
         measured for the fall-back (``--check``); default the model's own
         fit. Identified models only. Dropped samples are read as gaps: the
         model runs through them and only the measured samples are compared.
+        A list of two of them: two complete runs of the same program, whose
+        noise is taken out by their cross-products (``--check a --check b``).
 
     Returns
     -------
@@ -820,18 +822,25 @@ def compensate(
         if smooth.strip() != "auto":
             raise InputError(f"invalid smooth `{smooth}`: expected a time in seconds or auto")
         smooth = None
-    if check is None or isinstance(check, Recording):
-        check_rec = check
-    elif isinstance(check, Identification):
-        check_rec = check.recording
-    elif isinstance(check, (str, bytes, os.PathLike)):
-        # (dropped samples: the model runs through them, as ``--check``)
-        check_rec = read(check, allow_gaps=True)
-    else:
-        t, u, y = check
-        check_rec = Recording(
-            _array(t, "time"), _array(u, "command"), _array(y, "position"), allow_gaps=True
+    def as_check(c: Any, allow_gaps: bool) -> Optional[Recording]:
+        if c is None or isinstance(c, Recording):
+            return c
+        if isinstance(c, Identification):
+            return c.recording
+        if isinstance(c, (str, bytes, os.PathLike)):
+            # (dropped samples: the model runs through them, as ``--check``)
+            return read(c, allow_gaps=allow_gaps)
+        t, u, y = c
+        return Recording(
+            _array(t, "time"), _array(u, "command"), _array(y, "position"), allow_gaps=allow_gaps
         )
+
+    check_rec, check2_rec = None, None
+    if isinstance(check, list) and len(check) == 2:
+        # two complete runs of the same program
+        check_rec, check2_rec = as_check(check[0], False), as_check(check[1], False)
+    else:
+        check_rec = as_check(check, True)
     command, predicted, summary = _feedid.compensate(
         _array(time, "time"),
         _array(desired, "desired"),
@@ -847,6 +856,7 @@ def compensate(
         min_fit=min_fit,
         fallback=fallback,
         check=check_rec,
+        check2=check2_rec,
         **kw,
     )
     out: Dict[str, Any] = json.loads(summary)

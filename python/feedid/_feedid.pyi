@@ -203,6 +203,7 @@ def compensate(
     min_fit: float = 90.0,
     fallback: bool = True,
     check: Optional[Recording] = None,
+    check2: Optional[Recording] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], str]: ...
 
 def learn(

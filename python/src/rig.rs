@@ -120,7 +120,8 @@ fn quality(file: &ModelFile) -> ModelQuality {
 #[pyo3(signature = (time, desired, *, model_json = None, model_path = None, params_path = None,
     params_json = None, position_loop = "sampled", smooth = None, max_smoothing = 0.02,
     max_velocity = 1.0, max_acceleration = 30.0, keep_dc_gain = false, allow_unstable = false,
-    start = "rest", min_benefit = 1.25, min_fit = 90.0, fallback = true, check = None))]
+    start = "rest", min_benefit = 1.25, min_fit = 90.0, fallback = true, check = None,
+    check2 = None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn compensate<'py>(
     py: Python<'py>,
@@ -142,7 +143,20 @@ pub fn compensate<'py>(
     min_fit: f64,
     fallback: bool,
     check: Option<&Bound<'py, PyRecording>>,
+    check2: Option<&Bound<'py, PyRecording>>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, String)> {
+    // one recording of the axis, or two runs of the same program
+    let checked = |file: &ModelFile| -> PyResult<ModelQuality> {
+        match (check, check2) {
+            (Some(a), Some(b)) => {
+                ModelQuality::from_two_recordings(&file.model, &a.get().inner, &b.get().inner)
+                    .map_err(|e| input(format!("check: {e}")))
+            }
+            (Some(c), None) => ModelQuality::from_recording(&file.model, &c.get().inner)
+                .map_err(|e| input(format!("check: {e}"))),
+            (None, _) => Ok(quality(file)),
+        }
+    };
     let (t, x) = (slice(&time, "time")?, slice(&desired, "desired")?);
     // the desired trajectory is checked as a recording (time increasing, finite)
     let rec = Recording::new(t.to_vec(), x.to_vec(), x.to_vec()).py_err()?;
@@ -163,22 +177,14 @@ pub fn compensate<'py>(
     let comp = match (model_json, model_path) {
         (Some(text), _) => {
             let file = ModelFile::from_json(&text).py_err()?;
-            cfg.quality = match check {
-                Some(c) => ModelQuality::from_recording(&file.model, &c.get().inner)
-                    .map_err(|e| input(format!("check: {e}")))?,
-                None => quality(&file),
-            };
+            cfg.quality = checked(&file)?;
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))
                 .py_err()?
         }
         (None, Some(path)) => {
             let text = feedid::io::read_small_text(Path::new(&path)).py_err()?;
             let file = ModelFile::from_json_file(&text, Path::new(&path)).py_err()?;
-            cfg.quality = match check {
-                Some(c) => ModelQuality::from_recording(&file.model, &c.get().inner)
-                    .map_err(|e| input(format!("check: {e}")))?,
-                None => quality(&file),
-            };
+            cfg.quality = checked(&file)?;
             py.detach(|| compensate_model(&file.model, rec.position(), dt, &cfg))
                 .map_err(|e| input(format!("{path}: {e}")))?
         }

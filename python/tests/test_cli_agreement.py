@@ -135,14 +135,17 @@ def test_identify_equals_the_cli_on_emps(cli, tmp_path, emps):
         ({"min_fit": 99.999}, ["--min-fit", 99.999], "poor_fit"),
         ({"check": "CHECK"}, ["--check", "CHECK"], None),
         ({"check": "CHECK", "min_fit": 99.99}, ["--check", "CHECK", "--min-fit", 99.99], "poor_fit"),
+        # two runs of one program: the noise out by cross-products
+        ({"check": ["CHECK", "CHECK2"]}, ["--check", "CHECK", "--check", "CHECK2"], None),
     ],
 )
 def test_compensate_equals_the_cli_with_its_options(cli, tmp_path, py_options, cli_options, fallback):
     rec_path, model_path = tmp_path / "prbs.csv", tmp_path / "model.json"
     cli("simulate", "--scenario", "prbs", "--seed", 2, "-o", rec_path)
     cli("identify", rec_path, "--method", "arx", "-o", tmp_path / "p.csv", "--model-out", model_path)
-    check_path = tmp_path / "check.csv"
+    check_path, check2_path = tmp_path / "check.csv", tmp_path / "check2.csv"
     cli("simulate", "--scenario", "chirp", "--seed", 3, "-o", check_path)
+    cli("simulate", "--scenario", "chirp", "--seed", 4, "-o", check2_path)
     # a desired trajectory cut from a move: it starts at a small speed
     # (from rest, the compensated command would exceed 30 m/s²)
     t = np.arange(3000) * 2e-4
@@ -153,8 +156,15 @@ def test_compensate_equals_the_cli_with_its_options(cli, tmp_path, py_options, c
     py_options = {"start": "moving", **py_options}
     if "--start" not in cli_options:
         cli_options = ["--start", "moving", *cli_options]
-    py_options = {k: (feedid.read(check_path) if v == "CHECK" else v) for k, v in py_options.items()}
-    cli_options = [check_path if v == "CHECK" else v for v in cli_options]
+    paths = {"CHECK": check_path, "CHECK2": check2_path}
+
+    def as_py(v):
+        if isinstance(v, list):
+            return [as_py(x) for x in v]
+        return feedid.read(paths[v]) if isinstance(v, str) and v in paths else v
+
+    py_options = {k: as_py(v) for k, v in py_options.items()}
+    cli_options = [paths.get(v, v) if isinstance(v, str) else v for v in cli_options]
     out_path, summary_path = tmp_path / "c.csv", tmp_path / "c.json"
     cli("compensate", "--desired", desired_path, "--model", model_path, "-o", out_path,
         "--summary", summary_path, *cli_options)

@@ -658,9 +658,9 @@ pub struct CompensateArgs {
     /// Always send the compensated command (no fall-back to the plain one).
     #[arg(long)]
     pub no_fallback: bool,
-    /// A recording of the axis (time_s,command_m,position_m; e.g. the identification run) on which the model's fits are measured for the fall-back [default: the model file's fit].
-    #[arg(long, value_name = "rec.csv", requires = "model")]
-    pub check: Option<PathBuf>,
+    /// A recording of the axis (time_s,command_m,position_m; e.g. the identification run) on which the model's fits are measured for the fall-back [default: the model file's fit]. Given twice, two complete runs of the same program: the noise is taken out by their cross-products.
+    #[arg(long, value_name = "rec.csv", requires = "model", action = clap::ArgAction::Append)]
+    pub check: Vec<PathBuf>,
     /// Use an unstable physical model anyway (its simulation diverges; refused by default).
     #[arg(long)]
     pub allow_unstable: bool,

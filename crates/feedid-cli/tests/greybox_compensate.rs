@@ -853,3 +853,98 @@ fn compensate_slews_a_slow_axis_to_its_lead_within_the_limits_and_says_so() {
     let benefit = s["benefit"]["expected_benefit"].as_f64().unwrap();
     assert!(benefit > 4.0, "{benefit}");
 }
+
+/// A run of a 0.1 m/s ramp through a 10 ms lag at 1 kHz (the exact
+/// zero-order-hold sampling of `1/(0.01·s + 1)`), with white noise of
+/// `noise` m from a seeded generator; `shift` moves the ramp's start.
+fn lag_run(path: &Path, seed: u64, noise: f64, shift: usize) {
+    let a = (-0.1_f64).exp();
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut text = String::from("time_s,command_m,position_m\n");
+    let (mut y, mut u_last) = (0.0, 0.0);
+    for k in 0..3000 {
+        let u = 1e-4 * (k as f64 - 200.0 - shift as f64).clamp(0.0, 1500.0);
+        if k > 0 {
+            y = a * y + (1.0 - a) * u_last;
+        }
+        u_last = u;
+        let n = noise * 3.0_f64.sqrt() * (2.0 * uniform() - 1.0);
+        text.push_str(&format!("{},{u},{}\n", k as f64 * 1e-3, y + n));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn compensate_checks_the_model_on_two_runs_of_the_program_without_their_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("lag.json");
+    std::fs::write(
+        &model,
+        r#"{"model": {"kind": "continuous", "num": [1.0], "den": [0.01, 1.0]}}"#,
+    )
+    .unwrap();
+    let (run1, run2, other) = (
+        dir.path().join("run1.csv"),
+        dir.path().join("run2.csv"),
+        dir.path().join("other.csv"),
+    );
+    lag_run(&run1, 1, 20e-6, 0);
+    lag_run(&run2, 2, 20e-6, 0);
+    lag_run(&other, 3, 20e-6, 5);
+    let cmd = dir.path().join("cmd.csv");
+    let summary = dir.path().join("s.json");
+    let compensate = |checks: &[&Path]| {
+        let mut args = vec![
+            "compensate",
+            "--desired",
+            p(&run1),
+            "--desired-column",
+            "command_m",
+            "--model",
+            p(&model),
+            "--max-velocity",
+            "1",
+            "--max-acceleration",
+            "1000",
+            "-o",
+            p(&cmd),
+            "--summary",
+            p(&summary),
+        ];
+        for c in checks {
+            args.extend(["--check", p(c)]);
+        }
+        feedid(&args)
+    };
+    // the model is exact: two runs leave its error at nothing but the
+    // chance products of independent noise (20 µm against a 1 mm lag)
+    let o = compensate(&[&run1, &run2]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("on the two --check runs"), "{out}");
+    let b = &json(&summary)["benefit"];
+    let (error, plain) = (
+        b["model_error_rms_m"].as_f64().unwrap(),
+        b["predicted_plain_rms_m"].as_f64().unwrap(),
+    );
+    assert!(error < 2e-3 * plain, "{error} of {plain}");
+    // two runs of different programs: refused, both named, nothing written
+    std::fs::remove_file(&cmd).unwrap();
+    let o = compensate(&[&run1, &other]);
+    assert_fails(
+        &o,
+        &["run1.csv and", "other.csv", "not of the same program"],
+    );
+    assert!(!cmd.exists());
+    // three: refused
+    let o = compensate(&[&run1, &run2, &other]);
+    assert_fails(&o, &["--check given 3 times"]);
+}

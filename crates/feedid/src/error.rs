@@ -366,6 +366,16 @@ pub enum Error {
         second: f64,
     },
 
+    /// One of two check runs has dropped samples: the cross-products of two
+    /// runs need both complete.
+    #[error("check run {run} has {dropped} dropped samples: two check runs must both be complete recordings of the program (a run with gaps can be the only check)")]
+    GapsInCheckRun {
+        /// Which run (1 or 2).
+        run: usize,
+        /// Samples dropped in it.
+        dropped: usize,
+    },
+
     /// A smoothing (σ of the Gaussian) longer than a compensation may use:
     /// its buffers grow with its square.
     #[error("{what} {} s is {samples:.0} samples at this rate, more than the {max_samples} samples ({} s) a compensation smooths over", short_number(*seconds), short_number(*max_seconds))]

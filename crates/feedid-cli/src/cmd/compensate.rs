@@ -80,7 +80,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
     ins.extend(a.params.as_deref());
     ins.extend(a.rig.as_deref());
     ins.extend(a.effects.as_deref());
-    ins.extend(a.check.as_deref());
+    ins.extend(a.check.iter().map(|p| p.as_path()));
     let mut outs = vec![a.output.as_path()];
     outs.extend(a.verify_out.as_deref());
     outs.extend(a.summary.as_deref());
@@ -118,7 +118,7 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         rec.len(),
         rec.rate_hz()
     );
-    describe(&mut text, &comp, &cfg.quality, a.check.is_some());
+    describe(&mut text, &comp, &cfg.quality, a.check.len());
 
     let command = Command {
         rec: &rec,
@@ -144,8 +144,8 @@ fn from_model(
     cfg: &mut CompensateConfig,
 ) -> Result<(String, Compensation)> {
     let file = crate::cmd::load_model_file(path)?;
-    cfg.quality = match &a.check {
-        Some(check) => {
+    cfg.quality = match a.check.as_slice() {
+        [check] => {
             // (dropped samples: the model runs through them)
             let opts = ReadOptions {
                 allow_gaps: true,
@@ -155,8 +155,16 @@ fn from_model(
             ModelQuality::from_recording(&file.model, &r)
                 .with_context(|| check.display().to_string())?
         }
-        // the fits on the model's own identification recording
-        None => ModelQuality {
+        [first, second] => {
+            // two runs of the program: complete, the noise out by cross-products
+            let opts = ReadOptions::default();
+            let r1 = read_recording(first, &opts)?;
+            let r2 = read_recording(second, &opts)?;
+            ModelQuality::from_two_recordings(&file.model, &r1, &r2)
+                .with_context(|| format!("{} and {}", first.display(), second.display()))?
+        }
+        [] => ModelQuality {
+            // the fits on the model's own identification recording
             position_fit_percent: file.identified_by.as_ref().map(|p| p.fit_percent),
             error_fit_percent: file
                 .identified_by
@@ -164,6 +172,10 @@ fn from_model(
                 .and_then(|p| p.error_fit_percent),
             noise_rms_m: None,
         },
+        more => anyhow::bail!(
+            "--check given {} times: one recording of the axis, or two runs of the same program",
+            more.len()
+        ),
     };
     let comp = compensate_model(&file.model, desired, dt, cfg)
         .with_context(|| path.display().to_string())?;
@@ -372,7 +384,7 @@ fn json_limit(v: f64) -> serde_json::Value {
     }
 }
 
-fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checked: bool) {
+fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checks: usize) {
     let count = |h: ZeroHandling| c.zeros.iter().filter(|z| z.handling == h).count();
     let _ = writeln!(
         t,
@@ -405,10 +417,10 @@ fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checked: bool) {
                 micrometres(c.benefit.predicted_compensated_rms_m),
                 micrometres(c.benefit.model_error_rms_m),
                 match c.benefit.model_error_from {
-                    ModelErrorSource::ErrorFit => if checked {
-                        "the share of the following error it does not explain on --check"
-                    } else {
-                        "the share of the following error it does not explain on its identification recording; --check run.csv measures it on this program"
+                    ModelErrorSource::ErrorFit => match checks {
+                        0 => "the share of the following error it does not explain on its identification recording; --check run.csv measures it on this program",
+                        1 => "the share of the following error it does not explain on --check; two runs of the program (--check a.csv --check b.csv) take the noise out exactly",
+                        _ => "the share of the following error it does not explain on the two --check runs, without their noise (cross-products)",
                     },
                     ModelErrorSource::PositionFit => "its free-run fit scaled to this motion; --check run.csv measures it on the axis",
                     ModelErrorSource::Unknown => "unknown: the model file has no fit; give --check run.csv",

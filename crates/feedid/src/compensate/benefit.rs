@@ -165,6 +165,42 @@ impl ModelQuality {
         })
     }
 
+    /// [`ModelQuality::from_two_runs`] on two recordings of the same program
+    /// on the axis, complete (no dropped samples, else
+    /// [`Error::GapsInCheckRun`]) and, for a discrete model, at its sampling
+    /// (else [`Error::SampleTimeMismatch`]).
+    pub fn from_two_recordings<S: AsRef<[f64]>, T: AsRef<[f64]>>(
+        model: &LinearModel,
+        first: &Recording<S>,
+        second: &Recording<T>,
+    ) -> Result<Self> {
+        for (run, (dt, gaps)) in [(first.dt(), &first.gaps()), (second.dt(), &second.gaps())]
+            .into_iter()
+            .enumerate()
+        {
+            if let LinearModel::Discrete { dt: m, .. } = model {
+                if (dt - m).abs() > 1e-6 * m {
+                    return Err(Error::SampleTimeMismatch {
+                        model: *m,
+                        actual: dt,
+                    });
+                }
+            }
+            if !gaps.is_empty() {
+                return Err(Error::GapsInCheckRun {
+                    run: run + 1,
+                    dropped: gaps.iter().map(|g| g.missing).sum(),
+                });
+            }
+        }
+        Self::from_two_runs(
+            model,
+            (first.command(), first.position()),
+            (second.command(), second.position()),
+            first.dt(),
+        )
+    }
+
     /// Both fits of `model` from **two runs of the same command** on the
     /// axis (`first` and `second`: command and measured position, equal
     /// lengths, at interval `dt` \[s\]), with the noise taken out by

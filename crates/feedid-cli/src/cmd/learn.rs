@@ -249,7 +249,7 @@ fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
     if s.gain > 0.0 {
         let _ = writeln!(
             t,
-            "  step: gain {:.3}{}, noise filter σ {:.3} ms, step smoothing σ {:.3} ms{}",
+            "  step: gain {:.3}{}, noise filter σ {:.3} ms{}, step smoothing σ {:.3} ms{}",
             s.gain,
             if s.gain_limited {
                 " (halved to keep the command within its limits)"
@@ -257,6 +257,14 @@ fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
                 ""
             },
             1e3 * s.noise_filter_s,
+            if s.robustness_filter_s > 0.0 {
+                format!(
+                    " (at least {:.3} ms: the band where the axis answered the last step as the model predicted)",
+                    1e3 * s.robustness_filter_s
+                )
+            } else {
+                String::new()
+            },
             1e3 * s.step_smoothing_s,
             if s.held_back_share > 0.0 {
                 format!(

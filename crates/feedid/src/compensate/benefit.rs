@@ -90,14 +90,7 @@ impl ModelQuality {
         model: &LinearModel,
         check: &Recording<S>,
     ) -> Result<Self> {
-        if let LinearModel::Discrete { dt, .. } = model {
-            if (check.dt() - dt).abs() > 1e-6 * dt {
-                return Err(Error::SampleTimeMismatch {
-                    model: *dt,
-                    actual: check.dt(),
-                });
-            }
-        }
+        at_model_rate(model, check.dt())?;
         if check.gaps().is_empty() {
             return Self::from_run(model, check.command(), check.position(), check.dt());
         }
@@ -178,14 +171,7 @@ impl ModelQuality {
             .into_iter()
             .enumerate()
         {
-            if let LinearModel::Discrete { dt: m, .. } = model {
-                if (dt - m).abs() > 1e-6 * m {
-                    return Err(Error::SampleTimeMismatch {
-                        model: *m,
-                        actual: dt,
-                    });
-                }
-            }
+            at_model_rate(model, dt)?;
             if !gaps.is_empty() {
                 return Err(Error::GapsInCheckRun {
                     run: run + 1,
@@ -283,6 +269,20 @@ impl ModelQuality {
             error_fit_percent: error_fit,
             noise_rms_m: Some(noise),
         })
+    }
+}
+
+/// A check recording sampled every `dt` \[s\] must be at a discrete
+/// model's own sampling ([`Error::SampleTimeMismatch`]).
+fn at_model_rate(model: &LinearModel, dt: f64) -> Result<()> {
+    match model {
+        LinearModel::Discrete { dt: m, .. } if (dt - m).abs() > 1e-6 * m => {
+            Err(Error::SampleTimeMismatch {
+                model: *m,
+                actual: dt,
+            })
+        }
+        _ => Ok(()),
     }
 }
 

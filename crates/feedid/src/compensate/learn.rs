@@ -324,89 +324,88 @@ fn explained_share(desired: &[f64], error: &[f64], model: &[f64]) -> f64 {
 /// step did not act as the model predicts; the damping decides).
 const MIN_RESPONSE: f64 = 0.1;
 
-/// The axis's answer to the last step relative to the model's prediction
-/// of it: with `Δu = u_j − u_{j−1}`, the measured change of the error
-/// `Δe = e_j − e_{j−1}` and the predicted one `Δê = −G·Δu`, the least-squares
-/// factor `<Δe, Δê>/‖Δê‖²`; `None` when `rms(Δê)` is below 3× the noise.
-#[allow(clippy::too_many_arguments)]
-fn response_ratio(
-    sys: &DiscreteStateSpace,
-    (u, e): (&[f64], &[f64]),
-    (u_last, e_last): (&[f64], &[f64]),
-    out_scale: f64,
-    g_dc: f64,
-    start: StartMode,
-    noise: f64,
-) -> Result<Option<f64>> {
-    let y = simulate_run(sys, u, out_scale, g_dc, start)?;
-    let y_last = simulate_run(sys, u_last, out_scale, g_dc, start)?;
-    let (mut dot, mut pp) = (0.0, 0.0);
-    for k in 0..e.len() {
-        let predicted = -(y[k] - y_last[k]);
-        dot += (e[k] - e_last[k]) * predicted;
-        pp += predicted * predicted;
-    }
-    let n = e.len() as f64;
-    if pp > 0.0 && (pp / n).sqrt() > 3.0 * noise {
-        Ok(Some(dot / pp))
-    } else {
-        Ok(None)
-    }
-}
-
 /// Largest misfit of the axis's answer to the model's prediction within the
 /// band a step learns (robustness filter, module doc): `‖a − ρ·b‖ ≤ ½·‖a‖`,
 /// three quarters of the change's energy predicted in shape.
 const MAX_MISFIT: f64 = 0.5;
 
-/// The robustness filter from the axis's answer to the last step (module
-/// doc): the smallest σ \[samples\] of the compensation's levels up to
-/// `max_sigma` at which the measured change of the error `Δe` and the
-/// model's prediction of it `Δê` (both smoothed with σ) agree in shape —
-/// `‖L·Δe − ρ·L·Δê‖ ≤ MAX_MISFIT·‖L·Δe‖` with their least-squares ratio `ρ`
-/// (> [`MIN_RESPONSE`]); `max_sigma` when none does, `None` when the
-/// predicted change is lost in the noise (as [`response_ratio`]).
-#[allow(clippy::too_many_arguments)]
-fn robustness_sigma(
-    sys: &DiscreteStateSpace,
-    (u, e): (&[f64], &[f64]),
-    (u_last, e_last): (&[f64], &[f64]),
-    out_scale: f64,
-    g_dc: f64,
-    start: StartMode,
-    noise: f64,
-    max_sigma: f64,
-) -> Result<Option<f64>> {
-    let y = simulate_run(sys, u, out_scale, g_dc, start)?;
-    let y_last = simulate_run(sys, u_last, out_scale, g_dc, start)?;
-    let n = e.len();
-    let measured: Vec<f64> = (0..n).map(|k| e[k] - e_last[k]).collect();
-    let predicted: Vec<f64> = (0..n).map(|k| -(y[k] - y_last[k])).collect();
-    let pp = predicted.iter().map(|v| v * v).sum::<f64>();
-    if !(pp > 0.0 && (pp / n as f64).sqrt() > 3.0 * noise) {
-        return Ok(None);
+/// The axis's answer to the last step beside the model's prediction of it:
+/// with `Δu = u_j − u_{j−1}`, the measured change of the error
+/// `Δe = e_j − e_{j−1}` and the predicted one `Δê = −G·Δu`.
+struct Answer {
+    /// `Δe`.
+    measured: Vec<f64>,
+    /// `Δê`.
+    predicted: Vec<f64>,
+}
+
+impl Answer {
+    /// The answer to the step from `(u_last, e_last)` to `(u, e)`; `None`
+    /// when `rms(Δê)` is below 3× the noise (the step was lost in it).
+    #[allow(clippy::too_many_arguments)]
+    fn of(
+        sys: &DiscreteStateSpace,
+        (u, e): (&[f64], &[f64]),
+        (u_last, e_last): (&[f64], &[f64]),
+        out_scale: f64,
+        g_dc: f64,
+        start: StartMode,
+        noise: f64,
+    ) -> Result<Option<Self>> {
+        let y = simulate_run(sys, u, out_scale, g_dc, start)?;
+        let y_last = simulate_run(sys, u_last, out_scale, g_dc, start)?;
+        let n = e.len();
+        let measured: Vec<f64> = (0..n).map(|k| e[k] - e_last[k]).collect();
+        let predicted: Vec<f64> = (0..n).map(|k| -(y[k] - y_last[k])).collect();
+        let pp = predicted.iter().map(|v| v * v).sum::<f64>();
+        Ok(
+            (pp > 0.0 && (pp / n as f64).sqrt() > 3.0 * noise).then_some(Self {
+                measured,
+                predicted,
+            }),
+        )
     }
-    let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-    for sigma in levels(max_sigma) {
-        gaussian_smooth(&measured, sigma, &mut a);
-        gaussian_smooth(&predicted, sigma, &mut b);
-        let (mut ab, mut bb, mut aa) = (0.0, 0.0, 0.0);
-        for k in 0..n {
-            ab += a[k] * b[k];
-            bb += b[k] * b[k];
-            aa += a[k] * a[k];
+
+    /// How strongly the axis answered relative to the model: the
+    /// least-squares factor `<Δe, Δê>/‖Δê‖²`.
+    fn ratio(&self) -> f64 {
+        let (mut dot, mut pp) = (0.0, 0.0);
+        for (m, p) in self.measured.iter().zip(&self.predicted) {
+            dot += m * p;
+            pp += p * p;
         }
-        if !(bb > 0.0 && aa > 0.0) {
-            continue;
-        }
-        let rho = ab / bb;
-        // ‖a − ρb‖² = ‖a‖² − ρ·<a, b> at the least-squares ρ
-        let misfit = ((aa - rho * ab).max(0.0) / aa).sqrt();
-        if rho > MIN_RESPONSE && misfit <= MAX_MISFIT {
-            return Ok(Some(sigma));
-        }
+        dot / pp
     }
-    Ok(Some(max_sigma))
+
+    /// The robustness filter (module doc): the smallest σ \[samples\] of
+    /// the compensation's levels up to `max_sigma` at which `Δe` and `Δê`
+    /// (both smoothed with σ) agree in shape — `‖L·Δe − ρ·L·Δê‖ ≤
+    /// MAX_MISFIT·‖L·Δe‖` with their least-squares ratio `ρ`
+    /// (> [`MIN_RESPONSE`]); `max_sigma` when none does.
+    fn robustness_sigma(&self, max_sigma: f64) -> f64 {
+        let n = self.measured.len();
+        let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+        for sigma in levels(max_sigma) {
+            gaussian_smooth(&self.measured, sigma, &mut a);
+            gaussian_smooth(&self.predicted, sigma, &mut b);
+            let (mut ab, mut bb, mut aa) = (0.0, 0.0, 0.0);
+            for k in 0..n {
+                ab += a[k] * b[k];
+                bb += b[k] * b[k];
+                aa += a[k] * a[k];
+            }
+            if !(bb > 0.0 && aa > 0.0) {
+                continue;
+            }
+            let rho = ab / bb;
+            // ‖a − ρb‖² = ‖a‖² − ρ·<a, b> at the least-squares ρ
+            let misfit = ((aa - rho * ab).max(0.0) / aa).sqrt();
+            if rho > MIN_RESPONSE && misfit <= MAX_MISFIT {
+                return sigma;
+            }
+        }
+        max_sigma
+    }
 }
 
 /// Multiplier of the noise level for a wild sample (Hampel's identifier).
@@ -590,8 +589,8 @@ pub fn learn(
     let trust = explained.clamp(cfg.min_trust, 1.0);
     // once a step has been taken, the axis's measured answer to it replaces
     // that guess: its size relative to the model's prediction
-    let response_ratio = match &history.last {
-        Some(last) => response_ratio(
+    let answer = match &history.last {
+        Some(last) => Answer::of(
             &sys,
             (sent, &error),
             (&last.command, &last.error),
@@ -602,6 +601,7 @@ pub fn learn(
         )?,
         None => None,
     };
+    let response_ratio = answer.as_ref().map(Answer::ratio);
     // a larger step only after one that lowered the error
     let shrank = previous_rms_m.is_some_and(|p| stats.rms < p);
     let scale_step = match response_ratio {
@@ -611,20 +611,9 @@ pub fn learn(
 
     // the robustness filter: only the band in which the axis answered the
     // last step as the model predicted is learned
-    let robust_sigma = match &history.last {
-        Some(last) => robustness_sigma(
-            &sys,
-            (sent, &error),
-            (&last.command, &last.error),
-            out_scale,
-            g_dc,
-            comp_cfg.start,
-            noise,
-            comp_cfg.max_smoothing / dt,
-        )?
-        .unwrap_or(0.0),
-        None => 0.0,
-    };
+    let robust_sigma = answer
+        .as_ref()
+        .map_or(0.0, |a| a.robustness_sigma(comp_cfg.max_smoothing / dt));
     let sigma = match cfg.noise_filter {
         NoiseFilter::Fixed(s) => s / dt,
         NoiseFilter::Auto => discrepancy_sigma(&base_err, noise),
@@ -878,7 +867,7 @@ mod tests {
                 let y = plant.simulate(cmd).unwrap();
                 desired.iter().zip(&y).map(|(d, y)| d - y).collect()
             };
-            robustness_sigma(
+            Answer::of(
                 &sys,
                 (&u, &e(&u)),
                 (&u_last, &e(&u_last)),
@@ -886,10 +875,10 @@ mod tests {
                 g,
                 StartMode::Rest,
                 1e-12,
-                40.0,
             )
             .unwrap()
             .unwrap()
+            .robustness_sigma(40.0)
         };
         // the model is the axis: every band is learned
         assert_eq!(sigma(&axis()), 0.0);

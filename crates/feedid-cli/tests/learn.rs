@@ -126,6 +126,11 @@ fn learning_from_runs_lowers_the_measured_error_run_by_run() {
         assert!(text.contains(&format!("run {run} of")), "{text}");
         let s = json(&summary);
         assert_eq!(s["run"], run);
+        // the robustness filter needs an answer to a step: none in run 1;
+        // it floors the step's filter
+        let robust = s["robustness_filter_s"].as_f64().unwrap();
+        assert!(run > 1 || robust == 0.0, "{s}");
+        assert!(s["noise_filter_s"].as_f64().unwrap() >= robust, "{s}");
         rms.push(s["measured"]["rms"].as_f64().unwrap());
         let h = json(&history);
         assert_eq!(h["runs"].as_array().unwrap().len(), run as usize);

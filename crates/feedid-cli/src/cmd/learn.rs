@@ -257,9 +257,11 @@ fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
                 ""
             },
             1e3 * s.noise_filter_s,
-            if s.robustness_filter_s > 0.0 {
+            if s.robustness_filter_s >= a.max_smoothing * (1.0 - 1e-9) {
+                " (at least --max-smoothing: the axis answered the last step as the model predicted in no narrower band)".to_string()
+            } else if s.robustness_filter_s > 0.0 {
                 format!(
-                    " (at least {:.3} ms: the band where the axis answered the last step as the model predicted)",
+                    " (at least {:.3} ms: the band in which the axis answered the last step as the model predicted)",
                     1e3 * s.robustness_filter_s
                 )
             } else {

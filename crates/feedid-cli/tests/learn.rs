@@ -7,7 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{assert_fails, feedid, stderr, stdout};
+use common::{assert_fails, csv_column as column, feedid, stderr, stdout};
 
 fn run_ok(args: &[&str]) -> String {
     let o = feedid(args);
@@ -402,4 +402,73 @@ fn a_history_that_is_not_a_regular_file_is_refused_and_left_alone() {
         .unwrap()
         .file_type()
         .is_symlink());
+}
+
+#[test]
+fn a_step_the_axis_did_not_answer_settles_on_the_best_run_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let prog = d.join("prog.csv");
+    run_ok(&["simulate", "--scenario", "scurve", "-o", p(&prog)]);
+    let model = d.join("m.json");
+    run_ok(&[
+        "identify",
+        p(&prog),
+        "-o",
+        p(&d.join("pred.csv")),
+        "--model-out",
+        p(&model),
+    ]);
+    let history = d.join("h.json");
+    let learn = |sent: Option<&Path>, out: &Path, summary: &Path| {
+        let mut args = vec![
+            "compensate",
+            "--desired",
+            p(&prog),
+            "--desired-column",
+            "command_m",
+            "--model",
+            p(&model),
+            "--measured",
+            p(&prog),
+            "--history",
+            p(&history),
+            "-o",
+            p(out),
+            "--summary",
+            p(summary),
+        ];
+        if let Some(s) = sent {
+            args.extend_from_slice(&["--sent", p(s)]);
+        }
+        let o = feedid(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        (stdout(&o), stderr(&o))
+    };
+    // run 1: the plain program; a step from it
+    let cmd2 = d.join("cmd2.csv");
+    learn(None, &cmd2, &d.join("s1.json"));
+    // run 2 "measured" the same position although cmd2 was sent: the step
+    // achieved nothing of what the model predicted
+    let cmd3 = d.join("cmd3.csv");
+    let s2 = d.join("s2.json");
+    let (out, err) = learn(Some(&cmd2), &cmd3, &s2);
+    let s = json(&s2);
+    assert_eq!(s["status"]["status"], "settled", "{s}");
+    assert_eq!(s["status"]["best_run"], 1, "{s}");
+    assert!(
+        s["status"]["achieved_share"].as_f64().unwrap().abs() < 0.01,
+        "{s}"
+    );
+    assert_eq!(s["gain"], 0.0);
+    assert!(out.contains("settled: the last step achieved 0 %"), "{out}");
+    assert!(out.contains("run 1's command"), "{out}");
+    assert!(err.contains("the learning has settled"), "{err}");
+    // run 1's command, the program, is written again
+    let sent = column(&cmd3, "command_m");
+    let plain = column(&prog, "command_m");
+    assert_eq!(sent.len(), plain.len());
+    for (a, b) in sent.iter().zip(&plain) {
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-3), "{a} {b}");
+    }
 }

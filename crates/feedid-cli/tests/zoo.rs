@@ -2,17 +2,7 @@
 
 mod common;
 
-use common::{assert_fails, feedid, stderr, stdout};
-
-fn column(path: &std::path::Path, name: &str) -> Vec<f64> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let i = header.iter().position(|h| *h == name).unwrap();
-    lines
-        .map(|l| l.split(',').nth(i).unwrap().parse().unwrap())
-        .collect()
-}
+use common::{assert_fails, csv_column as column, feedid, stderr, stdout};
 
 #[test]
 fn zoo_list_prints_one_row_per_member_and_the_ranges() {

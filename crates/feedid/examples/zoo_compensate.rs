@@ -108,6 +108,8 @@ struct Row {
     repeat_spread: f64,
     /// Why the learning ended early, if it did.
     learn_note: String,
+    /// What the last learning step did ("" without learning).
+    ended: &'static str,
     /// The model's predicted rms error of the command sent \[m\].
     predicted_sent_rms: f64,
     /// The model's own error the expectation assumed \[m\].
@@ -305,6 +307,7 @@ fn run(
     let mut history = None;
     let mut run_rms = Vec::new();
     let mut learn_note = String::new();
+    let mut ended = "";
     let lcfg = LearnConfig {
         compensate: cfg,
         ..LearnConfig::default()
@@ -334,7 +337,9 @@ fn run(
                     S::AtNoise => "at noise",
                     S::Damped { .. } => "damped",
                     S::Stopped { .. } => "stopped",
+                    S::Settled { .. } => "settled",
                 };
+                ended = tag;
                 if !learn_note.is_empty() {
                     learn_note.push_str(", ");
                 }
@@ -391,6 +396,7 @@ fn run(
         floor,
         repeat_spread,
         learn_note,
+        ended,
         predicted_sent_rms,
         model_error_assumed,
         model_error_plain,
@@ -458,6 +464,25 @@ fn learning_summary(rows: &[Row], runs: usize) {
         );
     }
     let missed: Vec<&Row> = rows.iter().filter(|r| !reached(r, runs)).collect();
+    // how the learning ended: the last step's status, all and not at the target
+    let tags = [
+        "improving",
+        "damped",
+        "settled",
+        "stopped",
+        "at noise",
+        "first",
+    ];
+    for (name, sel) in [
+        ("all", rows.iter().collect::<Vec<_>>()),
+        ("not at the target", missed.clone()),
+    ] {
+        let counts: Vec<String> = tags
+            .iter()
+            .map(|t| format!("{} {t}", sel.iter().filter(|r| r.ended == *t).count()))
+            .collect();
+        println!("last step, {name} ({}): {}", sel.len(), counts.join(", "));
+    }
     println!(
         "\n{} of {} members at the target within {runs} runs; {} grew by more than the noise in some run",
         rows.len() - missed.len(),

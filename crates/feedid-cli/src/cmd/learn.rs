@@ -215,6 +215,31 @@ fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
             "stopped: run {best_run}'s command (rms {}) is sent again",
             micrometres(best_rms_m)
         ),
+        LearnStatus::Settled {
+            best_run,
+            best_rms_m,
+            achieved_share,
+        } => match achieved_share {
+            Some(share) => format!(
+                "settled: the last step achieved {:.0} % of the reduction the model predicted for it (less than a tenth), and the model did not predict the axis's answer in any band; run {best_run}'s command (rms {}) is sent again",
+                100.0 * share,
+                micrometres(best_rms_m)
+            ),
+            None => format!(
+                "settled: the model expects a further step to lower the rms by less than a tenth{}; run {best_run}'s command (rms {}) is sent again",
+                if s.held_back_share > 0.5 {
+                    format!(
+                        " (the limits hold it back on {:.1} % of the samples: --max-velocity {} m/s, --max-acceleration {} m/s²)",
+                        100.0 * s.held_back_share,
+                        a.max_velocity,
+                        a.max_acceleration
+                    )
+                } else {
+                    String::new()
+                },
+                micrometres(best_rms_m)
+            ),
+        },
     };
     let _ = writeln!(t, "  learning: {status}");
     let share = if s.explained_share > 0.0 {
@@ -244,6 +269,13 @@ fn describe(t: &mut String, s: &Learning, a: &CompensateArgs) {
             } else {
                 ""
             }
+        );
+    }
+    if s.unanswered_share > 0.0 && s.gain > 0.0 {
+        let _ = writeln!(
+            t,
+            "  the axis did not answer the last step as the model predicted on {:.1} % of the samples: little or nothing of their error is learned again",
+            100.0 * s.unanswered_share
         );
     }
     if s.gain > 0.0 {
@@ -310,6 +342,9 @@ fn warn(s: &Learning, a: &CompensateArgs) {
         LearnStatus::Damped { best_run, .. } => eprintln!(
             "warning: run {} was worse than run {best_run} or did not shrink as the model predicted; the gain is halved to {} — if this repeats, identify the model again on a richer run",
             s.run, s.gain
+        ),
+        LearnStatus::Settled { best_run, .. } => eprintln!(
+            "note: the learning has settled: what is left of the error is not what the model can correct; run {best_run}'s command is written again. A model identified on a run of the compensated command, or one of richer structure, may lower it further (start a new history)"
         ),
         LearnStatus::Stopped { best_run, .. } => eprintln!(
             "warning: the learning has stopped: the error kept growing with the gain halved; run {best_run}'s command is written again. The model is wrong where the error lives: identify it again (a richer run, or on this program's own recording) and start a new history"

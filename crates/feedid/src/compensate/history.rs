@@ -31,6 +31,20 @@ pub enum LearnStatus {
         /// Its measured rms \[m\].
         best_rms_m: f64,
     },
+    /// The last step lowered the error by less than a tenth of what the
+    /// model predicted for it, or the model expects the next to lower it by
+    /// less than a tenth: what is left is not what the model can correct,
+    /// and the best run's command is sent again (in every later step too).
+    Settled {
+        /// The best run so far, whose command is sent again.
+        best_run: usize,
+        /// Its measured rms \[m\].
+        best_rms_m: f64,
+        /// Share of the predicted reduction of the rms that the last step
+        /// achieved; `None` when it is the next step that the model
+        /// expected to lower the rms by less than a tenth.
+        achieved_share: Option<f64>,
+    },
     /// The error kept growing after the gain was halved the most allowed:
     /// the best run's command is sent again.
     Stopped {

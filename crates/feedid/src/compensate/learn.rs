@@ -930,69 +930,6 @@ pub fn learn(
     })
 }
 
-/// A history that starts with the run of the plain program (run 0: the
-/// command was `desired` itself, its `measured` position, at interval `dt`
-/// \[s\]) and the rms error \[m\] the compensation sent after it was
-/// predicted to leave (`predicted_next_rms_m`, noise-free): the first
-/// learning step then has the axis's answer to the compensation (module
-/// doc), and a compensated run worse than the plain one is damped from it.
-pub fn history_from_plain_run(
-    desired: &[f64],
-    measured: &[f64],
-    dt: f64,
-    predicted_next_rms_m: f64,
-) -> Result<LearningHistory> {
-    let n = desired.len();
-    if measured.len() != n {
-        return Err(Error::LengthMismatch {
-            what: "measured position of the plain run",
-            expected: n,
-            actual: measured.len(),
-        });
-    }
-    for (channel, v) in [("desired", desired), ("plain run's position", measured)] {
-        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-            return Err(Error::NonFinite {
-                channel: channel.to_string(),
-                index: i,
-                value: v[i],
-            });
-        }
-    }
-    if !(predicted_next_rms_m.is_finite() && predicted_next_rms_m >= 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "predicted rms after the plain run",
-            value: predicted_next_rms_m,
-            reason: "must be finite and >= 0 (m)",
-        });
-    }
-    let raw: Vec<f64> = desired.iter().zip(measured).map(|(d, y)| d - y).collect();
-    let noise = noise_level_of_run(&raw, measured);
-    let (error, _) = hold_wild(&raw, noise);
-    let stats = ErrorStats::from_pairs(desired.iter().copied().zip(measured.iter().copied()));
-    let mut history = LearningHistory::new(desired, dt);
-    history.runs.push(LearningRun {
-        run: 0,
-        measured_rms_m: stats.rms,
-        measured_max_m: stats.max_abs,
-        noise_m: noise,
-        status: LearnStatus::First,
-        gain: 1.0,
-        noise_filter_s: 0.0,
-        predicted_next_rms_m,
-        response_ratio: None,
-    });
-    let plain = BestRun {
-        run: 0,
-        measured_rms_m: stats.rms,
-        command: desired.to_vec(),
-        error,
-    };
-    history.best = Some(plain.clone());
-    history.last = Some(plain);
-    Ok(history)
-}
-
 /// The model's position for the command `u` of a run: from rest at `u[0]`
 /// ([`StartMode::Rest`]) or moving at `u`'s first velocity
 /// ([`StartMode::Moving`], the velocity held back until the model settles);

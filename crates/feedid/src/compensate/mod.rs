@@ -48,7 +48,7 @@ pub use history::{
     BestRun, LearnStatus, LearningHistory, LearningRun, HISTORY_FORMAT, HISTORY_VERSION,
 };
 pub use inverse::{StableInverse, ZeroHandling, ZeroInfo};
-pub use learn::{history_from_plain_run, learn, LearnConfig, Learning, NoiseFilter};
+pub use learn::{learn, LearnConfig, Learning, NoiseFilter};
 pub use online::{
     following_error_of, OnlineCompensator, OnlineConfig, OnlineState, OnlineStats, MAX_PREVIEW,
 };

@@ -217,6 +217,33 @@ pub fn noise_level_of_run(e: &[f64], measured: &[f64]) -> f64 {
     mad.max((ms / (6.0 * 0.874)).sqrt())
 }
 
+/// The resolution of a quantised measurement \[its units\]: the smallest
+/// non-zero step between consecutive samples of `measured`, when at least
+/// 99 % of the non-zero steps are whole multiples of it (to a thousandth)
+/// and there are at least 10 of them; `None` for a signal that is not
+/// quantised (the steps of a continuous signal are no multiples of the
+/// smallest).
+pub fn resolution(measured: &[f64]) -> Option<f64> {
+    let scale = measured.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let steps: Vec<f64> = measured
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|d| *d > 1e-12 * scale)
+        .collect();
+    if steps.len() < 10 {
+        return None;
+    }
+    let q = steps.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+    let whole = steps
+        .iter()
+        .filter(|d| {
+            let m = *d / q;
+            (m - m.round()).abs() < 1e-3
+        })
+        .count();
+    (100 * whole >= 99 * steps.len()).then_some(q)
+}
+
 /// The median of `v` (reordered in place; 0 when empty).
 pub fn median(v: &mut [f64]) -> f64 {
     if v.is_empty() {
@@ -255,6 +282,20 @@ pub fn error_fit_percent(residual: &[f64], following: &[f64], noise: f64) -> Opt
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_resolution_of_a_quantised_signal_is_its_step_and_a_continuous_one_has_none() {
+        let q = 0.39e-6;
+        let x: Vec<f64> = (0..2000)
+            .map(|k| 1e-3 * (k as f64 * 0.003).sin() + 2e-7 * ((k * 7919) % 13) as f64)
+            .collect();
+        let quantised: Vec<f64> = x.iter().map(|v| q * (v / q).round()).collect();
+        let r = resolution(&quantised).unwrap();
+        assert!((r - q).abs() < 1e-9 * q, "{r}");
+        assert_eq!(resolution(&x), None);
+        // at rest: no steps, nothing to tell
+        assert_eq!(resolution(&[1e-3; 100]), None);
+    }
 
     #[test]
     fn fit_percent_matches_definition() {

@@ -929,8 +929,11 @@ def learn(
     dict
         ``command`` [m] and ``predicted`` [m] (NumPy), ``history`` (a dict:
         pass it to the next step, or ``json.dump`` it), and the summary's keys
-        (``run``, ``measured``, ``status``, ``gain``,
-        ``predicted_next_rms_m``, ...).
+        (``run``, ``measured``, ``status``, ``gain``, ``unanswered_share``,
+        ``predicted_next_rms_m``, ...). ``status["status"]`` is ``first``,
+        ``improving``, ``at_noise``, ``damped``, ``settled`` (what is left is
+        not what the model can correct: the best run's command again) or
+        ``stopped``.
     """
     kw = _model_kw(model, "learn")
     if isinstance(measured, (str, bytes, os.PathLike)):

@@ -25,6 +25,7 @@
 //!   (`feedid stream --compensate`); [`co_simulate`]: the axis stepped with
 //!   the compensator in the loop.
 
+mod answer;
 mod benefit;
 mod command;
 mod cosim;

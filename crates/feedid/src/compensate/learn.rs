@@ -501,6 +501,13 @@ pub fn learn(
     // the decision against the best run so far
     let last_gain = history.runs.last().map(|r| r.gain);
     let last_filter = history.runs.last().map(|r| r.noise_filter_s);
+    // the best run so far with this one: (run, rms, command, error)
+    let best_with_this = || match &history.best {
+        Some(b) if b.measured_rms_m <= stats.rms => {
+            (b.run, b.measured_rms_m, b.command.clone(), b.error.clone())
+        }
+        _ => (run, stats.rms, sent.to_vec(), error.clone()),
+    };
     let grew = history
         .best
         .as_ref()
@@ -539,24 +546,14 @@ pub fn learn(
     let halvings = |g: f64| (cfg.gain / g).log2().round().max(0.0) as u32;
     let (status, gain, base_cmd, base_err, filter_floor) = match (&history.best, grew) {
         // the best run's command again: this run's when it is the best
-        (Some(b), _) if !stopped && (settled.is_some() || settles) => {
-            let status = |best_run, best_rms_m| LearnStatus::Settled {
+        (Some(_), _) if !stopped && (settled.is_some() || settles) => {
+            let (best_run, best_rms_m, command, error) = best_with_this();
+            let status = LearnStatus::Settled {
                 best_run,
                 best_rms_m,
                 achieved_share: settled.unwrap_or(achieved),
             };
-            if stats.rms < b.measured_rms_m {
-                (
-                    status(run, stats.rms),
-                    0.0,
-                    sent.to_vec(),
-                    error.clone(),
-                    0.0,
-                )
-            } else {
-                let s = status(b.run, b.measured_rms_m);
-                (s, 0.0, b.command.clone(), b.error.clone(), 0.0)
-            }
+            (status, 0.0, command, error, 0.0)
         }
         (Some(b), worse) if worse || stopped => {
             let g = 0.5 * last_gain.unwrap_or(cfg.gain);
@@ -738,12 +735,7 @@ pub fn learn(
     let (mut status, mut command, mut gain, mut gain_limited) =
         (status, command, gain, gain_limited);
     if gain > 0.0 && predicted_next_rms_m.hypot(noise) > (1.0 - MIN_PREDICTED_GAIN) * from_rms {
-        let (best_run, best_rms_m, best_cmd) = match &history.best {
-            Some(b) if b.measured_rms_m <= stats.rms => {
-                (b.run, b.measured_rms_m, b.command.clone())
-            }
-            _ => (run, stats.rms, sent.to_vec()),
-        };
+        let (best_run, best_rms_m, best_cmd, _) = best_with_this();
         status = LearnStatus::Settled {
             best_run,
             best_rms_m,

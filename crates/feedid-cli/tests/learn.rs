@@ -41,6 +41,23 @@ fn heavy_axis(dir: &Path) -> (PathBuf, PathBuf) {
     (params, effects)
 }
 
+/// The built-in rig's S-curve in `dir` (`prog.csv`) and the model
+/// `identify` writes of it (`m.json`).
+fn scurve_and_model(dir: &Path) -> (PathBuf, PathBuf) {
+    let prog = dir.join("prog.csv");
+    run_ok(&["simulate", "--scenario", "scurve", "-o", p(&prog)]);
+    let model = dir.join("m.json");
+    run_ok(&[
+        "identify",
+        p(&prog),
+        "-o",
+        p(&dir.join("pred.csv")),
+        "--model-out",
+        p(&model),
+    ]);
+    (prog, model)
+}
+
 /// Run `command` on the axis (fresh noise per seed); the recording's path.
 fn run_on_axis(dir: &Path, axis: &(PathBuf, PathBuf), command: &Path, seed: u64) -> PathBuf {
     let out = dir.join(format!("run{seed}.csv"));
@@ -151,17 +168,7 @@ fn the_sent_command_can_be_given_apart_from_the_run() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let axis = heavy_axis(d);
-    let prog = d.join("prog.csv");
-    run_ok(&["simulate", "--scenario", "scurve", "-o", p(&prog)]);
-    let model = d.join("m.json");
-    run_ok(&[
-        "identify",
-        p(&prog),
-        "-o",
-        p(&d.join("pred.csv")),
-        "--model-out",
-        p(&model),
-    ]);
+    let (prog, model) = scurve_and_model(d);
     let rec = run_on_axis(d, &axis, &prog, 1);
     let a = d.join("a.csv");
     let b = d.join("b.csv");
@@ -190,17 +197,7 @@ fn the_sent_command_can_be_given_apart_from_the_run() {
 fn a_run_of_another_length_or_a_foreign_history_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let prog = d.join("prog.csv");
-    run_ok(&["simulate", "--scenario", "scurve", "-o", p(&prog)]);
-    let model = d.join("m.json");
-    run_ok(&[
-        "identify",
-        p(&prog),
-        "-o",
-        p(&d.join("pred.csv")),
-        "--model-out",
-        p(&model),
-    ]);
+    let (prog, model) = scurve_and_model(d);
     let short = d.join("short.csv");
     run_ok(&[
         "simulate",
@@ -364,17 +361,7 @@ fn simulate_runs_a_command_from_a_file_at_its_own_rate() {
 fn a_history_that_is_not_a_regular_file_is_refused_and_left_alone() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let prog = d.join("prog.csv");
-    run_ok(&["simulate", "--scenario", "scurve", "-o", p(&prog)]);
-    let model = d.join("m.json");
-    run_ok(&[
-        "identify",
-        p(&prog),
-        "-o",
-        p(&d.join("pred.csv")),
-        "--model-out",
-        p(&model),
-    ]);
+    let (prog, model) = scurve_and_model(d);
     let target = d.join("precious.txt");
     std::fs::write(&target, "keep me").unwrap();
     let link = d.join("h.json");
@@ -408,17 +395,7 @@ fn a_history_that_is_not_a_regular_file_is_refused_and_left_alone() {
 fn a_step_the_axis_did_not_answer_settles_on_the_best_run_and_says_why() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let prog = d.join("prog.csv");
-    run_ok(&["simulate", "--scenario", "scurve", "-o", p(&prog)]);
-    let model = d.join("m.json");
-    run_ok(&[
-        "identify",
-        p(&prog),
-        "-o",
-        p(&d.join("pred.csv")),
-        "--model-out",
-        p(&model),
-    ]);
+    let (prog, model) = scurve_and_model(d);
     let history = d.join("h.json");
     let learn = |sent: Option<&Path>, out: &Path, summary: &Path| {
         let mut args = vec![

@@ -138,24 +138,8 @@ impl Answer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compensate::learn::tests::{axis, program, DT};
     use crate::ident::LinearModel;
-
-    const DT: f64 = 1e-3;
-
-    fn axis() -> LinearModel {
-        // second-order position loop with one sample of delay, unit DC gain
-        LinearModel::discrete(vec![0.0, 0.05, 0.03], vec![1.0, -1.5, 0.58], DT).unwrap()
-    }
-
-    fn program() -> Vec<f64> {
-        // rest, a smooth move of 2 mm, rest
-        (0..600)
-            .map(|k| {
-                let s = ((k as f64 - 50.0) / 300.0).clamp(0.0, 1.0);
-                2e-3 * (3.0 * s * s - 2.0 * s * s * s)
-            })
-            .collect()
-    }
 
     #[test]
     fn the_robustness_filter_passes_only_the_band_the_model_predicts() {

@@ -887,21 +887,21 @@ fn discrepancy_sigma(e: &[f64], noise: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::stats::noise_level;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    const DT: f64 = 1e-3;
+    pub(in crate::compensate) const DT: f64 = 1e-3;
 
-    fn axis() -> LinearModel {
-        // second-order position loop with one sample of delay, unit DC gain
+    /// A second-order position loop with one sample of delay, unit DC gain.
+    pub(in crate::compensate) fn axis() -> LinearModel {
         LinearModel::discrete(vec![0.0, 0.05, 0.03], vec![1.0, -1.5, 0.58], DT).unwrap()
     }
 
-    fn program() -> Vec<f64> {
-        // rest, a smooth move of 2 mm, rest
+    /// Rest, a smooth move of 2 mm, rest.
+    pub(in crate::compensate) fn program() -> Vec<f64> {
         (0..600)
             .map(|k| {
                 let s = ((k as f64 - 50.0) / 300.0).clamp(0.0, 1.0);

@@ -26,9 +26,12 @@
 //!    `||z| − 1| ≤ δ` for a zero in the left half plane (`Re z < 0`, where
 //!    the exact inverse would ring at up to the Nyquist frequency with gain
 //!    `1/||z| − 1|`: the spurious zeros of an identified model lie there),
-//!    and `||z| − 1| ≤ 2e-4` elsewhere (a slow zero near `z = 1` is inverted
-//!    exactly unless its inverse would take more than 200 000 samples to
-//!    settle: the approximation is poor at low frequency);
+//!    and `1 ≤ |z| ≤ 1 + 2e-4` in the right half plane (an anti-causal
+//!    inverse that would take more than 200 000 samples to settle). A slow
+//!    zero just inside the circle near `z = 1` (a fast-sampled model's
+//!    slow mode, nearly cancelled by a pole) is always inverted exactly by
+//!    step 3: the approximation's gain at the Nyquist frequency,
+//!    `(1 + z)/(1 − z)²`, would be 10⁸ for `1 − z = 1.5·10⁻⁴`;
 //! 5. zeros outside (`|z| > 1 + δ`, e.g. the sampling zeros of a model of
 //!    relative degree ≥ 3): anti-causal recursion run backwards from the end,
 //!    `u[k−1] = (u[k] − w[k])/z`, started at the steady state — the exact
@@ -39,7 +42,10 @@
 //! exact inverse (up to rounding) wherever no zero needed step 4: the model
 //! driven by `u` reproduces `y` at every sample. The signal is extended with
 //! its final value by enough samples for every causal section to settle (to
-//! 1e-17) before the backward pass starts; the anti-causal part makes the
+//! 1e-17, at most 200 000 samples; what is left of a slower one only shifts
+//! the start of the backward pass, which forgets it within its own settling,
+//! added to the extension) before the backward pass starts; the anti-causal
+//! part makes the
 //! command move before the trajectory does ("pre-actuation"), and whatever of
 //! it would fall before the first sample is lost.
 //!
@@ -61,10 +67,15 @@ const SETTLE: f64 = 1e-17;
 /// Longest extension of the trajectory \[samples\].
 const MAX_TAIL: usize = 200_000;
 
-/// Half-width of the band around the unit circle where a zero in the right
-/// half plane gets the zero-phase approximation: closer, its exact inverse
-/// would take more than [`MAX_TAIL`] samples to settle.
+/// Half-width of the band outside the unit circle where a zero in the right
+/// half plane gets the zero-phase approximation: closer, its exact
+/// (anti-causal) inverse would take more than [`MAX_TAIL`] samples to settle.
 const SLOW_BAND: f64 = 2e-4;
+
+/// Most samples of a slow causal zero's settling counted in
+/// [`StableInverse::settle`] (the margins a caller extends a trajectory by;
+/// the tail itself covers it up to [`MAX_TAIL`]).
+const SETTLE_CAP: usize = 20_000;
 
 /// How one zero of the model is inverted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -124,13 +135,25 @@ impl Factor {
     }
 }
 
-/// Half-width of the band around the unit circle where a zero with real
-/// part `re` gets the zero-phase approximation (see the module doc).
-fn band_of(re: f64, margin: f64) -> f64 {
-    if re < 0.0 {
+/// How a zero of modulus `m` and real part `re` is inverted (module doc):
+/// causally inside the unit circle, anti-causally outside it, with the
+/// zero-phase approximation within `margin` of it in the left half plane
+/// and within [`SLOW_BAND`] outside it in the right half plane. A slow zero
+/// just inside the circle near `z = 1` is inverted exactly: there the
+/// approximation's gain `(1 + z)/(1 − z)²` would reach 10⁸ at the Nyquist
+/// frequency for `1 − z = 1.5·10⁻⁴`.
+fn handling_of(m: f64, re: f64, margin: f64) -> ZeroHandling {
+    let band = if re < 0.0 {
         margin.max(SLOW_BAND)
     } else {
         SLOW_BAND
+    };
+    if m < 1.0 - band || (re >= 0.0 && m < 1.0) {
+        ZeroHandling::Causal
+    } else if m > 1.0 + band {
+        ZeroHandling::AntiCausal
+    } else {
+        ZeroHandling::ZeroPhase
     }
 }
 
@@ -207,11 +230,10 @@ impl StableInverse {
         let mut zero_phase = Vec::new();
         let mut anticausal = Vec::new();
         for f in factors(zeros)? {
-            let m = f.modulus();
-            let band = band_of(f.real_part(), margin);
-            if m < 1.0 - band {
+            let handling = handling_of(f.modulus(), f.real_part(), margin);
+            if handling == ZeroHandling::Causal {
                 causal.push(f);
-            } else if m > 1.0 + band {
+            } else if handling == ZeroHandling::AntiCausal {
                 anticausal.push(f);
             } else {
                 if f.at_one().abs() < 1e-12 {
@@ -225,50 +247,51 @@ impl StableInverse {
         }
         let zeros_info = zeros
             .iter()
-            .map(|z| {
-                let m = z.norm();
-                let band = band_of(z.re, margin);
-                ZeroInfo {
-                    re: z.re,
-                    im: z.im,
-                    modulus: m,
-                    handling: if m < 1.0 - band {
-                        ZeroHandling::Causal
-                    } else if m > 1.0 + band {
-                        ZeroHandling::AntiCausal
-                    } else {
-                        ZeroHandling::ZeroPhase
-                    },
-                }
+            .map(|z| ZeroInfo {
+                re: z.re,
+                im: z.im,
+                modulus: z.norm(),
+                handling: handling_of(z.norm(), z.re, margin),
             })
             .collect();
-        let mut tail = delay + 4;
+        // the causal sections settle within the tail, so that the backward
+        // passes start from the steady state; a slow zero's settling is cut
+        // at MAX_TAIL, and what is left of it then only shifts the
+        // anti-causal sections' start, which they forget within their own
+        // settling (added to the tail)
+        let mut causal_settle = delay + 4;
         for f in &causal {
             let m = f.modulus();
             if m > 0.0 {
                 let n = (SETTLE.ln() / m.ln()).ceil();
-                tail = tail.max(if n.is_finite() {
+                causal_settle = causal_settle.max(if n.is_finite() {
                     n as usize + 4
                 } else {
-                    MAX_TAIL
+                    usize::MAX
                 });
             }
         }
-        let mut settle = tail;
+        let mut settle = delay + 4;
         for f in &anticausal {
             let m = f.modulus();
             let n = (SETTLE.ln() / (1.0 / m).ln()).ceil();
             settle = settle.max(if n.is_finite() {
                 n as usize + 4
             } else {
-                MAX_TAIL
+                usize::MAX
             });
         }
-        if tail > MAX_TAIL || settle > MAX_TAIL {
+        if settle > MAX_TAIL {
             return Err(Error::InvalidModel {
                 reason: "a zero is so close to the unit circle that its inverse does not settle; increase the unit-circle margin",
             });
         }
+        let tail = if causal_settle > MAX_TAIL {
+            MAX_TAIL + settle
+        } else {
+            causal_settle.max(settle)
+        };
+        let settle = settle.max(causal_settle.min(SETTLE_CAP));
         Ok(Self {
             gain,
             delay,
@@ -592,6 +615,37 @@ mod tests {
             .map(|(p, q)| (p - q).abs())
             .fold(0.0, f64::max);
         assert!(err < 1e-3, "{err}");
+    }
+
+    #[test]
+    fn a_slow_zero_just_inside_the_circle_is_inverted_exactly() {
+        // a fast-sampled model's slow mode: zero 0.99985 beside pole 0.9997
+        // (the causal section settles to 1e-17 only after 260 000 samples,
+        // more than the tail allows); unit DC gain
+        let beta = crate::lti::poly_from_roots(&[Complex::new(0.99985, 0.0)]);
+        let a = crate::lti::poly_from_roots(&[Complex::new(0.9, 0.0), Complex::new(0.9997, 0.0)]);
+        let g = 0.1 * 3e-4 / 1.5e-4;
+        let mut b = vec![0.0];
+        b.extend(beta.iter().map(|c| g * c));
+        let inv = StableInverse::from_polynomials(&b, &a, 1e-6).unwrap();
+        assert_eq!(inv.zeros()[0].handling, ZeroHandling::Causal);
+        assert!(inv.is_exact());
+        assert!((inv.dc_gain() - 1.0).abs() < 1e-9);
+        assert!(inv.tail() >= MAX_TAIL);
+        let y = trajectory(3000);
+        let mut u = vec![0.0; 3000];
+        inv.apply_into(&y, &mut u, &mut Vec::new()).unwrap();
+        // the model driven by u follows y; the command stays of its size
+        // (the zero-phase approximation's gain here is (1 + z)/(1 − z)² ≈ 10⁸)
+        let back = simulate(&b, &a, &u);
+        let err = back
+            .iter()
+            .zip(&y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-9, "{err}");
+        let peak = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(peak < 20.0, "{peak}");
     }
 
     #[test]

@@ -47,7 +47,7 @@ use crate::error::{Error, Result};
 use crate::ident::methods::{
     fit_arx, fit_arx_segments, fit_oe, fit_oe_measured, ArxConfig, ArxOrders, OeConfig,
 };
-use crate::ident::model::LinearModel;
+use crate::ident::model::{LinearModel, NEGLIGIBLE_PAIR};
 use crate::recording::Recording;
 use crate::stats::{error_fit_percent, noise_level_of_run, ErrorStats};
 
@@ -405,6 +405,48 @@ fn simulated_with_fit(model: &LinearModel, data: &Data<'_>) -> Result<(ErrorStat
     Ok((stats, fit))
 }
 
+/// Largest growth of the free-run rms that cancelling the pairs the
+/// recording cannot resolve may cost.
+const UNRESOLVED_PAIR_COST: f64 = 0.1;
+
+/// `model` without the pole–zero pairs whose change of a unit-step response
+/// over `span` seconds is below the free-run residual `rms` relative to the
+/// command's travel (what the recording resolves), when its own free run is
+/// within [`UNRESOLVED_PAIR_COST`] of `rms`: the model, the pairs cancelled,
+/// its simulation and error fit; `None` when there is no such pair or the
+/// free run disagrees. Such a pair (a slow pole beside a slow zero on the
+/// other side of the origin) changes nothing within the recording but
+/// rules the model's steady-state gain, which the compensation's unit-gain
+/// scaling and inverse depend on.
+fn unresolved_pairs(
+    model: &LinearModel,
+    data: &Data<'_>,
+    span: f64,
+    rms: f64,
+) -> Result<Option<(LinearModel, usize, ErrorStats, Option<f64>)>> {
+    let u0 = data.command.first().copied().unwrap_or(0.0);
+    let travel = data
+        .command
+        .iter()
+        .fold(0.0_f64, |m, v| m.max((v - u0).abs()));
+    if !(travel > 0.0 && rms.is_finite()) {
+        return Ok(None);
+    }
+    let tolerance = rms / travel;
+    if tolerance <= NEGLIGIBLE_PAIR {
+        return Ok(None);
+    }
+    let (reduced, n) = model.without_pairs_below(span, tolerance)?;
+    if n == 0 {
+        return Ok(None);
+    }
+    let (stats, error_fit) = simulated_with_fit(&reduced, data)?;
+    if !(stats.rms.is_finite() && stats.rms <= (1.0 + UNRESOLVED_PAIR_COST) * rms) {
+        return Ok(None);
+    }
+    Ok(Some((reduced, n, stats, error_fit)))
+}
+
 /// The fitted samples.
 struct Data<'a> {
     /// Command \[m\], one per sample.
@@ -536,6 +578,14 @@ fn fit_one(data: &Data<'_>, kind: &GlobalModelKind) -> Result<ModelFile> {
             reason: "the global model's simulation is not finite",
         });
     }
+    // and a pair whose mode the recording cannot resolve: its change of the
+    // response within the recording below the fit's own residual (relative
+    // to the command's travel), kept out when the free run agrees
+    let (model, cancelled_pairs, stats, error_fit) =
+        match unresolved_pairs(&model, data, span, stats.rms)? {
+            Some((m, n, st, ef)) => (m, cancelled_pairs + n, st, ef),
+            None => (model, cancelled_pairs, stats, error_fit),
+        };
     Ok(ModelFile {
         model,
         identified_by: Some(ModelProvenance {
@@ -673,6 +723,64 @@ mod tests {
             .simulate(&u, None)
             .unwrap();
         (g, Recording::from_rate(1000.0, u, y).unwrap())
+    }
+
+    /// `g·(s − z)/(s − p)`: the second-order axis with a pole–zero pair.
+    fn with_pair(g: &TransferFunction, z: f64, p: f64) -> LinearModel {
+        let mul = |a: &[f64], b: &[f64]| {
+            let mut c = vec![0.0; a.len() + b.len() - 1];
+            for (i, x) in a.iter().enumerate() {
+                for (j, y) in b.iter().enumerate() {
+                    c[i + j] += x * y;
+                }
+            }
+            c
+        };
+        let tf = TransferFunction::new(mul(g.num(), &[1.0, -z]), mul(g.den(), &[1.0, -p])).unwrap();
+        LinearModel::continuous(&tf)
+    }
+
+    #[test]
+    fn a_pair_the_recording_cannot_resolve_is_cancelled_and_one_it_can_is_kept() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let (g, exact) = exact_second_order();
+        // 1 µm of noise on a 1 mm square wave: the recording resolves 1e-3
+        // of a step
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let noise = Normal::new(0.0, 1e-6).unwrap();
+        let y: Vec<f64> = exact
+            .position()
+            .iter()
+            .map(|v| v + noise.sample(&mut rng))
+            .collect();
+        let rec = Recording::from_rate(1000.0, exact.command().to_vec(), y).unwrap();
+        let d = Deviations::of(&rec).unwrap();
+        let data = d.data(&rec);
+        let span = 1.2;
+        // an output-error fit's slow pair: a zero at +2e-4 rad/s beside a pole
+        // at −4e-5 rad/s changes a step by 3e-4 within the 1.2 s, but makes
+        // the steady-state gain −5
+        let slow = with_pair(&g, 2e-4, -4e-5);
+        assert!((slow.dc_gain().unwrap() + 5.0).abs() < 1e-6);
+        assert_eq!(slow.without_negligible_pairs(span).unwrap().1, 0);
+        let rms = simulated(&slow, &data).unwrap().rms;
+        let (reduced, n, stats, _) = unresolved_pairs(&slow, &data, span, rms)
+            .unwrap()
+            .expect("the slow pair is cancelled");
+        assert_eq!(n, 1);
+        assert!((reduced.dc_gain().unwrap() - 1.0).abs() < 1e-9);
+        assert!(stats.rms <= (1.0 + UNRESOLVED_PAIR_COST) * rms);
+        // a pair that changes the response within the recording stays
+        let felt = with_pair(&g, 0.5, -4e-5);
+        let rms = simulated(&felt, &data).unwrap().rms;
+        assert!(unresolved_pairs(&felt, &data, span, rms).unwrap().is_none());
+        // and so does the slow pair on the noise-free recording, whose only
+        // residual is the pair's own
+        let d = Deviations::of(&exact).unwrap();
+        let data = d.data(&exact);
+        let rms = simulated(&slow, &data).unwrap().rms;
+        assert!(unresolved_pairs(&slow, &data, span, rms).unwrap().is_none());
     }
 
     #[test]

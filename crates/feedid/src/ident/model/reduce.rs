@@ -52,6 +52,20 @@ impl LinearModel {
     /// assert!((m.dc_gain().unwrap() - 1.0).abs() < 1e-9);
     /// ```
     pub fn without_negligible_pairs(&self, span_s: f64) -> Result<(LinearModel, usize)> {
+        self.without_pairs_below(span_s, NEGLIGIBLE_PAIR)
+    }
+
+    /// [`LinearModel::without_negligible_pairs`] with the largest change of
+    /// a unit-step response over `span_s` seconds for which a pair is
+    /// cancelled given (`tolerance`, a share of the step, ≥ 0).
+    pub fn without_pairs_below(&self, span_s: f64, tolerance: f64) -> Result<(LinearModel, usize)> {
+        if !(tolerance.is_finite() && tolerance >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "pair tolerance",
+                value: tolerance,
+                reason: "must be finite and >= 0 (share of a step)",
+            });
+        }
         if !(span_s.is_finite() && span_s > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "span",
@@ -74,7 +88,7 @@ impl LinearModel {
                         Some(span_s.min(1.0 / p.re.abs().max(f64::MIN_POSITIVE)))
                     }
                 };
-                let (zl, pl, n) = cancel(&zeros, &poles, reach);
+                let (zl, pl, n) = cancel(&zeros, &poles, reach, tolerance);
                 if n == 0 {
                     return Ok((self.clone(), 0));
                 }
@@ -104,7 +118,7 @@ impl LinearModel {
                         Some(samples.min(1.0 / (1.0 - m).abs().max(f64::MIN_POSITIVE)))
                     }
                 };
-                let (zl, pl, n) = cancel(&zeros, &poles, reach);
+                let (zl, pl, n) = cancel(&zeros, &poles, reach, tolerance);
                 if n == 0 {
                     return Ok((self.clone(), 0));
                 }
@@ -131,13 +145,14 @@ fn cancel(
     zeros: &[Complex<f64>],
     poles: &[Complex<f64>],
     reach: impl Fn(Complex<f64>) -> Option<f64>,
+    tolerance: f64,
 ) -> (Vec<Complex<f64>>, Vec<Complex<f64>>, usize) {
     let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
     for (i, z) in zeros.iter().enumerate() {
         for (j, p) in poles.iter().enumerate() {
             if let Some(r) = reach(*p) {
                 let figure = (p - z).norm() * r;
-                if figure <= NEGLIGIBLE_PAIR {
+                if figure <= tolerance {
                     pairs.push((figure, i, j));
                 }
             }

@@ -405,6 +405,10 @@ fn simulated_with_fit(model: &LinearModel, data: &Data<'_>) -> Result<(ErrorStat
     Ok((stats, fit))
 }
 
+/// A model with pairs cancelled: the model, how many pairs, its free-run
+/// simulation and its error fit.
+type Reduced = (LinearModel, usize, ErrorStats, Option<f64>);
+
 /// Largest growth of the free-run rms that cancelling the pairs the
 /// recording cannot resolve may cost.
 const UNRESOLVED_PAIR_COST: f64 = 0.1;
@@ -423,7 +427,7 @@ fn unresolved_pairs(
     data: &Data<'_>,
     span: f64,
     rms: f64,
-) -> Result<Option<(LinearModel, usize, ErrorStats, Option<f64>)>> {
+) -> Result<Option<Reduced>> {
     let u0 = data.command.first().copied().unwrap_or(0.0);
     let travel = data
         .command

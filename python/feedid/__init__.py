@@ -1011,9 +1011,12 @@ def fit_structure(
     ``offset``, ``gain``, ``kp``, ``kv``, ``Fs``; two-mass ``Mm``, ``k``,
     ``c``) from command and measured position by output error, as ``feedid
     greybox --params s.toml --estimate …``, with ``restarts`` fits started
-    ±22 % away (``identifiable`` false where they end apart). The result has
-    the estimates with standard errors, the rms error before and after, the
-    fit [%], and ``toml``: the structure with the estimates."""
+    ±22 % away; the best of them is the estimate (``identifiable`` false
+    where equally good fits end apart or three standard errors exceed 5 %
+    of the estimate; ``restarts_elsewhere``: fits that ended in a local
+    minimum). The result has the estimates with standard errors, the rms
+    error before and after, the fit [%], and ``toml``: the structure with
+    the estimates."""
     if isinstance(estimate, str):
         estimate = [e for e in estimate.split(",") if e.strip()]
     fit, toml = _feedid.structure_fit(

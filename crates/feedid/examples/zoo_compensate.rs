@@ -11,6 +11,7 @@
 //! cargo run --release -p feedid --example zoo_compensate
 //! cargo run --release -p feedid --example zoo_compensate -- --ident chirp
 //! cargo run --release -p feedid --example zoo_compensate -- --limit 20 --csv comp.csv
+//! cargo run --release -p feedid --example zoo_compensate -- --only 47,147 --runs 5
 //! ```
 //!
 //! Per member:
@@ -456,11 +457,12 @@ fn learning_summary(rows: &[Row], runs: usize) {
             .map(|r| r.plain_measured / r.runs[r.runs.len() - 1])
             .collect();
         println!(
-            "{name}: {} of {} at the target within {runs} runs, {} grew, median plain / last run {:.1}×",
+            "{name}: {} of {} at the target within {runs} runs, {} grew, median plain / last run {:.1}×, {} end settled",
             sel.iter().filter(|r| reached(r, runs)).count(),
             sel.len(),
             sel.iter().filter(|r| grows(r)).count(),
-            median(&mut last)
+            median(&mut last),
+            sel.iter().filter(|r| r.ended == "settled").count()
         );
     }
     let missed: Vec<&Row> = rows.iter().filter(|r| !reached(r, runs)).collect();
@@ -562,6 +564,7 @@ fn summary(name: &str, rows: &[&Row]) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut limit = usize::MAX;
+    let mut only: Option<Vec<usize>> = None;
     let mut max_smoothing = CompensateConfig::default().max_smoothing;
     let mut csv: Option<PathBuf> = None;
     let mut runs = 1usize;
@@ -575,6 +578,12 @@ fn main() {
                     .get(i + 1)
                     .and_then(|s| s.parse().ok())
                     .unwrap_or(limit);
+                i += 1;
+            }
+            "--only" => {
+                only = args
+                    .get(i + 1)
+                    .map(|s| s.split(',').filter_map(|v| v.parse().ok()).collect());
                 i += 1;
             }
             "--max-smoothing" => {
@@ -616,7 +625,7 @@ fn main() {
                 i += 1;
             }
             other => {
-                eprintln!("unknown argument {other}; use --limit N, --max-smoothing S, --runs R, --wrong gain|delay|pole, --ident program|chirp, --csv FILE");
+                eprintln!("unknown argument {other}; use --limit N, --only I,J, --max-smoothing S, --runs R, --wrong gain|delay|pole, --ident program|chirp, --csv FILE");
                 std::process::exit(2);
             }
         }
@@ -636,6 +645,7 @@ fn main() {
                 )
             })
         })
+        .filter(|i| only.as_ref().is_none_or(|o| o.contains(i)))
         .take(limit)
         .collect();
     let start = std::time::Instant::now();

@@ -38,7 +38,9 @@
 //! The design (which member gets what) is in `design.rs`, the rig recipe
 //! (mechanics, motor, loop tuning, stability checks) in `axis.rs`, the servo
 //! plants in `servo.rs`, the commands in `command.rs`, glitches and dropped
-//! rows in `defects.rs`, the disturbed members in `disturbance.rs`. No
+//! rows in `defects.rs`, the disturbed members in `disturbance.rs`; a
+//! family of drive structures with known physical parameters, for the
+//! structure fit, in `structures.rs` ([`StructureAxis`]). No
 //! member is chosen or tuned for any identification method: parameters come
 //! from the design and the physical recipe only.
 //!
@@ -62,6 +64,7 @@ mod member;
 mod plant;
 mod servo;
 mod spec;
+mod structures;
 
 pub use disturbance::{Disturbance, Disturbed};
 pub use family::{
@@ -73,3 +76,4 @@ pub use plant::{PlantRun, PlantStepper};
 pub use spec::{
     AxisClass, CommandSpec, Glitch, MemberSpec, PlantKind, RigSetup, ServoSetup, Stability,
 };
+pub use structures::StructureAxis;

@@ -9,7 +9,7 @@
 //! logarithms, so that no step makes them negative and their scale does not
 //! matter; the offset as itself over the drive gain (controller-output
 //! units). Standard errors come from the Jacobian at the solution,
-//! `σ²·(JᵀJ)⁻¹` by QR (`σ²` the residual variance): they assume white
+//! `σ²·(JᵀJ)⁻¹` by SVD (`σ²` the residual variance): they assume white
 //! residuals and are optimistic when the residuals are correlated, as a
 //! simulation's residuals usually are.
 
@@ -94,7 +94,9 @@ impl StructureParam {
         }
     }
 
-    fn get(self, s: &DriveStructure) -> f64 {
+    /// Its value in the structure `s` (the static level: the Coulomb
+    /// level when absent; the motor mass and stiffness: 0 when rigid).
+    pub fn get(self, s: &DriveStructure) -> f64 {
         match self {
             StructureParam::Mass => s.mechanics.mass,
             StructureParam::Viscous => s.friction.viscous,
@@ -110,7 +112,8 @@ impl StructureParam {
         }
     }
 
-    fn set(self, s: &mut DriveStructure, v: f64) {
+    /// `s` with this parameter set to `v`.
+    pub fn set(self, s: &mut DriveStructure, v: f64) {
         match self {
             StructureParam::Mass => s.mechanics.mass = v,
             StructureParam::Viscous => s.friction.viscous = v,
@@ -172,8 +175,10 @@ pub struct StructureEstimate {
     /// Largest relative difference from this estimate of the fits restarted
     /// ±22 % away from it (`None` without restarts).
     pub restart_spread: Option<f64>,
-    /// The restarts ended within `max(10⁻³, 3·std_error/|value|)` of it
-    /// (true without restarts): the data pin it.
+    /// The data pin it: three standard errors are at most [`PINNED`] of it
+    /// (of the drive gain, for a constant force smaller than that), and the
+    /// restarts, if any, ended within `max(10⁻³, 3·std_error/|value|)` of
+    /// it.
     pub identifiable: bool,
 }
 
@@ -194,7 +199,26 @@ pub struct StructureFit {
     pub iterations: usize,
     /// Why it stopped.
     pub termination: Termination,
+    /// Fits of [`DriveStructure::fit_with_restarts`] (the first one or
+    /// restarts) that ended with a simulation error more than
+    /// [`EQUALLY_GOOD`] above the best's: local minima, not compared.
+    pub restarts_elsewhere: usize,
 }
+
+/// Largest share of an estimate its three standard errors may make for the
+/// estimate to be called identifiable: beyond, the data do not pin it to
+/// 5 %, whatever the restarts say (a parameter the output hardly depends
+/// on ends where it starts, restarted or not).
+pub const PINNED: f64 = 0.05;
+
+/// How far a restart starts from the estimate (a share of it).
+const RESTART_MOVE: f64 = 0.22;
+
+/// A restart whose simulation error is within this share of the best fit's
+/// (or within a millionth of the rms motion, on data without noise) is as
+/// good a fit: its parameters must agree with the best's for them to be
+/// pinned. Beyond, it ended in a local minimum and is not compared.
+pub const EQUALLY_GOOD: f64 = 0.01;
 
 /// The most restarts a fit accepts: each restart is a full fit, so the
 /// bound keeps the work of one call finite.
@@ -329,19 +353,12 @@ impl DriveStructure {
         let report = lm.minimize(residual, &mut x, &config)?;
         let r = lm.residuals().to_vec();
         let rms = crate::stats::rms(&r);
-        // standard errors: σ²·(JᵀJ)⁻¹ = σ²·R⁻¹R⁻ᵀ from the QR of J, in the
-        // varied coordinates, then through the chain rule
+        // standard errors: σ²·(JᵀJ)⁻¹ from the SVD of J, in the varied
+        // coordinates, then through the chain rule
         let n = x.len();
         let j = DMatrix::from_column_slice(m, n, lm.jacobian());
         let sigma2 = r.iter().map(|v| v * v).sum::<f64>() / (m.saturating_sub(n).max(1)) as f64;
-        let rmat = j.qr().r();
-        let std: Vec<f64> = match rmat.clone().try_inverse() {
-            Some(ri) => {
-                let cov = &ri * ri.transpose() * sigma2;
-                (0..n).map(|i| cov[(i, i)].max(0.0).sqrt()).collect()
-            }
-            None => vec![f64::INFINITY; n],
-        };
+        let std = standard_errors(j, sigma2);
         let structure = build(&x);
         let estimates = estimate
             .iter()
@@ -349,14 +366,22 @@ impl DriveStructure {
             .zip(&std)
             .map(|((&p, &xi), &si)| {
                 let value = from_p(p, xi);
+                // d value / d x: value for a logarithm, the scale otherwise
+                let std_error = si * if p.logarithmic() { value } else { scale_of(p) };
+                // a constant force is measured against the drive's unit of
+                // output as well (it may be near 0)
+                let size = if p.logarithmic() {
+                    value.abs()
+                } else {
+                    value.abs().max(scale_of(p))
+                };
                 StructureEstimate {
                     param: p,
                     start: p.get(self),
                     value,
-                    // d value / d x: value for a logarithm, the scale otherwise
-                    std_error: si * if p.logarithmic() { value } else { scale_of(p) },
+                    std_error,
                     restart_spread: None,
-                    identifiable: true,
+                    identifiable: std_error.is_finite() && 3.0 * std_error <= PINNED * size,
                 }
             })
             .collect();
@@ -370,17 +395,51 @@ impl DriveStructure {
             fit_percent: simulated.fit_percent,
             iterations: report.iterations,
             termination: report.termination,
+            restarts_elsewhere: 0,
         })
     }
+}
+
+/// Standard errors `√diag(σ²·(JᵀJ)⁺)` from the SVD of the Jacobian `J`: a
+/// direction the data do not see (a singular value below 10⁻¹⁰ of the
+/// largest) makes infinite the errors of the parameters it moves, and only
+/// theirs.
+fn standard_errors(j: DMatrix<f64>, sigma2: f64) -> Vec<f64> {
+    let n = j.ncols();
+    let svd = j.svd(false, true);
+    let Some(vt) = svd.v_t else {
+        return vec![f64::INFINITY; n];
+    };
+    let largest = svd.singular_values.iter().fold(0.0_f64, |m, v| m.max(*v));
+    let mut var = vec![0.0; n];
+    for (i, &s) in svd.singular_values.iter().enumerate() {
+        let seen = s > 1e-10 * largest && s > 0.0;
+        for (k, v) in var.iter_mut().enumerate() {
+            let w = vt[(i, k)] * vt[(i, k)];
+            if seen {
+                *v += w / (s * s);
+            } else if w > 1e-12 {
+                *v = f64::INFINITY;
+            }
+        }
+    }
+    var.iter().map(|v| (v * sigma2).sqrt()).collect()
 }
 
 impl DriveStructure {
     /// [`DriveStructure::fit`], then `restarts` fits started from the
     /// estimate moved ±22 % (parameter `i` of restart `r` up when `i + r` is
     /// even, down otherwise; the offset by 22 % of its size plus 1 % of the
-    /// drive gain): an estimate whose restarts end farther than
+    /// drive gain; 11 % or 5.5 % when the loop cannot run from the moved
+    /// start). The fit with the smallest simulation error is the estimate;
+    /// of the others, those within [`EQUALLY_GOOD`] of its error are as
+    /// good a fit, and an estimate they leave farther than
     /// `max(10⁻³, 3·σ/|value|)` from it is flagged not identifiable — the
-    /// data do not pin it, whatever its standard error says.
+    /// data do not pin it, whatever its standard error says — as is one
+    /// whose three standard errors exceed [`PINNED`] of it. Fits that ended
+    /// clearly worse are local minima of the simulation error, counted in
+    /// [`StructureFit::restarts_elsewhere`]; a restart that cannot be
+    /// fitted at all flags every estimate.
     pub fn fit_with_restarts(
         &self,
         command: &[f64],
@@ -390,39 +449,73 @@ impl DriveStructure {
         restarts: usize,
     ) -> Result<StructureFit> {
         check_restarts(restarts)?;
-        let mut fit = self.fit(command, position, rate_hz, estimate)?;
+        let first = self.fit(command, position, rate_hz, estimate)?;
+        let mut fits = Vec::with_capacity(restarts);
+        let mut failed = 0;
         for r in 0..restarts {
-            let mut moved = fit.structure.clone();
-            for (i, &p) in estimate.iter().enumerate() {
-                let v = p.get(&fit.structure);
-                let up = (i + r) % 2 == 0;
-                let w = if p.logarithmic() {
-                    if up {
-                        v * 1.22
+            let moved_by = |share: f64| {
+                let mut moved = first.structure.clone();
+                for (i, &p) in estimate.iter().enumerate() {
+                    let v = p.get(&first.structure);
+                    let up = (i + r) % 2 == 0;
+                    let w = if p.logarithmic() {
+                        if up {
+                            v * (1.0 + share)
+                        } else {
+                            v / (1.0 + share)
+                        }
                     } else {
-                        v / 1.22
-                    }
-                } else {
-                    let step = 0.22 * v.abs() + 0.01 * self.drive.gain;
-                    if up {
-                        v + step
-                    } else {
-                        v - step
-                    }
-                };
-                p.set(&mut moved, w);
-            }
-            let again = match moved.fit(command, position, rate_hz, estimate) {
-                Ok(f) => f,
-                // a restart that cannot be fitted pins nothing
-                Err(_) => {
-                    for e in &mut fit.estimates {
-                        e.restart_spread = Some(f64::INFINITY);
-                        e.identifiable = false;
-                    }
-                    continue;
+                        let step = share * v.abs() + 0.01 * self.drive.gain;
+                        if up {
+                            v + step
+                        } else {
+                            v - step
+                        }
+                    };
+                    p.set(&mut moved, w);
                 }
+                moved
             };
+            // a start the loop cannot run from (a sampled loop made
+            // unstable by the move) is moved half as far, twice at most
+            let again = [RESTART_MOVE, RESTART_MOVE / 2.0, RESTART_MOVE / 4.0]
+                .into_iter()
+                .find_map(|share| {
+                    moved_by(share)
+                        .fit(command, position, rate_hz, estimate)
+                        .ok()
+                });
+            match again {
+                Some(f) => fits.push(f),
+                None => failed += 1,
+            }
+        }
+        // the best of all is the estimate; a fit that ended clearly worse
+        // (a local minimum of the simulation error) says nothing of what
+        // the data pin
+        let start_rms = first.start_rms;
+        fits.push(first);
+        let best = fits
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.rms.total_cmp(&b.1.rms))
+            .map_or(0, |(i, _)| i);
+        let mut fit = fits.swap_remove(best);
+        fit.start_rms = start_rms;
+        // (and on data without noise, a fit within a millionth of the
+        // motion: what is left there is the solver's tolerance)
+        let n = position.len().max(1) as f64;
+        let mean = position.iter().sum::<f64>() / n;
+        let motion = (position.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / n).sqrt();
+        let as_good = (fit.rms * (1.0 + EQUALLY_GOOD)).max(1e-6 * motion);
+        for e in &mut fit.estimates {
+            e.restart_spread = (restarts > 0).then_some(0.0);
+        }
+        for again in &fits {
+            if again.rms > as_good {
+                fit.restarts_elsewhere += 1;
+                continue;
+            }
             for (e, a) in fit.estimates.iter_mut().zip(&again.estimates) {
                 let rel = (a.value - e.value).abs() / e.value.abs().max(f64::MIN_POSITIVE);
                 e.restart_spread = Some(e.restart_spread.map_or(rel, |s| s.max(rel)));
@@ -431,6 +524,13 @@ impl DriveStructure {
                 if rel.is_nan() || rel > tolerance {
                     e.identifiable = false;
                 }
+            }
+        }
+        // a restart that cannot be fitted at all pins nothing
+        if failed > 0 {
+            for e in &mut fit.estimates {
+                e.restart_spread = Some(f64::INFINITY);
+                e.identifiable = false;
             }
         }
         Ok(fit)
@@ -530,6 +630,62 @@ impl fmt::Display for StructureFit {
             self.fit_percent,
             self.iterations,
             self.termination.label()
-        )
+        )?;
+        if self.restarts_elsewhere > 0 {
+            writeln!(
+                f,
+                "{} of the fits ended in a local minimum (simulation error more than {:.0} % above the best) and were not compared",
+                self.restarts_elsewhere,
+                100.0 * EQUALLY_GOOD
+            )?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn standard_errors_of_orthogonal_columns_are_the_noise_over_their_norms() {
+        // orthogonal columns of norms 2 and 4: σ/2 and σ/4
+        let j = DMatrix::from_column_slice(3, 2, &[2.0, 0.0, 0.0, 0.0, 4.0, 0.0]);
+        let s = standard_errors(j, 9.0);
+        assert!((s[0] - 1.5).abs() < 1e-12, "{s:?}");
+        assert!((s[1] - 0.75).abs() < 1e-12, "{s:?}");
+    }
+
+    #[test]
+    fn a_direction_the_data_do_not_see_makes_only_its_parameters_unknown() {
+        // the third parameter moves nothing: its error is infinite, the
+        // others keep theirs (a QR inverse would have made all infinite)
+        let j = DMatrix::from_column_slice(
+            4,
+            3,
+            &[
+                1.0, 1.0, 0.0, 0.0, //
+                0.0, 0.0, 2.0, 0.0, //
+                0.0, 0.0, 0.0, 0.0,
+            ],
+        );
+        let s = standard_errors(j, 1.0);
+        assert!((s[0] - 1.0 / 2f64.sqrt()).abs() < 1e-12, "{s:?}");
+        assert!((s[1] - 0.5).abs() < 1e-12, "{s:?}");
+        assert!(s[2].is_infinite(), "{s:?}");
+        // two parameters that only act as their sum: both unknown, the
+        // third still known
+        let j = DMatrix::from_column_slice(
+            3,
+            3,
+            &[
+                1.0, 2.0, 0.0, //
+                1.0, 2.0, 0.0, //
+                0.0, 0.0, 3.0,
+            ],
+        );
+        let s = standard_errors(j, 1.0);
+        assert!(s[0].is_infinite() && s[1].is_infinite(), "{s:?}");
+        assert!((s[2] - 1.0 / 3.0).abs() < 1e-12, "{s:?}");
     }
 }

@@ -78,7 +78,7 @@ use crate::error::{Error, Result};
 
 pub use fit::{
     check_restarts, StructureEstimate, StructureFit, StructureParam, StructureValidation,
-    MAX_RESTARTS,
+    EQUALLY_GOOD, MAX_RESTARTS, PINNED,
 };
 pub use idim::{inverse_dynamics, IdimConfig, IdimFit};
 pub use linear::StructureSummary;

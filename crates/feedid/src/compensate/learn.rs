@@ -43,8 +43,8 @@
 //! drive zoo the compensated run's error is mostly what the model did not
 //! predict (the share is near 0 on most axes), and a first step of a
 //! quarter of the gain grows the error on fewer axes than one of half (8
-//! against 13 of 120) at the cost of two axes at the target within five
-//! runs (69 against 71; the answer below sets every later step).
+//! against 14 of 120) at the cost of two axes at the target within five
+//! runs (72 against 74; the answer below sets every later step).
 //!
 //! **The axis's answer.** From the second step on, the measured change of
 //! the error between the last two runs is compared with the model's

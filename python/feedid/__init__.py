@@ -1033,10 +1033,12 @@ def fit_structure(
 
 
 def tune(path: PathLike, bandwidth: float, damping: float = 0.7071067811865476) -> Dict[str, Any]:
-    """Gains of a P position loop around a P velocity loop for a closed-loop
-    bandwidth [Hz] and damping ratio, as ``feedid tune``: the gains before
-    and after, both closed loops, the step overshoot [%], and ``toml``: the
-    retuned structure."""
+    """Gains of a rigid drive structure — a P position loop around a P or PI
+    velocity loop, or a PD or PID position loop commanding the force — for
+    a closed-loop bandwidth [Hz] and damping ratio, as ``feedid tune``: the
+    gains before and after (``position_kp``, ``velocity_kp``,
+    ``velocity_ki``, ``position_ki``, ``position_kd``), both closed loops,
+    the step overshoot [%], and ``toml``: the retuned structure."""
     out_json, toml = _feedid.structure_tune(os.fspath(path), bandwidth, damping)
     out: Dict[str, Any] = json.loads(out_json)
     out["toml"] = toml

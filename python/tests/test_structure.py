@@ -53,3 +53,20 @@ def test_tune_returns_the_gains_for_the_bandwidth_asked(tmp_path):
     rig.write_text("[control]\nkv = 30.0\n")
     with pytest.raises(feedid.InputError, match="not a drive structure"):
         feedid.tune(rig, 40.0)
+
+
+def test_tune_places_the_poles_of_a_pi_velocity_loop(tmp_path):
+    # P around PI on a 20 kg mass: the bandwidth asked, the integral kept
+    pi = tmp_path / "pi.toml"
+    pi.write_text(
+        "[position]\nkp = 30.0\n[velocity]\nkind = \"PI\"\nkp = 200.0\nki = 20.0\n"
+        "[drive]\ngain = 20.0\n[mechanics]\nmass = 20.0\n[friction]\nviscous = 50.0\n"
+    )
+    t = feedid.tune(pi, 15.0)
+    assert t["after"]["bandwidth_hz"] == pytest.approx(15.0, rel=1e-6)
+    assert t["after"]["stable"]
+    assert 0.0 < t["velocity_ki"][1] < t["position_kp"][1]
+    assert t["position_kd"] == [0.0, 0.0]
+    out = tmp_path / "tuned.toml"
+    out.write_text(t["toml"])
+    assert feedid.structure(out)["bandwidth_hz"] == pytest.approx(15.0, rel=1e-6)

@@ -42,7 +42,7 @@ pub enum Command {
     Compensate(Box<CompensateArgs>),
     /// List the drive zoo (generated recordings of many drives) or write its members as CSV.
     Zoo(crate::cmd::zoo::ZooArgs),
-    /// Retune the position and velocity gains of a drive structure for a bandwidth and damping.
+    /// Retune the loop gains of a drive structure (P/P, P/PI, PD or PID commanding force) for a bandwidth and damping.
     Tune(crate::cmd::tune::TuneArgs),
 }
 

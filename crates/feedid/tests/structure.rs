@@ -443,8 +443,8 @@ fn tuning_a_p_p_loop_hits_the_bandwidth_and_damping_asked() {
         .is_err());
     // another loop structure is refused with the reason
     let mut pi = s.clone();
-    pi.velocity.kind = feedid::drive::LoopKind::PI;
-    pi.velocity.ki = 10.0;
+    pi.position.kind = feedid::drive::LoopKind::PI;
+    pi.position.ki = 10.0;
     let e = pi
         .tune(&TuneTarget {
             bandwidth_hz: 40.0,
@@ -742,4 +742,69 @@ fn an_imprecise_estimate_is_not_called_identifiable_even_when_restarts_agree() {
     );
     assert!(mm.restart_spread.unwrap() < 1e-3, "{fit}");
     assert!(!mm.identifiable, "{fit}");
+}
+
+/// The coefficients of `M·(s + p)(s² + 2ζω·s + ω²)`, highest power first.
+fn placed_cubic(m: f64, p: f64, z: f64, w: f64) -> [f64; 4] {
+    [
+        m,
+        m * (p + 2.0 * z * w),
+        m * (w * w + 2.0 * z * w * p),
+        m * p * w * w,
+    ]
+}
+
+#[test]
+fn tuning_an_integral_loop_places_its_poles_and_hits_the_bandwidth() {
+    use feedid::drive::{LoopKind, TuneTarget};
+    let z = std::f64::consts::FRAC_1_SQRT_2;
+    // P around PI with feed-forward (family axis 1), and a PID loop
+    // commanding the force (family axis 2)
+    for (i, bw) in [(1, 8.0), (1, 15.0), (2, 10.0), (2, 25.0)] {
+        let s = feedid::zoo::StructureAxis::new(i).unwrap().truth;
+        let t = s
+            .tune(&TuneTarget {
+                bandwidth_hz: bw,
+                damping: z,
+            })
+            .unwrap();
+        let after = &t.after;
+        assert!(after.stable, "#{i} {bw}");
+        assert!(
+            (after.bandwidth_hz.unwrap() - bw).abs() < 1e-6 * bw,
+            "#{i} {bw}: {:?}",
+            after.bandwidth_hz
+        );
+        // the complex pair at the damping asked, the real pole at ω/4
+        let pair: Vec<_> = after.poles.iter().filter(|p| p.im.abs() > 0.0).collect();
+        assert_eq!(pair.len(), 2, "#{i} {bw}: {:?}", after.poles);
+        let w = (pair[0].re * pair[0].re + pair[0].im * pair[0].im).sqrt();
+        assert!((-pair[0].re / w - z).abs() < 1e-6, "#{i} {bw}");
+        let real = after.poles.iter().find(|p| p.im == 0.0).unwrap();
+        assert!((-real.re - 0.25 * w).abs() < 1e-6 * w, "#{i} {bw}");
+        // the closed loop's denominator is M·(s + ω/4)(s² + 2ζω·s + ω²)
+        let m = s.mechanics.total_mass();
+        let expected = placed_cubic(m, 0.25 * w, z, w);
+        let scale = after.denominator[0] / m;
+        for (a, e) in after.denominator.iter().zip(expected) {
+            assert!((a / scale - e).abs() < 1e-6 * e.abs(), "#{i} {bw}: {a} {e}");
+        }
+        // gains of the loop's own kind; mass, friction, feed-forward kept
+        match s.velocity.kind {
+            LoopKind::PI => assert!(t.velocity_ki.1 > 0.0 && t.velocity_ki.1 < t.position_kp.1),
+            _ => assert!(t.position_ki.1 > 0.0 && t.position_kd.1 > 0.0),
+        }
+        assert_eq!(t.structure.friction, s.friction);
+        assert_eq!(t.structure.feed_forward, s.feed_forward);
+    }
+    // a two-mass axis is refused with the reason
+    let e = feedid::zoo::StructureAxis::new(3)
+        .unwrap()
+        .truth
+        .tune(&TuneTarget {
+            bandwidth_hz: 10.0,
+            damping: z,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("rigid"), "{e}");
 }

@@ -111,6 +111,15 @@ pub fn run(a: &TuneArgs) -> Result<()> {
         "{:<28} {:>20.4} {:>20.4}",
         "velocity kp", tuned.velocity_kp.0, tuned.velocity_kp.1
     );
+    for (name, (before, after)) in [
+        ("velocity ki [1/s]", tuned.velocity_ki),
+        ("position ki [1/s]", tuned.position_ki),
+        ("position kd [s]", tuned.position_kd),
+    ] {
+        if before != 0.0 || after != 0.0 {
+            println!("{name:<28} {before:>20.6} {after:>20.6}");
+        }
+    }
     println!(
         "{:<28} {:>20} {:>20}",
         "bandwidth",

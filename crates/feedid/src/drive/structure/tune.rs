@@ -1,6 +1,7 @@
-//! Gains retuned from a drive structure's model: for a P position loop
-//! around a P velocity loop on a force-source drive and a rigid mass (the
-//! EMPS class), the linear closed loop is the second-order system
+//! Gains retuned from a drive structure's model, by placing the poles of
+//! its linear closed loop on a force-source drive and a rigid mass. For a P
+//! position loop around a P velocity loop (the EMPS class) the closed loop
+//! is the second-order system
 //!
 //! ```text
 //! X/X_s = g·kv·kp / (M·s² + (Fv + g·kv)·s + g·kv·kp)
@@ -8,12 +9,30 @@
 //!
 //! so a natural frequency `ω_n` and a damping ratio `ζ` give the gains in
 //! closed form, `kv = (2ζω_n·M − Fv)/g` and `kp = ω_n²·M/(g·kv)`; a −3 dB
-//! bandwidth `ω_b` asked for is `ω_n·√(1 − 2ζ² + √(4ζ⁴ − 4ζ² + 2))`. The
-//! result reports both gain sets' closed loops (poles, bandwidth, following
-//! error) and step overshoot, and [`DriveStructure::run_figures`] runs a
-//! program through the nonlinear simulation (friction, saturation, a sampled
-//! controller) for either gain set.
-//! Other loop structures are refused with the reason.
+//! bandwidth `ω_b` asked for is `ω_n·√(1 − 2ζ² + √(4ζ⁴ − 4ζ² + 2))`. A PD
+//! position loop commanding the force is the same second-order system
+//! (`M·s² + (Fv + g·kp·kd)·s + g·kp`). With an integral — a PI velocity
+//! loop, or a PID position loop commanding the force — the closed loop is
+//! of third order, and its poles are placed at `(s + p)(s² + 2ζω_n·s +
+//! ω_n²)`, `p = ω_n/4` (0.15 or 0.1 `ω_n` where that leaves no real gains):
+//!
+//! ```text
+//! P/PI:  M·s³ + (Fv + g·kv)·s² + g·kv·(ki + kp)·s + g·kv·ki·kp
+//!        kv = (M·(p + 2ζω_n) − Fv)/g;  ki, kp the roots of t² − S·t + P,
+//!        S = M·(ω_n² + 2ζω_n·p)/(g·kv), P = M·p·ω_n²/(g·kv), ki the smaller
+//!        (its zero −ki beside the pole −p)
+//! PID:   M·s³ + (Fv + g·kp·kd)·s² + g·kp·s + g·kp·ki
+//!        kp = M·(ω_n² + 2ζω_n·p)/g,  ki = M·p·ω_n²/(g·kp),  kd = (M·(p + 2ζω_n) − Fv)/(g·kp)
+//! ```
+//!
+//! and `ω_n` is found by bisection where the closed loop's −3 dB bandwidth
+//! is the one asked (the zeros shift it from the second-order formula).
+//! Feed-forward gains are kept. The result reports both gain sets' closed
+//! loops (poles, bandwidth, following error) and step overshoot, and
+//! [`DriveStructure::run_figures`] runs a program through the nonlinear
+//! simulation (friction, saturation, a sampled controller) for either gain
+//! set. Two-mass axes and other loop structures are refused with the
+//! reason.
 
 use serde::Serialize;
 
@@ -39,6 +58,12 @@ pub struct Tuned {
     pub position_kp: (f64, f64),
     /// Velocity-loop gain before and after.
     pub velocity_kp: (f64, f64),
+    /// Position-loop integral rate before and after \[1/s\] (0 without).
+    pub position_ki: (f64, f64),
+    /// Position-loop derivative time before and after \[s\] (0 without).
+    pub position_kd: (f64, f64),
+    /// Velocity-loop integral rate before and after \[1/s\] (0 without).
+    pub velocity_ki: (f64, f64),
     /// The closed loop before.
     pub before: StructureSummary,
     /// The closed loop after.
@@ -86,13 +111,6 @@ impl DriveStructure {
                 reason: "gains are retuned for rigid mechanics only (a two-mass axis's mode needs more than two gains)",
             });
         }
-        if self.position.kind != LoopKind::P || self.velocity.kind != LoopKind::P {
-            return Err(Error::InvalidParameter {
-                name: "tune",
-                value: f64::NAN,
-                reason: "gains are retuned for a P position loop around a P velocity loop (the EMPS class) only",
-            });
-        }
         let z = target.damping;
         if !(z.is_finite() && z > 0.0 && z <= 2.0) {
             return Err(Error::InvalidParameter {
@@ -109,38 +127,165 @@ impl DriveStructure {
                 reason: "must be finite and > 0 Hz",
             });
         }
+        let class = match (self.position.kind, self.velocity.kind) {
+            (LoopKind::P, LoopKind::P) => Class::CascadeP,
+            (LoopKind::P, LoopKind::PI) => Class::CascadePi,
+            (LoopKind::PD, LoopKind::None) => Class::ForcePd,
+            (LoopKind::PID, LoopKind::None) => Class::ForcePid,
+            _ => {
+                return Err(Error::InvalidParameter {
+                    name: "tune",
+                    value: f64::NAN,
+                    reason: "gains are retuned for a P position loop around a P or PI velocity loop, or a PD or PID position loop commanding the force",
+                })
+            }
+        };
         let ratio = (1.0 - 2.0 * z * z + (4.0 * z.powi(4) - 4.0 * z * z + 2.0).sqrt()).sqrt();
         let wn = 2.0 * std::f64::consts::PI * fb / ratio;
-        let (g, m, fv) = (
-            self.drive.gain,
-            self.mechanics.total_mass(),
-            self.friction.viscous,
-        );
-        let kv = (2.0 * z * wn * m - fv) / g;
-        if kv.is_nan() || kv <= 0.0 {
-            return Err(Error::InvalidParameter {
-                name: "bandwidth",
-                value: fb,
-                reason:
-                    "is below what the viscous friction alone gives at this damping: ask for more",
-            });
-        }
-        let kp = wn * wn * m / (g * kv);
-        let mut structure = self.clone();
-        structure.position.kp = kp;
-        structure.velocity.kp = kv;
+        let structure = match class {
+            // second order: the bandwidth gives ω_n in closed form
+            Class::CascadeP | Class::ForcePd => self.placed(class, wn, z)?,
+            // third order (the integral's pole at ω_n/4 and its zero near
+            // it): ω_n found where the closed loop's bandwidth is the one asked
+            Class::CascadePi | Class::ForcePid => {
+                let bandwidth = |w: f64| -> Result<f64> {
+                    self.placed(class, w, z)?.closed_loop()?.bandwidth_hz.ok_or(
+                        Error::InvalidModel {
+                            reason: "the tuned closed loop has no bandwidth",
+                        },
+                    )
+                };
+                let (mut lo, mut hi) = (wn / 8.0, wn * 8.0);
+                if !(bandwidth(lo)? < fb && bandwidth(hi)? > fb) {
+                    return Err(Error::InvalidParameter {
+                        name: "bandwidth",
+                        value: fb,
+                        reason: "cannot be reached by placing the loop's poles at this damping",
+                    });
+                }
+                for _ in 0..80 {
+                    let mid = (lo * hi).sqrt();
+                    if bandwidth(mid)? < fb {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                    if hi / lo - 1.0 < 1e-12 {
+                        break;
+                    }
+                }
+                self.placed(class, (lo * hi).sqrt(), z)?
+            }
+        };
         let before = self.closed_loop()?;
         let after = structure.closed_loop()?;
+        let pair = |f: fn(&DriveStructure) -> f64| (f(self), f(&structure));
         Ok(Tuned {
-            position_kp: (self.position.kp, kp),
-            velocity_kp: (self.velocity.kp, kv),
+            position_kp: pair(|s| s.position.kp),
+            velocity_kp: pair(|s| s.velocity.kp),
+            position_ki: pair(|s| s.position.terms().1),
+            position_kd: pair(|s| s.position.terms().2),
+            velocity_ki: pair(|s| s.velocity.terms().1),
             overshoot_percent: (overshoot(self, &before)?, overshoot(&structure, &after)?),
             before,
             after,
             structure,
         })
     }
+
+    /// The structure with the gains that place its closed-loop poles at
+    /// `s² + 2ζω_n·s + ω_n²` (and, with an integral, at `s + ω_n/4`; closer
+    /// to the origin where that leaves no real gains).
+    fn placed(&self, class: Class, wn: f64, z: f64) -> Result<DriveStructure> {
+        let (g, m, fv) = (
+            self.drive.gain,
+            self.mechanics.total_mass(),
+            self.friction.viscous,
+        );
+        let too_low = Error::InvalidParameter {
+            name: "bandwidth",
+            value: wn,
+            reason: "is below what the viscous friction alone gives at this damping: ask for more",
+        };
+        let mut s = self.clone();
+        match class {
+            Class::CascadeP => {
+                let kv = (2.0 * z * wn * m - fv) / g;
+                if kv.is_nan() || kv <= 0.0 {
+                    return Err(too_low);
+                }
+                s.velocity.kp = kv;
+                s.position.kp = wn * wn * m / (g * kv);
+            }
+            Class::ForcePd => {
+                // M·s² + (Fv + g·kp·kd)·s + g·kp
+                let kp = wn * wn * m / g;
+                let kd = (2.0 * z * wn * m - fv) / (g * kp);
+                if kd.is_nan() || kd < 0.0 {
+                    return Err(too_low);
+                }
+                s.position.kp = kp;
+                s.position.kd = kd;
+            }
+            Class::CascadePi => {
+                // M·s³ + (Fv + g·kv)·s² + g·kv·(ki + kp)·s + g·kv·ki·kp
+                let placed = INTEGRAL_POLES.iter().find_map(|share| {
+                    let p = share * wn;
+                    let kv = (m * (p + 2.0 * z * wn) - fv) / g;
+                    if kv.is_nan() || kv <= 0.0 {
+                        return None;
+                    }
+                    let sum = m * (wn * wn + 2.0 * z * wn * p) / (g * kv);
+                    let product = m * p * wn * wn / (g * kv);
+                    let disc = sum * sum - 4.0 * product;
+                    // the integral's zero (−ki) is the smaller root, beside
+                    // its pole: little overshoot from it
+                    (disc >= 0.0).then(|| {
+                        let root = disc.sqrt();
+                        (kv, 0.5 * (sum + root), 0.5 * (sum - root))
+                    })
+                });
+                let Some((kv, kp, ki)) = placed else {
+                    return Err(too_low);
+                };
+                s.velocity.kp = kv;
+                s.velocity.ki = ki;
+                s.position.kp = kp;
+            }
+            Class::ForcePid => {
+                // M·s³ + (Fv + g·kp·kd)·s² + g·kp·s + g·kp·ki
+                let p = INTEGRAL_POLES[0] * wn;
+                let kp = m * (wn * wn + 2.0 * z * wn * p) / g;
+                let ki = m * p * wn * wn / (g * kp);
+                let kd = (m * (p + 2.0 * z * wn) - fv) / (g * kp);
+                if kd.is_nan() || kd < 0.0 {
+                    return Err(too_low);
+                }
+                s.position.kp = kp;
+                s.position.ki = ki;
+                s.position.kd = kd;
+            }
+        }
+        Ok(s)
+    }
 }
+
+/// The loop structures `tune` retunes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Class {
+    /// P position loop around a P velocity loop.
+    CascadeP,
+    /// P position loop around a PI velocity loop.
+    CascadePi,
+    /// PD position loop commanding the force.
+    ForcePd,
+    /// PID position loop commanding the force.
+    ForcePid,
+}
+
+/// Places of the integral's pole tried, as shares of `ω_n`: the first that
+/// leaves real gains.
+const INTEGRAL_POLES: [f64; 3] = [0.25, 0.15, 0.1];
 
 /// A program run through a structure's nonlinear simulation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

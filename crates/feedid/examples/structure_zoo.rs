@@ -69,18 +69,17 @@ struct Outcome {
 fn run(i: usize) -> Result<Outcome, String> {
     let a = StructureAxis::new(i).map_err(|e| format!("#{i}: {e}"))?;
     let measured = a.measured();
-    let fit = [0.3, 0.15, 0.05]
-        .into_iter()
-        .map(|share| {
-            a.start(share)
-                .fit_with_restarts(&a.command, &measured, a.rate_hz, &a.estimate, 2)
-        })
-        .find(|f| f.is_ok())
-        .unwrap_or_else(|| {
-            a.start(0.3)
-                .fit_with_restarts(&a.command, &measured, a.rate_hz, &a.estimate, 2)
-        })
-        .map_err(|e| format!("#{i} {}: {e}", a.label))?;
+    let mut fitted = Err(String::new());
+    for share in [0.3, 0.15, 0.05] {
+        fitted = a
+            .start(share)
+            .fit_with_restarts(&a.command, &measured, a.rate_hz, &a.estimate, 2)
+            .map_err(|e| format!("#{i} {}: {e}", a.label));
+        if fitted.is_ok() {
+            break;
+        }
+    }
+    let fit = fitted?;
     let checked = fit
         .estimates
         .iter()

@@ -530,6 +530,14 @@ mod tests {
             .unwrap()
     }
 
+    /// Largest |a − b| over the samples both have.
+    fn largest_gap(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max)
+    }
+
     fn trajectory(n: usize) -> Vec<f64> {
         // smooth rest-to-rest move after 100 samples of rest
         (0..n)
@@ -579,11 +587,7 @@ mod tests {
         let mut u = vec![0.0; 300];
         inv.apply_into(&y, &mut u, &mut Vec::new()).unwrap();
         let back = simulate(&b, &a, &u);
-        let err = back
-            .iter()
-            .zip(&y)
-            .map(|(p, q)| (p - q).abs())
-            .fold(0.0, f64::max);
+        let err = largest_gap(&back, &y);
         assert!(err < 1e-13, "{err}");
         // the anti-causal part moves the input before the output
         assert!(u[95].abs() > 1e-6);
@@ -609,11 +613,7 @@ mod tests {
         let mut u = vec![0.0; 300];
         inv.apply_into(&y, &mut u, &mut Vec::new()).unwrap();
         let back = simulate(&b, &a, &u);
-        let err = back
-            .iter()
-            .zip(&y)
-            .map(|(p, q)| (p - q).abs())
-            .fold(0.0, f64::max);
+        let err = largest_gap(&back, &y);
         assert!(err < 1e-3, "{err}");
     }
 
@@ -638,11 +638,7 @@ mod tests {
         // the model driven by u follows y; the command stays of its size
         // (the zero-phase approximation's gain here is (1 + z)/(1 − z)² ≈ 10⁸)
         let back = simulate(&b, &a, &u);
-        let err = back
-            .iter()
-            .zip(&y)
-            .map(|(p, q)| (p - q).abs())
-            .fold(0.0, f64::max);
+        let err = largest_gap(&back, &y);
         assert!(err < 1e-9, "{err}");
         let peak = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         assert!(peak < 20.0, "{peak}");

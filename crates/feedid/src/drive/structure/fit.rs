@@ -406,6 +406,10 @@ impl DriveStructure {
 /// theirs.
 fn standard_errors(j: DMatrix<f64>, sigma2: f64) -> Vec<f64> {
     let n = j.ncols();
+    if j.nrows() < n {
+        // fewer samples than parameters: some direction is never seen
+        return vec![f64::INFINITY; n];
+    }
     let svd = j.svd(false, true);
     let Some(vt) = svd.v_t else {
         return vec![f64::INFINITY; n];
@@ -687,5 +691,8 @@ mod tests {
         let s = standard_errors(j, 1.0);
         assert!(s[0].is_infinite() && s[1].is_infinite(), "{s:?}");
         assert!((s[2] - 1.0 / 3.0).abs() < 1e-12, "{s:?}");
+        // fewer samples than parameters: nothing is known
+        let s = standard_errors(DMatrix::from_column_slice(1, 2, &[1.0, 2.0]), 1.0);
+        assert!(s.iter().all(|v| v.is_infinite()), "{s:?}");
     }
 }

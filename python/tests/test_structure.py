@@ -70,3 +70,12 @@ def test_tune_places_the_poles_of_a_pi_velocity_loop(tmp_path):
     out = tmp_path / "tuned.toml"
     out.write_text(t["toml"])
     assert feedid.structure(out)["bandwidth_hz"] == pytest.approx(15.0, rel=1e-6)
+
+
+def test_the_papers_cascade_reads_as_a_structure_with_its_seventh_order_closed_loop():
+    paper = pathlib.Path(__file__).resolve().parents[2] / "examples" / "paper.toml"
+    s = feedid.structure(paper)
+    assert s["stable"]
+    assert len(s["poles"]) == 7
+    assert len(s["denominator"]) == 8
+    assert s["following_error_per_velocity"] == pytest.approx(1.0 / 700.0, rel=1e-9)

@@ -808,3 +808,102 @@ fn tuning_an_integral_loop_places_its_poles_and_hits_the_bandwidth() {
         .unwrap_err();
     assert!(e.to_string().contains("rigid"), "{e}");
 }
+
+#[test]
+fn the_papers_cascade_as_a_structure_is_its_seventh_order_closed_loop() {
+    use feedid::drive::{closed_loop_coefficients, D1Variant, RigParams};
+    let mut ff = RigParams::default();
+    ff.control.kvff = 0.8;
+    ff.control.kaff = 0.5;
+    for p in [RigParams::default(), ff] {
+        let s = DriveStructure::paper(&p).unwrap();
+        let ours = s.transfer_function().unwrap();
+        let paper = closed_loop_coefficients(&p, D1Variant::Corrected)
+            .transfer_function()
+            .unwrap();
+        // the same polynomials up to a common factor
+        let k = ours.den()[0] / paper.den()[0];
+        for (a, b) in [(ours.den(), paper.den()), (ours.num(), paper.num())] {
+            let top = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let (a, b) = (trimmed(a), trimmed(b));
+            assert_eq!(a.len(), b.len(), "{a:?} {b:?}");
+            for (x, y) in a.iter().zip(b) {
+                assert!((x / k - y).abs() <= 1e-9 * top, "{x} {y}");
+            }
+        }
+        // through a structure file and back
+        let again = DriveStructure::from_toml_str(&s.to_toml_string(), None).unwrap();
+        assert_eq!(again, s);
+    }
+}
+
+/// `p` without leading coefficients below 1e-300 of its largest.
+fn trimmed(p: &[f64]) -> Vec<f64> {
+    let top = p.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let first = p.iter().position(|v| v.abs() > 1e-300 * top).unwrap_or(0);
+    p[first..].to_vec()
+}
+
+#[test]
+fn a_current_loop_simulation_follows_its_transfer_function() {
+    // the paper's cascade (current loop, back-EMF, screw stiffness, velocity
+    // from the motor) without friction or limits: the simulated ramp
+    // response is the transfer function's
+    let p = feedid::drive::RigParams::default();
+    let s = DriveStructure::paper(&p).unwrap();
+    let worst = ramp_gap(&s, 0.05, 5000.0, 2500);
+    assert!(worst < 1e-9, "{worst}");
+    // and a current loop far faster than the mechanics is a force source
+    let mut fast = emps();
+    fast.controller.sample_time = None;
+    fast.drive.limit = None;
+    let ideal = fast.closed_loop().unwrap();
+    fast.current = Some(feedid::drive::CurrentLoop {
+        kp: 1e4,
+        ki: 0.0,
+        inductance: 1e-4,
+        resistance: 0.0,
+        back_emf: 0.0,
+    });
+    let with = fast.closed_loop().unwrap();
+    let (a, b) = (ideal.bandwidth_hz.unwrap(), with.bandwidth_hz.unwrap());
+    assert!((a - b).abs() < 1e-3 * a, "{a} {b}");
+    // whose gains `tune` does not place
+    let e = fast
+        .tune(&feedid::drive::TuneTarget {
+            bandwidth_hz: 40.0,
+            damping: 0.7,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("force-source"), "{e}");
+    // a current loop's values are checked by name
+    let text = "[position]\nkp = 1.0\n[drive]\ngain = 1.0\n[mechanics]\nmass = 1.0\n\
+                [current]\nkp = 1.0\ninductance = 0.0\nresistance = 1.0\n";
+    let e = DriveStructure::from_toml_str(text, None).unwrap_err();
+    assert!(e.to_string().contains("current.inductance"), "{e}");
+}
+
+#[test]
+fn the_paper_cascade_s_mass_and_table_friction_are_recovered_and_the_start_reported() {
+    use feedid::drive::StructureParam as P;
+    // a PRBS-like program through the paper's cascade (current loop,
+    // screw, velocity from the motor); the fit starts from 4 kg and 70 N·s/m
+    let p = feedid::drive::RigParams::default();
+    let truth = DriveStructure::paper(&p).unwrap();
+    let rate = 5000.0;
+    let cmd = feedid::signal::Scenario::Prbs
+        .command(rate, 1.1, 0)
+        .unwrap();
+    let run = truth.simulate(&cmd, rate, 0.0).unwrap();
+    let mut start = truth.clone();
+    start.mechanics.mass = 4.0;
+    start.friction.viscous = 70.0;
+    let fit = start
+        .fit_with_restarts(&cmd, &run.position, rate, &[P::Mass, P::Viscous], 2)
+        .unwrap();
+    for (e, (file, t)) in fit.estimates.iter().zip([(4.0, 3.0), (70.0, 100.0)]) {
+        assert_eq!(e.start, file, "{fit}");
+        assert!(((e.value - t) / t).abs() < 1e-6, "{fit}");
+        assert!(e.identifiable, "{fit}");
+    }
+}

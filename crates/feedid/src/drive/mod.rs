@@ -25,9 +25,9 @@ pub use rig::{
 };
 pub use stability::{check_model, require_stable, ModelCheck};
 pub use structure::{
-    check_restarts, inverse_dynamics, Controller, Drive, DriveStructure, FeedForward, FrictionLaw,
-    IdimConfig, IdimFit, LoopGains, LoopKind, Measured, Mechanics, RunFigures, StructureEstimate,
-    StructureFit, StructureParam, StructureRun, StructureSummary, StructureValidation, TuneTarget,
-    Tuned, VelocityEstimate, EQUALLY_GOOD, MAX_RESTARTS, PINNED,
+    check_restarts, inverse_dynamics, Controller, CurrentLoop, Drive, DriveStructure, FeedForward,
+    FrictionLaw, IdimConfig, IdimFit, LoopGains, LoopKind, Measured, Mechanics, RunFigures,
+    StructureEstimate, StructureFit, StructureParam, StructureRun, StructureSummary,
+    StructureValidation, TuneTarget, Tuned, VelocityEstimate, EQUALLY_GOOD, MAX_RESTARTS, PINNED,
 };
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

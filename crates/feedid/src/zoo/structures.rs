@@ -184,6 +184,7 @@ fn draw(i: usize, attempt: u64) -> StructureAxis {
     let controller = Controller {
         sample_time: sampled.then_some(1.0 / rate),
         velocity_estimate: VelocityEstimate::Central,
+        velocity_feedback: None,
     };
     let p = |kp: f64| LoopGains {
         kind: LoopKind::P,
@@ -203,6 +204,7 @@ fn draw(i: usize, attempt: u64) -> StructureAxis {
         stiffness: None,
         damping: 0.0,
         measured: Measured::Load,
+        motor_viscous: 0.0,
     };
     let drive = Drive { gain, limit: None };
     let no_ff = FeedForward::default();
@@ -215,6 +217,7 @@ fn draw(i: usize, attempt: u64) -> StructureAxis {
                 position: p(w_v / 4.0),
                 velocity: p(w_v * mass / gain),
                 drive,
+                current: None,
                 mechanics: rigid(mass),
                 friction,
                 feed_forward: no_ff,
@@ -233,6 +236,7 @@ fn draw(i: usize, attempt: u64) -> StructureAxis {
                     kd: 0.0,
                 },
                 drive,
+                current: None,
                 mechanics: rigid(mass),
                 friction,
                 feed_forward: FeedForward {
@@ -257,6 +261,7 @@ fn draw(i: usize, attempt: u64) -> StructureAxis {
                     },
                     velocity: none,
                     drive,
+                    current: None,
                     mechanics: rigid(mass),
                     friction,
                     feed_forward: no_ff,
@@ -280,12 +285,14 @@ fn draw(i: usize, attempt: u64) -> StructureAxis {
                     position: p(w_v / 4.0),
                     velocity: p(w_v * (mass + motor) / gain),
                     drive,
+                    current: None,
                     mechanics: Mechanics {
                         mass,
                         motor_mass: Some(motor),
                         stiffness: Some(stiffness),
                         damping,
                         measured: Measured::Motor,
+                        motor_viscous: 0.0,
                     },
                     friction,
                     feed_forward: no_ff,

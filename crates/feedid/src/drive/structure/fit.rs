@@ -497,7 +497,10 @@ impl DriveStructure {
         // the best of all is the estimate; a fit that ended clearly worse
         // (a local minimum of the simulation error) says nothing of what
         // the data pin
-        let start_rms = first.start_rms;
+        let (start_rms, starts) = (
+            first.start_rms,
+            first.estimates.iter().map(|e| e.start).collect::<Vec<_>>(),
+        );
         fits.push(first);
         let best = fits
             .iter()
@@ -505,7 +508,11 @@ impl DriveStructure {
             .min_by(|a, b| a.1.rms.total_cmp(&b.1.rms))
             .map_or(0, |(i, _)| i);
         let mut fit = fits.swap_remove(best);
+        // the start reported is the caller's, whichever fit ended best
         fit.start_rms = start_rms;
+        for (e, start) in fit.estimates.iter_mut().zip(starts) {
+            e.start = start;
+        }
         // (and on data without noise, a fit within a millionth of the
         // motion: what is left there is the solver's tolerance)
         let n = position.len().max(1) as f64;

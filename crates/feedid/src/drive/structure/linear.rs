@@ -2,18 +2,24 @@
 //! its viscous term, no saturation, the controller continuous.
 //!
 //! With the mechanics `P(s) = P_n/P_d` from force to the measured position
-//! ([`DriveStructure::plant`]; rigid `1/(s·(M·s + Fv))`) and each controller
-//! `C = N/D` as polynomials, the command-to-position transfer function is,
-//! with a velocity loop,
+//! ([`DriveStructure::plant`]; rigid `1/(s·(M·s + Fv))`), `P_v/P_d` to the
+//! position whose velocity the velocity loop feeds back and `P_m/P_d` to
+//! the motor's, and each controller `C = N/D` as polynomials, the drive
+//! from the controller's output `u` to the force is `F = g·u` (a force
+//! source) or, with a current loop `C_i = N_i/D_i` on a winding `L, R` with
+//! back-EMF `ke`, `F = g·(N_i·u − D_i·ke·s·X_m)/Δ_i`, `Δ_i = D_i·(L·s + R) +
+//! N_i`. With `Q = Δ_i·P_d + g·D_i·ke·s·P_m` (`P_d` for a force source,
+//! `N_i = 1`), `A_n = g·N_i·P_n` and `A_v = g·N_i·P_v`, the
+//! command-to-position transfer function is, with a velocity loop,
 //!
 //! ```text
-//! X/X_s = P_n·(g·N_v·(N_p + kvff·s·D_p) + kaff·M·s²·D_p·D_v)
-//!         ─────────────────────────────────────────────────────────
-//!         P_d·D_p·D_v + g·P_n·N_v·(N_p + s·D_p)
+//! X/X_s = A_n·(N_v·(N_p + kvff·s·D_p) + (kaff·M/g)·s²·D_p·D_v)
+//!         ──────────────────────────────────────────────────────
+//!         Q·D_p·D_v + N_v·(N_p·A_n + s·D_p·A_v)
 //! ```
 //!
 //! and without one (`N_v = D_v = 1`, no velocity feedback)
-//! `P_n·(g·N_p + kaff·M·s²·D_p) / (P_d·D_p + g·P_n·N_p)`. The following
+//! `A_n·(N_p + (kaff·M/g)·s²·D_p) / (Q·D_p + A_n·N_p)`. The following
 //! error of a ramp of velocity `v` is `v·lim_{s→0} (D − N)/(s·D)`: with a
 //! velocity loop of kind P on a P position loop, `v·(1 − kvff)/kp + v·Fv/(g·kv·kp)`.
 
@@ -104,52 +110,89 @@ impl DriveStructure {
         let g = self.drive.gain;
         let m = self.mechanics.total_mass();
         let (kvff, kaff) = (self.feed_forward.velocity, self.feed_forward.acceleration);
-        // force to measured position: P = pn/pd
-        let (pn, pd) = self.plant();
+        // force to the load's, the motor's position: P = p/pd
+        let (pl, pm, pd) = self.plant_sides();
+        let side = |measured: super::Measured| match measured {
+            super::Measured::Load => pl.clone(),
+            super::Measured::Motor => pm.clone(),
+        };
+        let two_mass = self.mechanics.two_mass();
+        let pn = if two_mass {
+            side(self.mechanics.measured)
+        } else {
+            pl.clone()
+        };
+        let pv = match (two_mass, self.controller.velocity_feedback) {
+            (true, Some(v)) => side(v),
+            _ => pn.clone(),
+        };
+        // the drive, output to force F = g·(N_i·u − D_i·ke·s·X_m)/Δ_i:
+        // with the plant, F = g·N_i·P_d·u/Q, Q = Δ_i·P_d + g·D_i·ke·s·P_m
+        let (ni, q) = match &self.current {
+            Some(c) => {
+                let (ni, di) = if c.ki > 0.0 {
+                    (vec![c.kp, c.kp * c.ki], vec![1.0, 0.0])
+                } else {
+                    (vec![c.kp], vec![1.0])
+                };
+                let delta = add(&mul(&di, &[c.inductance, c.resistance]), &ni);
+                let emf = scale(&mul(&di, &mul(&[1.0, 0.0], &pm)), g * c.back_emf);
+                (ni, add(&mul(&delta, &pd), &emf))
+            }
+            None => (vec![1.0], pd.clone()),
+        };
+        // output to measured position: g·N_i·P_n/Q
+        let an = scale(&mul(&ni, &pn), g);
+        let av = scale(&mul(&ni, &pv), g);
         let s = [1.0, 0.0];
-        // the acceleration feed-forward's force kaff·M·s²·Xs through the plant
-        let accel = scale(&mul(&[m, 0.0, 0.0], &pn), kaff);
+        // the acceleration feed-forward's output kaff·M/g·s²·Xs
+        let accel = scale(&mul(&[m, 0.0, 0.0], &an), kaff / g);
         let (num, den) = if self.velocity.kind == LoopKind::None {
-            let num = add(&scale(&mul(&pn, &np), g), &mul(&accel, &dp));
-            let den = add(&mul(&pd, &dp), &scale(&mul(&pn, &np), g));
+            let num = add(&mul(&an, &np), &mul(&accel, &dp));
+            let den = add(&mul(&q, &dp), &mul(&an, &np));
             (num, den)
         } else {
             let inner = add(&np, &scale(&mul(&s, &dp), kvff));
-            let num = add(
-                &scale(&mul(&pn, &mul(&nv, &inner)), g),
-                &mul(&accel, &mul(&dp, &dv)),
-            );
-            let feedback = add(&np, &mul(&s, &dp));
-            let den = add(
-                &mul(&pd, &mul(&dp, &dv)),
-                &scale(&mul(&pn, &mul(&nv, &feedback)), g),
-            );
+            let num = add(&mul(&an, &mul(&nv, &inner)), &mul(&accel, &mul(&dp, &dv)));
+            let feedback = add(&mul(&np, &an), &mul(&s, &mul(&dp, &av)));
+            let den = add(&mul(&q, &mul(&dp, &dv)), &mul(&nv, &feedback));
             (num, den)
         };
         TransferFunction::new(trim(num), trim(den))
     }
 
     /// The mechanics from force to the measured position, `(numerator,
-    /// denominator)`, viscous friction only: rigid `1/(s·(M·s + Fv))`;
-    /// two-mass, with `K = c·s + k`, `A_m = M_m·s² + K`,
-    /// `A_l = M_l·s² + Fv·s + K` and `Δ = A_m·A_l − K²`, `K/Δ` on the load
-    /// and `A_l/Δ` on the motor.
+    /// denominator)`, viscous friction only: rigid `1/(s·(M·s + Fv + Fv_m))`;
+    /// two-mass, with `K = c·s + k`, `A_m = M_m·s² + (c + Fv_m)·s + k`,
+    /// `A_l = M_l·s² + (Fv + c)·s + k` and `Δ = A_m·A_l − K²`, `K/Δ` on the
+    /// load and `A_l/Δ` on the motor (`Fv_m` the motor side's viscous
+    /// friction).
     pub fn plant(&self) -> (Vec<f64>, Vec<f64>) {
+        let (pl, pm, pd) = self.plant_sides();
+        match self.mechanics.measured {
+            super::Measured::Motor if self.mechanics.two_mass() => (pm, pd),
+            _ => (pl, pd),
+        }
+    }
+
+    /// Force to the load's and to the motor's position: `(load numerator,
+    /// motor numerator, denominator)` ([`DriveStructure::plant`]).
+    fn plant_sides(&self) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let mech = &self.mechanics;
         let fv = self.friction.viscous;
         match (mech.stiffness, mech.motor_mass) {
             (Some(k), Some(mm)) => {
                 let kk = [mech.damping, k];
-                let am = [mm, mech.damping, k];
+                let am = [mm, mech.damping + mech.motor_viscous, k];
                 let al = [mech.mass, fv + mech.damping, k];
                 let delta = add(&mul(&am, &al), &scale(&mul(&kk, &kk), -1.0));
-                let num = match mech.measured {
-                    super::Measured::Load => kk.to_vec(),
-                    super::Measured::Motor => al.to_vec(),
-                };
-                (trim(num), trim(delta))
+                (trim(kk.to_vec()), trim(al.to_vec()), trim(delta))
             }
-            _ => (vec![1.0], vec![mech.total_mass(), fv, 0.0]),
+            _ => (
+                vec![1.0],
+                vec![1.0],
+                vec![mech.total_mass(), fv + mech.motor_viscous, 0.0],
+            ),
         }
     }
 

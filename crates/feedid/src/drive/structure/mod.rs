@@ -48,6 +48,12 @@
 //! [drive]
 //! gain = 35.1507               # N per unit of output
 //! limit = 10.0                 # ± output (optional)
+//! # [current]                  # a modelled current loop (absent: a force source;
+//! # kp = 4.4                   #   then gain is N/A and the output the current command)
+//! # ki = 3430.0                # 1/s
+//! # inductance = 3.5e-4        # H
+//! # resistance = 1.2           # Ω
+//! # back_emf = 37.7            # V/(m/s) of the motor side
 //! [mechanics]
 //! mass = 95.1089               # kg (two-mass: the load's, with motor_mass,
 //!                              #   stiffness [N/m], damping, measured = "load"/"motor")
@@ -60,13 +66,20 @@
 //! acceleration = 0.0           # kaff
 //! ```
 //!
-//! The paper's cascade (P / PI / PI with the motor's electrical dynamics and
-//! the screw's stiffness) is the rig parameter file ([`crate::drive::RigParams`]);
-//! this structure covers the axes whose current loop is a force source.
+//! A current loop may be modelled (`[current]`: PI on the winding, `L·di/dt
+//! = V − R·i − ke·v_m`, `F = g·i`), the velocity loop may feed back the
+//! motor's side of a two-mass axis while the position loop closes on the
+//! load (`[controller] velocity_feedback = "motor"`), and the motor side
+//! may have its own viscous friction (`motor_viscous`): the paper's cascade
+//! (P / PI / PI with the motor's electrical dynamics and the screw's
+//! stiffness) is then a structure too ([`DriveStructure::paper`],
+//! `examples/paper.toml`), whose closed loop is the rig parameter file's
+//! ([`crate::drive::RigParams`]) 7th-order one.
 
 mod fit;
 mod idim;
 mod linear;
+mod paper;
 mod simulate;
 mod tune;
 
@@ -154,6 +167,35 @@ pub struct Controller {
     /// Velocity estimate of a sampled controller; default central.
     #[serde(default)]
     pub velocity_estimate: VelocityEstimate,
+    /// Side whose velocity the velocity loop feeds back (two-mass: a motor
+    /// encoder under a position loop closed on the table, as the paper's
+    /// cascade); `None`: the measured side.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity_feedback: Option<Measured>,
+}
+
+/// A current loop between the controller and the motor (absent: the drive
+/// is an ideal force source): the controller's output is the current
+/// command \[A\], a PI controller `kp·(1 + ki/s)` drives the winding's
+/// voltage, `L·di/dt = V − R·i − ke·v_m` (`v_m` the motor side's velocity at
+/// the load), and the force is `drive.gain·i` (`drive.gain` then in N/A at
+/// the load: the motor constant over the screw's `h/2π`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurrentLoop {
+    /// Proportional gain \[V/A\].
+    pub kp: f64,
+    /// Integral rate \[1/s\]; default 0 (P).
+    #[serde(default)]
+    pub ki: f64,
+    /// Winding inductance L \[H\].
+    pub inductance: f64,
+    /// Winding resistance R \[Ω\].
+    pub resistance: f64,
+    /// Back-EMF per velocity of the motor side at the load \[V/(m/s)\]
+    /// (the motor's `Ke` over `h/2π`); default 0.
+    #[serde(default)]
+    pub back_emf: f64,
 }
 
 /// The drive: a force source commanded by the controller's output.
@@ -199,6 +241,15 @@ pub struct Mechanics {
     /// Side the position is measured on (two-mass); default load.
     #[serde(default)]
     pub measured: Measured,
+    /// Viscous friction on the motor side \[N·s/m at the load\] (the
+    /// motor's bearings, `C1/(h/2π)²`); default 0 (rigid: added to the
+    /// friction law's).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub motor_viscous: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Mechanics {
@@ -293,6 +344,9 @@ pub struct DriveStructure {
     pub velocity: LoopGains,
     /// The drive.
     pub drive: Drive,
+    /// The current loop, when modelled; default: an ideal force source.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub current: Option<CurrentLoop>,
     /// The mechanics.
     pub mechanics: Mechanics,
     /// The friction law; default none.
@@ -421,6 +475,29 @@ impl DriveStructure {
         }
         if !(mech.damping.is_finite() && mech.damping >= 0.0) {
             return bad("mechanics.damping", mech.damping, "must be finite and >= 0");
+        }
+        if !(mech.motor_viscous.is_finite() && mech.motor_viscous >= 0.0) {
+            return bad(
+                "mechanics.motor_viscous",
+                mech.motor_viscous,
+                "must be finite and >= 0",
+            );
+        }
+        if let Some(c) = &self.current {
+            for (name, x) in [("current.kp", c.kp), ("current.inductance", c.inductance)] {
+                if !(x.is_finite() && x > 0.0) {
+                    return bad(name, x, "must be finite and > 0");
+                }
+            }
+            for (name, x) in [
+                ("current.ki", c.ki),
+                ("current.resistance", c.resistance),
+                ("current.back_emf", c.back_emf),
+            ] {
+                if !(x.is_finite() && x >= 0.0) {
+                    return bad(name, x, "must be finite and >= 0");
+                }
+            }
         }
         if mech.two_mass() && mech.motor_mass.is_none() {
             return bad(

@@ -33,8 +33,9 @@ pub struct StructureRun {
 const MAX_STEPS: f64 = 1e8;
 
 /// State: load position and velocity, position-loop integral, velocity-loop
-/// integral, motor position and velocity (rigid: the load's).
-type State = [f64; 6];
+/// integral, motor position and velocity (rigid: the load's), winding
+/// current and current-loop integral (0 for a force source).
+type State = [f64; 8];
 
 impl DriveStructure {
     /// Simulate the structure on `command` sampled at `rate_hz`, from rest at
@@ -95,7 +96,16 @@ impl DriveStructure {
             velocity: vec![0.0; n],
             output: vec![0.0; n],
         };
-        let mut x: State = [initial_position, 0.0, 0.0, 0.0, initial_position, 0.0];
+        let mut x: State = [
+            initial_position,
+            0.0,
+            0.0,
+            0.0,
+            initial_position,
+            0.0,
+            0.0,
+            0.0,
+        ];
         let (mut e_prev, mut history) = (command[0] - initial_position, [initial_position; 2]);
         for k in 0..n {
             let (xm, vm) = self.measured(&x);
@@ -107,9 +117,10 @@ impl DriveStructure {
             let accel = (next - 2.0 * command[k] + prev) / (dt * dt);
             if self.controller.sample_time.is_some() {
                 // the sampled controller: measure, estimate, hold
+                let xv = self.velocity_side(&x).0;
                 let v_hat = match self.controller.velocity_estimate {
-                    VelocityEstimate::Central => (xm - history[1]) / (2.0 * dt),
-                    VelocityEstimate::Backward => (xm - history[0]) / dt,
+                    VelocityEstimate::Central => (xv - history[1]) / (2.0 * dt),
+                    VelocityEstimate::Backward => (xv - history[0]) / dt,
                 };
                 let e = command[k] - xm;
                 let (kp, ki, kd) = self.position.terms();
@@ -127,11 +138,10 @@ impl DriveStructure {
                 };
                 let u = self.saturate(raw + self.acceleration_output(accel));
                 run.output[k] = u;
-                history = [xm, history[0]];
+                history = [xv, history[0]];
                 if k + 1 < n {
-                    let force = self.drive.gain * u;
                     for j in 0..substeps {
-                        rk4(&mut x, j as f64 * h, h, |_, s| self.held(s, force));
+                        rk4(&mut x, j as f64 * h, h, |_, s| self.held(s, u));
                     }
                 }
             } else {
@@ -205,6 +215,15 @@ impl DriveStructure {
         }
     }
 
+    /// The position and velocity the velocity loop feeds back in state `s`.
+    fn velocity_side(&self, s: &State) -> (f64, f64) {
+        match self.controller.velocity_feedback {
+            Some(Measured::Motor) if self.mechanics.two_mass() => (s[4], s[5]),
+            Some(Measured::Load) => (s[0], s[1]),
+            _ => self.measured(s),
+        }
+    }
+
     /// Accelerations of the load and the motor under the drive's `force`.
     fn accelerations(&self, s: &State, force: f64) -> (f64, f64) {
         let mech = &self.mechanics;
@@ -212,20 +231,36 @@ impl DriveStructure {
             (Some(k), Some(mm)) => {
                 let spring = k * (s[4] - s[0]) + mech.damping * (s[5] - s[1]);
                 let load = (spring - self.friction.force(s[1])) / mech.mass;
-                (load, (force - spring) / mm)
+                (load, (force - spring - mech.motor_viscous * s[5]) / mm)
             }
             _ => {
-                let a = (force - self.friction.force(s[1])) / mech.total_mass();
+                let a = (force - self.friction.force(s[1]) - mech.motor_viscous * s[1])
+                    / mech.total_mass();
                 (a, a)
             }
         }
     }
 
-    /// The mechanics under a held force (the sampled controller's integrals
-    /// change only at the samples).
-    fn held(&self, s: &State, force: f64) -> State {
+    /// The drive under the controller's output `u`: the force, and the
+    /// rates of the winding current and the current loop's integral (0 for
+    /// a force source).
+    fn drive(&self, s: &State, u: f64) -> (f64, f64, f64) {
+        match &self.current {
+            Some(c) => {
+                let volts = c.kp * (u - s[6]) + c.kp * c.ki * s[7];
+                let di = (volts - c.resistance * s[6] - c.back_emf * s[5]) / c.inductance;
+                (self.drive.gain * s[6], di, u - s[6])
+            }
+            None => (self.drive.gain * u, 0.0, 0.0),
+        }
+    }
+
+    /// The mechanics and the current loop under a held output `u` (the
+    /// sampled controller's integrals change only at the samples).
+    fn held(&self, s: &State, u: f64) -> State {
+        let (force, di, dz) = self.drive(s, u);
         let (al, am) = self.accelerations(s, force);
-        [s[1], al, 0.0, 0.0, s[5], am]
+        [s[1], al, 0.0, 0.0, s[5], am, di, dz]
     }
 
     /// The continuous controller in state `s` at command `xs` moving at
@@ -240,7 +275,7 @@ impl DriveStructure {
             return (self.saturate(cp + ff), 0.0);
         }
         let (kv, kvi, _) = self.velocity.terms();
-        let ev = cp + self.feed_forward.velocity * slope - v;
+        let ev = cp + self.feed_forward.velocity * slope - self.velocity_side(s).1;
         (self.saturate(kv * (ev + kvi * s[3]) + ff), ev)
     }
 
@@ -252,8 +287,9 @@ impl DriveStructure {
     /// The right-hand side with the continuous controller.
     fn continuous(&self, s: &State, xs: f64, slope: f64, ff: f64) -> State {
         let (u, ev) = self.continuous_law(s, xs, slope, ff);
-        let (al, am) = self.accelerations(s, self.drive.gain * u);
-        [s[1], al, xs - self.measured(s).0, ev, s[5], am]
+        let (force, di, dz) = self.drive(s, u);
+        let (al, am) = self.accelerations(s, force);
+        [s[1], al, xs - self.measured(s).0, ev, s[5], am, di, dz]
     }
 }
 
@@ -265,7 +301,7 @@ fn rk4(x: &mut State, t: f64, h: f64, f: impl Fn(f64, &State) -> State) {
     let k2 = f(t + 0.5 * h, &at(x, 0.5 * h, &k1));
     let k3 = f(t + 0.5 * h, &at(x, 0.5 * h, &k2));
     let k4 = f(t + h, &at(x, h, &k3));
-    for j in 0..6 {
+    for j in 0..x.len() {
         x[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
     }
 }

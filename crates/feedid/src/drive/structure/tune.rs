@@ -31,8 +31,8 @@
 //! loops (poles, bandwidth, following error) and step overshoot, and
 //! [`DriveStructure::run_figures`] runs a program through the nonlinear
 //! simulation (friction, saturation, a sampled controller) for either gain
-//! set. Two-mass axes and other loop structures are refused with the
-//! reason.
+//! set. Two-mass axes, modelled current loops and other loop structures
+//! are refused with the reason.
 
 use serde::Serialize;
 
@@ -109,6 +109,13 @@ impl DriveStructure {
                 name: "tune",
                 value: f64::NAN,
                 reason: "gains are retuned for rigid mechanics only (a two-mass axis's mode needs more than two gains)",
+            });
+        }
+        if self.current.is_some() {
+            return Err(Error::InvalidParameter {
+                name: "tune",
+                value: f64::NAN,
+                reason: "gains are retuned for a force-source drive (the poles placed do not include a modelled current loop)",
             });
         }
         let z = target.damping;

@@ -27,12 +27,17 @@
 //!
 //! and `ω_n` is found by bisection where the closed loop's −3 dB bandwidth
 //! is the one asked (the zeros shift it from the second-order formula).
+//! A two-mass axis or a modelled current loop (the paper's cascade) gets
+//! the gains of its rigid, force-source equivalent (every moving mass, both
+//! sides' viscous friction, the current loop ideal) — the cascade designed
+//! from the inside out — with `ω_n` found by bisection on the whole closed
+//! loop's bandwidth, mode and current loop included; whether that loop is
+//! stable and how damped its poles are is reported, not assumed.
 //! Feed-forward gains are kept. The result reports both gain sets' closed
 //! loops (poles, bandwidth, following error) and step overshoot, and
 //! [`DriveStructure::run_figures`] runs a program through the nonlinear
 //! simulation (friction, saturation, a sampled controller) for either gain
-//! set. Two-mass axes, modelled current loops and other loop structures
-//! are refused with the reason.
+//! set. Other loop structures are refused with the reason.
 
 use serde::Serialize;
 
@@ -104,20 +109,6 @@ impl DriveStructure {
     /// assert!(t.overshoot_percent.1 < 5.0);
     /// ```
     pub fn tune(&self, target: &TuneTarget) -> Result<Tuned> {
-        if self.mechanics.two_mass() {
-            return Err(Error::InvalidParameter {
-                name: "tune",
-                value: f64::NAN,
-                reason: "gains are retuned for rigid mechanics only (a two-mass axis's mode needs more than two gains)",
-            });
-        }
-        if self.current.is_some() {
-            return Err(Error::InvalidParameter {
-                name: "tune",
-                value: f64::NAN,
-                reason: "gains are retuned for a force-source drive (the poles placed do not include a modelled current loop)",
-            });
-        }
         let z = target.damping;
         if !(z.is_finite() && z > 0.0 && z <= 2.0) {
             return Err(Error::InvalidParameter {
@@ -149,30 +140,53 @@ impl DriveStructure {
         };
         let ratio = (1.0 - 2.0 * z * z + (4.0 * z.powi(4) - 4.0 * z * z + 2.0).sqrt()).sqrt();
         let wn = 2.0 * std::f64::consts::PI * fb / ratio;
+        let exact = !self.mechanics.two_mass() && self.current.is_none();
         let structure = match class {
-            // second order: the bandwidth gives ω_n in closed form
-            Class::CascadeP | Class::ForcePd => self.placed(class, wn, z)?,
+            // second order on a rigid mass and a force source: the
+            // bandwidth gives ω_n in closed form
+            Class::CascadeP | Class::ForcePd if exact => self.placed(class, wn, z)?,
             // third order (the integral's pole at ω_n/4 and its zero near
-            // it): ω_n found where the closed loop's bandwidth is the one asked
-            Class::CascadePi | Class::ForcePid => {
-                let bandwidth = |w: f64| -> Result<f64> {
-                    self.placed(class, w, z)?.closed_loop()?.bandwidth_hz.ok_or(
-                        Error::InvalidModel {
-                            reason: "the tuned closed loop has no bandwidth",
-                        },
-                    )
+            // it), or the poles placed on the rigid, force-source equivalent
+            // of a two-mass axis or a modelled current loop: ω_n found where
+            // the whole closed loop's bandwidth is the one asked
+            _ => {
+                // the bandwidth of the whole loop placed at ω (None: no
+                // such gains, or the loop unstable)
+                let bandwidth = |w: f64| -> Option<f64> {
+                    let cl = self.placed(class, w, z).ok()?.closed_loop().ok()?;
+                    cl.stable.then_some(cl.bandwidth_hz).flatten()
                 };
-                let (mut lo, mut hi) = (wn / 8.0, wn * 8.0);
-                if !(bandwidth(lo)? < fb && bandwidth(hi)? > fb) {
+                // bracket: down from ω_n until below the target, up until
+                // above it while the loop stays stable
+                let mut lo = wn;
+                while bandwidth(lo).is_none_or(|b| b >= fb) {
+                    lo /= 2.0;
+                    if lo < wn / 1e3 {
+                        return Err(Error::InvalidParameter {
+                            name: "bandwidth",
+                            value: fb,
+                            reason:
+                                "is below what the loop gives with the lowest gains at this damping",
+                        });
+                    }
+                }
+                let mut hi = lo;
+                while bandwidth(hi).is_some_and(|b| b < fb) {
+                    hi *= 1.25;
+                    if hi > wn * 1e3 {
+                        break;
+                    }
+                }
+                if bandwidth(hi).is_none_or(|b| b < fb) {
                     return Err(Error::InvalidParameter {
                         name: "bandwidth",
                         value: fb,
-                        reason: "cannot be reached by placing the loop's poles at this damping",
+                        reason: "cannot be reached at this damping: the whole loop (its mode, its current loop) turns unstable first",
                     });
                 }
                 for _ in 0..80 {
                     let mid = (lo * hi).sqrt();
-                    if bandwidth(mid)? < fb {
+                    if bandwidth(mid).is_some_and(|b| b < fb) {
                         lo = mid;
                     } else {
                         hi = mid;
@@ -204,10 +218,12 @@ impl DriveStructure {
     /// `s² + 2ζω_n·s + ω_n²` (and, with an integral, at `s + ω_n/4`; closer
     /// to the origin where that leaves no real gains).
     fn placed(&self, class: Class, wn: f64, z: f64) -> Result<DriveStructure> {
+        // the rigid, force-source equivalent: every moving mass, both
+        // sides' viscous friction, the current loop ideal
         let (g, m, fv) = (
             self.drive.gain,
             self.mechanics.total_mass(),
-            self.friction.viscous,
+            self.friction.viscous + self.mechanics.motor_viscous,
         );
         let too_low = Error::InvalidParameter {
             name: "bandwidth",

@@ -933,3 +933,28 @@ fn the_paper_cascade_s_mass_and_table_friction_are_recovered_and_the_start_repor
         assert!(e.identifiable, "{fit}");
     }
 }
+
+#[test]
+fn tuning_the_papers_cascade_places_its_bandwidth_or_says_why_not() {
+    use feedid::drive::TuneTarget;
+    let s = DriveStructure::paper(&feedid::drive::RigParams::default()).unwrap();
+    let z = std::f64::consts::FRAC_1_SQRT_2;
+    // 360 Hz: the whole loop (current loop, screw mode) placed there
+    let t = s
+        .tune(&TuneTarget {
+            bandwidth_hz: 360.0,
+            damping: z,
+        })
+        .unwrap();
+    assert!(t.after.stable);
+    assert!((t.after.bandwidth_hz.unwrap() - 360.0).abs() < 1e-6 * 360.0);
+    // 450 Hz: the lightly damped screw mode lifts the response above −3 dB
+    // and the bandwidth jumps across it: refused, not answered with another
+    let e = s
+        .tune(&TuneTarget {
+            bandwidth_hz: 450.0,
+            damping: z,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("jumps across"), "{e}");
+}

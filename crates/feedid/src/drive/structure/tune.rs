@@ -195,7 +195,16 @@ impl DriveStructure {
                         break;
                     }
                 }
-                self.placed(class, (lo * hi).sqrt(), z)?
+                let w = (lo * hi).sqrt();
+                // a resonance can make the bandwidth jump across the target
+                if bandwidth(w).is_none_or(|b| (b - fb).abs() > 1e-6 * fb) {
+                    return Err(Error::InvalidParameter {
+                        name: "bandwidth",
+                        value: fb,
+                        reason: "cannot be placed: the whole loop's bandwidth jumps across it as the gains rise (a resonance of the mode or the current loop lifts the response above −3 dB)",
+                    });
+                }
+                self.placed(class, w, z)?
             }
         };
         let before = self.closed_loop()?;

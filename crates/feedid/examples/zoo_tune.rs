@@ -21,6 +21,7 @@
 
 use feedid::drive::{DriveStructure, FeedForward, TuneTarget};
 use feedid::signal::Scenario;
+use feedid::stats::ErrorStats;
 use feedid::zoo::{PlantKind, Zoo};
 use rayon::prelude::*;
 
@@ -38,9 +39,7 @@ struct Row {
 /// positions `truth`).
 fn figures(program: &[f64], truth: &[f64]) -> (f64, f64, f64) {
     let n = program.len().min(truth.len());
-    let e: Vec<f64> = (0..n).map(|k| truth[k] - program[k]).collect();
-    let rms = (e.iter().map(|v| v * v).sum::<f64>() / n.max(1) as f64).sqrt();
-    let max = e.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let error = ErrorStats::from_pairs(program.iter().copied().zip(truth.iter().copied()));
     let (first, last) = (program[0], program[n - 1]);
     let travel = (last - first).abs();
     let dir = (last - first).signum();
@@ -56,7 +55,7 @@ fn figures(program: &[f64], truth: &[f64]) -> (f64, f64, f64) {
     } else {
         0.0
     };
-    (rms, max, overshoot)
+    (error.rms, error.max_abs, overshoot)
 }
 
 fn run(zoo: &Zoo, index: usize) -> Option<Result<Row, String>> {

@@ -1011,10 +1011,11 @@ def fit_structure(
     ``offset``, ``gain``, ``kp``, ``kv``, ``Fs``; two-mass ``Mm``, ``k``,
     ``c``) from command and measured position by output error, as ``feedid
     greybox --params s.toml --estimate …``, with ``restarts`` fits started
-    ±22 % away; the best of them is the estimate (``identifiable`` false
-    where equally good fits end apart or three standard errors exceed 5 %
-    of the estimate; ``restarts_elsewhere``: fits that ended in a local
-    minimum). The result has the estimates with standard errors, the rms
+    ±22 % away; the best of them is the estimate. Each estimate's
+    ``verdict``: ``"identifiable"``, ``"imprecise"`` (the restarts agree but
+    three standard errors exceed 5 % of it) or ``"not_identifiable"``
+    (equally good fits end apart); ``restarts_elsewhere``: fits that ended
+    in a local minimum. The result has the estimates with standard errors, the rms
     error before and after, the fit [%], and ``toml``: the structure with
     the estimates."""
     if isinstance(estimate, str):

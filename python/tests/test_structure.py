@@ -32,7 +32,7 @@ def test_a_structure_is_estimated_back_from_its_own_simulated_run():
     assert np.max(np.abs(run["output"])) <= 10.0
     fit = feedid.fit_structure(EMPS_TOML, command, run["position"], rate, "M,Fv,Fc,offset")
     values = {e["param"]: e["value"] for e in fit["estimates"]}
-    assert all(e["identifiable"] for e in fit["estimates"])
+    assert all(e["verdict"] == "identifiable" for e in fit["estimates"])
     assert fit["restarts_elsewhere"] == 0
     assert values["M"] == pytest.approx(95.1089, rel=1e-6)
     assert values["Fv"] == pytest.approx(203.5034, rel=1e-6)

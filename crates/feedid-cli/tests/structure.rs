@@ -191,6 +191,11 @@ fn greybox_recovers_a_structures_parameters_from_its_simulated_run() {
         assert!(rel.abs() < 1e-3, "{name}: {rel:e}");
     }
     assert!((value("offset") + 3.1648).abs() < 0.01);
+    // each estimate carries its verdict, printed and in the summary
+    for e in v["estimates"].as_array().unwrap() {
+        assert_eq!(e["verdict"], "identifiable", "{e}");
+    }
+    assert!(stdout(&o).contains("verdict"), "{}", stdout(&o));
     // the estimates explain the other run
     let fit = v["validation"]["fit_percent"].as_f64().unwrap();
     assert!(fit > 99.9, "{fit}");

@@ -25,7 +25,7 @@
 //! (**imprecise**; the constant force against the drive gain when smaller)
 //! or because equally good restarts disagree.
 
-use feedid::drive::{StructureParam as P, TuneTarget};
+use feedid::drive::{StructureParam as P, StructureVerdict, TuneTarget};
 use feedid::signal::Scenario;
 use feedid::zoo::StructureAxis;
 use rayon::prelude::*;
@@ -43,17 +43,17 @@ struct Checked {
     signed: f64,
     /// Its size.
     error: f64,
-    identifiable: bool,
+    verdict: StructureVerdict,
     spread: f64,
     /// Standard error relative to the estimate.
     rel_std: f64,
+    /// The truth lies within three standard errors of the estimate.
+    within_3_sigma: bool,
 }
 
 impl Checked {
-    /// Three standard errors exceed 5 % of it (infinite: the output does
-    /// not depend on it).
-    fn imprecise(&self) -> bool {
-        self.rel_std.is_nan() || 3.0 * self.rel_std > 0.05
+    fn identifiable(&self) -> bool {
+        self.verdict == StructureVerdict::Identifiable
     }
 }
 
@@ -95,9 +95,10 @@ fn run(i: usize) -> Result<Outcome, String> {
                 value: e.value,
                 signed: (e.value - truth) / scale,
                 error: (e.value - truth).abs() / scale,
-                identifiable: e.identifiable,
+                verdict: e.verdict,
                 spread: e.restart_spread.unwrap_or(f64::NAN),
                 rel_std: e.std_error / e.value.abs(),
+                within_3_sigma: (e.value - truth).abs() <= 3.0 * e.std_error,
             }
         })
         .collect();
@@ -290,10 +291,10 @@ fn main() {
                     100.0 * c.signed,
                     100.0 * c.rel_std,
                     c.spread,
-                    if c.identifiable {
-                        ""
-                    } else {
-                        " (not identifiable)"
+                    match c.verdict {
+                        StructureVerdict::Identifiable => "",
+                        StructureVerdict::Imprecise => " (imprecise)",
+                        StructureVerdict::NotIdentifiable => " (NOT IDENTIFIABLE)",
                     }
                 )
             })
@@ -306,8 +307,8 @@ fn main() {
             items.join(", ")
         );
     }
-    println!("\n| parameter | estimated | identifiable | within 5 % of the truth | largest error (identifiable) | not identifiable, within 5 % |");
-    println!("|---|---:|---:|---:|---:|---:|");
+    println!("\n| parameter | estimated | identifiable | within 5 % of the truth | largest error (identifiable) | imprecise: truth within 3σ | not identifiable: restarts apart | not identifiable: error |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
     let names = [
         P::Mass,
         P::Viscous,
@@ -327,45 +328,78 @@ fn main() {
         if all.is_empty() {
             continue;
         }
-        let ident: Vec<&&Checked> = all.iter().filter(|c| c.identifiable).collect();
+        let ident: Vec<&&Checked> = all.iter().filter(|c| c.identifiable()).collect();
         let within = ident.iter().filter(|c| c.error <= WITHIN).count();
         let worst = ident.iter().map(|c| c.error).fold(0.0_f64, f64::max);
-        let not_within = all
+        let imprecise: Vec<&&Checked> = all
             .iter()
-            .filter(|c| !c.identifiable && c.error <= WITHIN)
-            .count();
+            .filter(|c| c.verdict == StructureVerdict::Imprecise)
+            .collect();
+        let not: Vec<&&Checked> = all
+            .iter()
+            .filter(|c| c.verdict == StructureVerdict::NotIdentifiable)
+            .collect();
+        let apart: Vec<String> = not
+            .iter()
+            .map(|c| format!("{:.0} %", 100.0 * c.spread))
+            .collect();
+        let errors: Vec<String> = not
+            .iter()
+            .map(|c| format!("{:.0} %", 100.0 * c.error))
+            .collect();
         let name = p.map_or("all".to_string(), |p| p.name().to_string());
+        let or_dash = |v: Vec<String>| {
+            if v.is_empty() {
+                "–".to_string()
+            } else {
+                v.join(", ")
+            }
+        };
         println!(
-            "| {name} | {} | {} | {} | {:.2} % | {} of {} |",
+            "| {name} | {} | {} | {} | {:.2} % | {} of {} | {} | {} |",
             all.len(),
             ident.len(),
             within,
             100.0 * worst,
-            not_within,
-            all.len() - ident.len()
+            imprecise.iter().filter(|c| c.within_3_sigma).count(),
+            imprecise.len(),
+            if p.is_none() {
+                not.len().to_string()
+            } else {
+                or_dash(apart)
+            },
+            if p.is_none() {
+                format!(
+                    "{} off > 5 %",
+                    not.iter().filter(|c| c.error > WITHIN).count()
+                )
+            } else {
+                or_dash(errors)
+            }
         );
         if p.is_none() {
             total = (all.len(), ident.len(), within);
         }
     }
-    let not: Vec<&Checked> = rows
-        .iter()
-        .flat_map(|o| o.checked.iter())
-        .filter(|c| !c.identifiable)
-        .collect();
+    let count = |v: StructureVerdict| {
+        rows.iter()
+            .flat_map(|o| o.checked.iter())
+            .filter(|c| c.verdict == v)
+            .count()
+    };
     println!(
-        "\n{} of {} estimates identifiable, {} of those within 5 % of the truth; not identifiable: {} imprecise (three standard errors above 5 %, or infinite), {} more where equally good restarts disagree; {} fits ended in a local minimum (not compared)",
+        "\n{} of {} estimates identifiable, {} of those within 5 % of the truth; {} imprecise (restarts agree, three standard errors above 5 % or infinite); {} not identifiable (equally good restarts ended apart); {} fits ended in a local minimum (not compared)",
         total.1,
         total.0,
         total.2,
-        not.iter().filter(|c| c.imprecise()).count(),
-        not.iter().filter(|c| !c.imprecise()).count(),
+        count(StructureVerdict::Imprecise),
+        count(StructureVerdict::NotIdentifiable),
         rows.iter().map(|o| o.elsewhere).sum::<usize>()
     );
     let wrong: Vec<(usize, &Checked)> = rows
         .iter()
         .flat_map(|o| o.checked.iter().map(move |c| (o.index, c)))
-        .filter(|(_, c)| c.identifiable && c.error > WITHIN)
+        .filter(|(_, c)| c.identifiable() && c.error > WITHIN)
         .collect();
     if !wrong.is_empty() {
         println!("identifiable but off by more than 5 %:");
@@ -382,7 +416,7 @@ fn main() {
     }
     if let Some(path) = csv {
         let mut s = String::from(
-            "axis,label,fit_percent,param,truth,estimate,error,identifiable,restart_spread\n",
+            "axis,label,fit_percent,param,truth,estimate,error,verdict,restart_spread\n",
         );
         for o in &rows {
             for c in &o.checked {
@@ -395,7 +429,7 @@ fn main() {
                     c.truth,
                     c.value,
                     c.error,
-                    c.identifiable,
+                    c.verdict.label(),
                     c.spread
                 ));
             }

@@ -664,12 +664,17 @@ fn restarts_flag_what_only_enters_as_a_product() {
     let fit = s
         .fit_with_restarts(&cmd, &run.position, rate, &[P::DriveGain, P::VelocityKp], 2)
         .unwrap();
-    assert!(fit.estimates.iter().any(|e| !e.identifiable), "{fit}");
+    assert!(
+        fit.estimates
+            .iter()
+            .any(|e| e.verdict == feedid::drive::StructureVerdict::NotIdentifiable),
+        "{fit}"
+    );
     // the mass and the viscous friction are pinned
     let fit = s
         .fit_with_restarts(&cmd, &run.position, rate, &[P::Mass, P::Viscous], 2)
         .unwrap();
-    assert!(fit.estimates.iter().all(|e| e.identifiable), "{fit}");
+    assert!(fit.estimates.iter().all(|e| e.identifiable()), "{fit}");
     assert!(
         fit.estimates
             .iter()
@@ -711,7 +716,7 @@ fn identifiable_estimates_of_generated_axes_are_within_five_percent_of_the_truth
                 truth.abs()
             };
             let error = (e.value - truth).abs() / scale;
-            if e.identifiable {
+            if e.identifiable() {
                 identifiable += 1;
                 assert!(
                     error <= 0.05,
@@ -733,12 +738,18 @@ fn a_parameter_the_run_does_not_see_is_not_identifiable_and_leaves_the_others_kn
     // static level below the Coulomb level, where it acts no more
     let (a, fit) = fit_family_axis(6);
     let fs = fit.estimates.iter().find(|e| e.param == P::Static).unwrap();
-    assert!(!fs.identifiable, "{fit}");
+    // equally good restarts end far apart: the data do not decide it
+    assert_eq!(
+        fs.verdict,
+        feedid::drive::StructureVerdict::NotIdentifiable,
+        "{fit}"
+    );
+    assert!(fs.restart_spread.unwrap() > feedid::drive::PINNED, "{fit}");
     assert!(fs.std_error.is_infinite(), "{fit}");
     for p in [P::Mass, P::Viscous, P::Coulomb] {
         let e = fit.estimates.iter().find(|e| e.param == p).unwrap();
         assert!(e.std_error.is_finite(), "{}: {fit}", p.name());
-        assert!(e.identifiable, "{}: {fit}", p.name());
+        assert!(e.identifiable(), "{}: {fit}", p.name());
         let truth = p.get(&a.truth);
         assert!(
             ((e.value - truth) / truth).abs() < 0.05,
@@ -753,7 +764,7 @@ fn an_imprecise_estimate_is_not_called_identifiable_even_when_restarts_agree() {
     use feedid::drive::StructureParam as P;
     // a two-mass axis at 526 Hz: the motor mass is known to ±17 % (one
     // standard error); its restarts end together, but it is 14 % off
-    let (_, fit) = fit_family_axis(7);
+    let (a, fit) = fit_family_axis(7);
     let mm = fit
         .estimates
         .iter()
@@ -764,7 +775,17 @@ fn an_imprecise_estimate_is_not_called_identifiable_even_when_restarts_agree() {
         "{fit}"
     );
     assert!(mm.restart_spread.unwrap() < 1e-3, "{fit}");
-    assert!(!mm.identifiable, "{fit}");
+    assert_eq!(
+        mm.verdict,
+        feedid::drive::StructureVerdict::Imprecise,
+        "{fit}"
+    );
+    // and the truth is within its three standard errors
+    let truth = P::MotorMass.get(&a.truth);
+    assert!(
+        (mm.value - truth).abs() <= 3.0 * mm.std_error,
+        "{truth}: {fit}"
+    );
 }
 
 /// The coefficients of `M·(s + p)(s² + 2ζω·s + ω²)`, highest power first.
@@ -930,7 +951,7 @@ fn the_paper_cascade_s_mass_and_table_friction_are_recovered_and_the_start_repor
     for (e, (file, t)) in fit.estimates.iter().zip([(4.0, 3.0), (70.0, 100.0)]) {
         assert_eq!(e.start, file, "{fit}");
         assert!(((e.value - t) / t).abs() < 1e-6, "{fit}");
-        assert!(e.identifiable, "{fit}");
+        assert!(e.identifiable(), "{fit}");
     }
 }
 

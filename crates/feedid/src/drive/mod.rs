@@ -28,6 +28,7 @@ pub use structure::{
     check_restarts, inverse_dynamics, Controller, CurrentLoop, Drive, DriveStructure, FeedForward,
     FrictionLaw, IdimConfig, IdimFit, LoopGains, LoopKind, Measured, Mechanics, RunFigures,
     StructureEstimate, StructureFit, StructureParam, StructureRun, StructureSummary,
-    StructureValidation, TuneTarget, Tuned, VelocityEstimate, EQUALLY_GOOD, MAX_RESTARTS, PINNED,
+    StructureValidation, StructureVerdict, TuneTarget, Tuned, VelocityEstimate, EQUALLY_GOOD,
+    MAX_RESTARTS, PINNED,
 };
 pub use summary::{bandwidth_hz, ModelSummary, PoleInfo};

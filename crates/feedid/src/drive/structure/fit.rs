@@ -175,11 +175,46 @@ pub struct StructureEstimate {
     /// Largest relative difference from this estimate of the fits restarted
     /// ±22 % away from it (`None` without restarts).
     pub restart_spread: Option<f64>,
-    /// The data pin it: three standard errors are at most [`PINNED`] of it
-    /// (of the drive gain, for a constant force smaller than that), and the
-    /// restarts, if any, ended within `max(10⁻³, 3·std_error/|value|)` of
-    /// it.
-    pub identifiable: bool,
+    /// What the data say of it ([`StructureVerdict`]).
+    pub verdict: StructureVerdict,
+}
+
+impl StructureEstimate {
+    /// The data pin it ([`StructureVerdict::Identifiable`]).
+    pub fn identifiable(&self) -> bool {
+        self.verdict == StructureVerdict::Identifiable
+    }
+}
+
+/// What the data say of an estimate: structural identifiability, judged by
+/// fits restarted elsewhere, apart from practical identifiability, judged by
+/// the standard error (Raue et al., *Bioinformatics* 25 (2009) 1923–1929,
+/// make the same distinction with profile likelihoods).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StructureVerdict {
+    /// Three standard errors are at most [`PINNED`] of it (of the drive
+    /// gain, for a constant force smaller than that) and the equally good
+    /// restarts, if any, ended where it did.
+    Identifiable,
+    /// The restarts ended where it did, but three standard errors exceed
+    /// [`PINNED`] of it (or are infinite): the data locate it, not to 5 %.
+    Imprecise,
+    /// Equally good restarts ended apart, farther than
+    /// `max(10⁻³, min(3·std_error, PINNED·size)/|value|)`, or a restart
+    /// could not be fitted: the data do not decide it.
+    NotIdentifiable,
+}
+
+impl StructureVerdict {
+    /// The word printed for it.
+    pub fn label(self) -> &'static str {
+        match self {
+            StructureVerdict::Identifiable => "identifiable",
+            StructureVerdict::Imprecise => "imprecise",
+            StructureVerdict::NotIdentifiable => "NOT IDENTIFIABLE",
+        }
+    }
 }
 
 /// The result of [`DriveStructure::fit`].
@@ -381,7 +416,11 @@ impl DriveStructure {
                     value,
                     std_error,
                     restart_spread: None,
-                    identifiable: std_error.is_finite() && 3.0 * std_error <= PINNED * size,
+                    verdict: if std_error.is_finite() && 3.0 * std_error <= PINNED * size {
+                        StructureVerdict::Identifiable
+                    } else {
+                        StructureVerdict::Imprecise
+                    },
                 }
             })
             .collect();
@@ -438,9 +477,11 @@ impl DriveStructure {
     /// start). The fit with the smallest simulation error is the estimate;
     /// of the others, those within [`EQUALLY_GOOD`] of its error are as
     /// good a fit, and an estimate they leave farther than
-    /// `max(10⁻³, 3·σ/|value|)` from it is flagged not identifiable — the
-    /// data do not pin it, whatever its standard error says — as is one
-    /// whose three standard errors exceed [`PINNED`] of it. Fits that ended
+    /// `max(10⁻³, min(3·σ, PINNED·size)/|value|)` from it is
+    /// [`StructureVerdict::NotIdentifiable`] — the data do not decide it,
+    /// whatever its standard error says; one the restarts confirm but
+    /// whose three standard errors exceed [`PINNED`] of it is
+    /// [`StructureVerdict::Imprecise`]. Fits that ended
     /// clearly worse are local minima of the simulation error, counted in
     /// [`StructureFit::restarts_elsewhere`]; a restart that cannot be
     /// fitted at all flags every estimate.
@@ -528,20 +569,27 @@ impl DriveStructure {
                 continue;
             }
             for (e, a) in fit.estimates.iter_mut().zip(&again.estimates) {
-                let rel = (a.value - e.value).abs() / e.value.abs().max(f64::MIN_POSITIVE);
+                let magnitude = e.value.abs().max(f64::MIN_POSITIVE);
+                let rel = (a.value - e.value).abs() / magnitude;
                 e.restart_spread = Some(e.restart_spread.map_or(rel, |s| s.max(rel)));
-                let tolerance =
-                    (3.0 * e.std_error / e.value.abs().max(f64::MIN_POSITIVE)).max(1e-3);
+                // apart beyond the noise (three standard errors), and in
+                // any case beyond what an identifiable estimate may be off
+                let size = if e.param.logarithmic() {
+                    magnitude
+                } else {
+                    magnitude.max(self.drive.gain)
+                };
+                let tolerance = ((3.0 * e.std_error).min(PINNED * size) / magnitude).max(1e-3);
                 if rel.is_nan() || rel > tolerance {
-                    e.identifiable = false;
+                    e.verdict = StructureVerdict::NotIdentifiable;
                 }
             }
         }
-        // a restart that cannot be fitted at all pins nothing
+        // a restart that cannot be fitted at all decides nothing
         if failed > 0 {
             for e in &mut fit.estimates {
                 e.restart_spread = Some(f64::INFINITY);
-                e.identifiable = false;
+                e.verdict = StructureVerdict::NotIdentifiable;
             }
         }
         Ok(fit)
@@ -613,23 +661,22 @@ impl fmt::Display for StructureFit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "{:<8} {:>14} {:>14} {:>12} {:>14}  unit",
-            "param", "file", "estimate", "std error", "restarts"
+            "{:<8} {:>14} {:>14} {:>12} {:>10}  {:<16} unit",
+            "param", "file", "estimate", "std error", "restarts", "verdict"
         )?;
         for e in &self.estimates {
-            let verdict = match e.restart_spread {
-                None => "–".to_string(),
-                Some(_) if !e.identifiable => "NOT PINNED".to_string(),
-                Some(s) => format!("{:.1e}", s),
-            };
+            let spread = e
+                .restart_spread
+                .map_or_else(|| "–".to_string(), |s| format!("{:.1e}", s));
             writeln!(
                 f,
-                "{:<8} {:>14.6} {:>14.6} {:>12.3e} {:>14}  {}",
+                "{:<8} {:>14.6} {:>14.6} {:>12.3e} {:>10}  {:<16} {}",
                 e.param.name(),
                 e.start,
                 e.value,
                 e.std_error,
-                verdict,
+                spread,
+                e.verdict.label(),
                 e.param.unit()
             )?;
         }

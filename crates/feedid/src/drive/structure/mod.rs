@@ -91,7 +91,7 @@ use crate::error::{Error, Result};
 
 pub use fit::{
     check_restarts, StructureEstimate, StructureFit, StructureParam, StructureValidation,
-    EQUALLY_GOOD, MAX_RESTARTS, PINNED,
+    StructureVerdict, EQUALLY_GOOD, MAX_RESTARTS, PINNED,
 };
 pub use idim::{inverse_dynamics, IdimConfig, IdimFit};
 pub use linear::StructureSummary;

@@ -749,6 +749,7 @@ def compensate(
     min_fit: float = 90.0,
     fallback: bool = True,
     check: Union[None, Recording, "Identification", PathLike, Sequence[Any]] = None,
+    encoder_resolution: Optional[float] = None,
 ) -> Dict[str, Any]:
     """The command that makes a model follow the desired trajectory
     (``feedid compensate``).
@@ -795,6 +796,11 @@ def compensate(
         model runs through them and only the measured samples are compared.
         A list of two of them: two complete runs of the same program, whose
         noise is taken out by their cross-products (``--check a --check b``).
+    encoder_resolution : float, optional
+        The encoder's resolution [m] (its data sheet), with two check runs
+        whose positions lie on no grid (noise after the count): the rounding
+        both runs share is not counted as the model's error
+        (``--encoder-resolution``).
 
     Returns
     -------
@@ -857,6 +863,7 @@ def compensate(
         fallback=fallback,
         check=check_rec,
         check2=check2_rec,
+        encoder_resolution=encoder_resolution,
         **kw,
     )
     out: Dict[str, Any] = json.loads(summary)

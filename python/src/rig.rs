@@ -121,7 +121,7 @@ fn quality(file: &ModelFile) -> ModelQuality {
     params_json = None, position_loop = "sampled", smooth = None, max_smoothing = 0.02,
     max_velocity = 1.0, max_acceleration = 30.0, keep_dc_gain = false, allow_unstable = false,
     start = "rest", min_benefit = 1.25, min_fit = 90.0, fallback = true, check = None,
-    check2 = None))]
+    check2 = None, encoder_resolution = None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn compensate<'py>(
     py: Python<'py>,
@@ -144,14 +144,18 @@ pub fn compensate<'py>(
     fallback: bool,
     check: Option<&Bound<'py, PyRecording>>,
     check2: Option<&Bound<'py, PyRecording>>,
+    encoder_resolution: Option<f64>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, String)> {
     // one recording of the axis, or two runs of the same program
     let checked = |file: &ModelFile| -> PyResult<ModelQuality> {
         match (check, check2) {
-            (Some(a), Some(b)) => {
-                ModelQuality::from_two_recordings(&file.model, &a.get().inner, &b.get().inner)
-                    .map_err(|e| input(format!("check: {e}")))
-            }
+            (Some(a), Some(b)) => ModelQuality::from_two_recordings(
+                &file.model,
+                &a.get().inner,
+                &b.get().inner,
+                encoder_resolution,
+            )
+            .map_err(|e| input(format!("check: {e}"))),
             (Some(c), None) => ModelQuality::from_recording(&file.model, &c.get().inner)
                 .map_err(|e| input(format!("check: {e}"))),
             (None, _) => Ok(quality(file)),

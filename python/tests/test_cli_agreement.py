@@ -137,6 +137,12 @@ def test_identify_equals_the_cli_on_emps(cli, tmp_path, emps):
         ({"check": "CHECK", "min_fit": 99.99}, ["--check", "CHECK", "--min-fit", 99.99], "poor_fit"),
         # two runs of one program: the noise out by cross-products
         ({"check": ["CHECK", "CHECK2"]}, ["--check", "CHECK", "--check", "CHECK2"], None),
+        # and the encoder's resolution from its data sheet
+        (
+            {"check": ["CHECK", "CHECK2"], "encoder_resolution": 1e-7},
+            ["--check", "CHECK", "--check", "CHECK2", "--encoder-resolution", 1e-7],
+            None,
+        ),
     ],
 )
 def test_compensate_equals_the_cli_with_its_options(cli, tmp_path, py_options, cli_options, fallback):

@@ -661,6 +661,9 @@ pub struct CompensateArgs {
     /// A recording of the axis (time_s,command_m,position_m; e.g. the identification run) on which the model's fits are measured for the fall-back [default: the model file's fit]. Given twice, two complete runs of the same program: the noise is taken out by their cross-products.
     #[arg(long, value_name = "rec.csv", requires = "model", action = clap::ArgAction::Append)]
     pub check: Vec<PathBuf>,
+    /// The encoder's resolution [m] (its data sheet): with two --check runs whose positions lie on no grid (noise after the count), the rounding both runs share is not counted as the model's error.
+    #[arg(long, value_name = "M", requires = "check")]
+    pub encoder_resolution: Option<f64>,
     /// Use an unstable physical model anyway (its simulation diverges; refused by default).
     #[arg(long)]
     pub allow_unstable: bool,

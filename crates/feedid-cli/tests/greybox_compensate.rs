@@ -858,6 +858,12 @@ fn compensate_slews_a_slow_axis_to_its_lead_within_the_limits_and_says_so() {
 /// zero-order-hold sampling of `1/(0.01·s + 1)`), with white noise of
 /// `noise` m from a seeded generator; `shift` moves the ramp's start.
 fn lag_run(path: &Path, seed: u64, noise: f64, shift: usize) {
+    counted_lag_run(path, seed, noise, shift, 0.0)
+}
+
+/// [`lag_run`] read by an encoder of resolution `q` (0: none), the noise
+/// added after the count.
+fn counted_lag_run(path: &Path, seed: u64, noise: f64, shift: usize, q: f64) {
     let a = (-0.1_f64).exp();
     let mut state = seed
         .wrapping_mul(6364136223846793005)
@@ -877,7 +883,8 @@ fn lag_run(path: &Path, seed: u64, noise: f64, shift: usize) {
         }
         u_last = u;
         let n = noise * 3.0_f64.sqrt() * (2.0 * uniform() - 1.0);
-        text.push_str(&format!("{},{u},{}\n", k as f64 * 1e-3, y + n));
+        let counted = if q > 0.0 { q * (y / q).round() } else { y };
+        text.push_str(&format!("{},{u},{}\n", k as f64 * 1e-3, counted + n));
     }
     std::fs::write(path, text).unwrap();
 }
@@ -947,4 +954,72 @@ fn compensate_checks_the_model_on_two_runs_of_the_program_without_their_noise() 
     // three: refused
     let o = compensate(&[&run1, &run2, &other]);
     assert_fails(&o, &["--check given 3 times"]);
+}
+
+#[test]
+fn compensate_does_not_count_an_encoders_rounding_as_the_models_error() {
+    // the exact model; two runs counted by a 50 µm encoder with 5 µm of
+    // noise after the count: the rounding repeats in both runs
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("lag.json");
+    std::fs::write(
+        &model,
+        r#"{"model": {"kind": "continuous", "num": [1.0], "den": [0.01, 1.0]}}"#,
+    )
+    .unwrap();
+    let (run1, run2) = (dir.path().join("run1.csv"), dir.path().join("run2.csv"));
+    let q = 50e-6;
+    counted_lag_run(&run1, 1, 5e-6, 0, q);
+    counted_lag_run(&run2, 2, 5e-6, 0, q);
+    let summary = dir.path().join("s.json");
+    let compensate = |extra: &[&str]| {
+        let cmd = dir.path().join("cmd.csv");
+        let _ = std::fs::remove_file(&cmd);
+        let mut args = vec![
+            "compensate",
+            "--desired",
+            p(&run1),
+            "--desired-column",
+            "command_m",
+            "--model",
+            p(&model),
+            "--max-acceleration",
+            "1000",
+            "--check",
+            p(&run1),
+            "--check",
+            p(&run2),
+            "-o",
+            p(&cmd),
+            "--summary",
+            p(&summary),
+        ];
+        args.extend(extra);
+        let o = feedid(&args);
+        (o, cmd.exists())
+    };
+    let (o, _) = compensate(&[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let without = json(&summary)["benefit"]["model_error_rms_m"]
+        .as_f64()
+        .unwrap();
+    // the rounding counted as the model's error: far above what two runs
+    // of an exact model leave without an encoder (2e-3 of the plain
+    // error, above)
+    let plain = json(&summary)["benefit"]["predicted_plain_rms_m"]
+        .as_f64()
+        .unwrap();
+    assert!(without > 4e-3 * plain, "{without} of {plain}");
+    let (o, _) = compensate(&["--encoder-resolution", "50e-6"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let with = json(&summary)["benefit"]["model_error_rms_m"]
+        .as_f64()
+        .unwrap();
+    // taken out, down to the floor of half the cross-products' rms
+    assert!(with < 0.6 * without, "{with} against {without}");
+    assert!(with >= 0.49 * without, "{with} against {without}");
+    // a resolution that is no length: refused with its value, nothing written
+    let (o, written) = compensate(&["--encoder-resolution", "-1e-6"]);
+    assert_fails(&o, &["--encoder-resolution -0.000001", "positive length"]);
+    assert!(!written);
 }

@@ -30,7 +30,8 @@
 //!   the member's own recording — the plain program run once more, with its
 //!   noise and glitches: with `--ident program` from the two runs of the
 //!   program ([`ModelQuality::from_two_runs`], the noise taken out by their
-//!   cross-products), with `--ident chirp` from the recording alone
+//!   cross-products, the encoder's rounding with the member's resolution as
+//!   a data sheet gives it), with `--ident chirp` from the recording alone
 //!   ([`ModelQuality::from_run`], as `compensate --check` uses it);
 //! * limits: velocity `max(2·v, 1.5·v_plain)`, acceleration
 //!   `max(1.5·a, 1.5·a_plain)` (`v_plain`, `a_plain`: the plain command's own
@@ -254,6 +255,8 @@ fn run(
             (rec.command(), &ident_position),
             (desired, &measured),
             dt,
+            // the encoder's resolution, as its data sheet gives it
+            Some(spec.resolution_m),
         ),
         IdentRun::Chirp => ModelQuality::from_run(&file.model, desired, &measured, dt),
     }

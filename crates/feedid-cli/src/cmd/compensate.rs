@@ -144,6 +144,13 @@ fn from_model(
     cfg: &mut CompensateConfig,
 ) -> Result<(String, Compensation)> {
     let file = crate::cmd::load_model_file(path)?;
+    if let Some(q) = a.encoder_resolution {
+        if !(q.is_finite() && q > 0.0) {
+            anyhow::bail!(
+                "--encoder-resolution {q}: the encoder's resolution must be a positive length [m]"
+            );
+        }
+    }
     cfg.quality = match a.check.as_slice() {
         [check] => {
             // (dropped samples: the model runs through them)
@@ -160,7 +167,7 @@ fn from_model(
             let opts = ReadOptions::default();
             let r1 = read_recording(first, &opts)?;
             let r2 = read_recording(second, &opts)?;
-            ModelQuality::from_two_recordings(&file.model, &r1, &r2)
+            ModelQuality::from_two_recordings(&file.model, &r1, &r2, a.encoder_resolution)
                 .with_context(|| format!("{} and {}", first.display(), second.display()))?
         }
         [] => ModelQuality {

@@ -42,7 +42,10 @@
 //! cross-products of the two runs' residuals instead of an estimate of its
 //! level: independent between the runs, it leaves `Σ r₁·r₂` the noise-free
 //! squared error in expectation, whatever its spectrum (an encoder's
-//! rounding, constant at rest, is invisible to second differences).
+//! rounding, constant at rest, is invisible to second differences). The
+//! rounding both runs share (the same trajectory reads the same counts) is
+//! taken out: from the positions' grid, or from the encoder's resolution
+//! counted on the model's trajectory (`shared_rounding`).
 //!
 //! The second form scales the model's free-run error on its identification
 //! recording (a share `1 − fit_y` of that recording's motion) to the motion
@@ -166,6 +169,7 @@ impl ModelQuality {
         model: &LinearModel,
         first: &Recording<S>,
         second: &Recording<T>,
+        encoder: Option<f64>,
     ) -> Result<Self> {
         for (run, (dt, gaps)) in [(first.dt(), &first.gaps()), (second.dt(), &second.gaps())]
             .into_iter()
@@ -184,6 +188,7 @@ impl ModelQuality {
             (first.command(), first.position()),
             (second.command(), second.position()),
             first.dt(),
+            encoder,
         )
     }
 
@@ -202,9 +207,13 @@ impl ModelQuality {
     /// spectrum — an encoder's rounding, constant at rest and slowly varying
     /// in slow motion, escapes the second differences a single run's noise
     /// level is estimated from ([`ModelQuality::from_run`]) and would count
-    /// as the model's error. The position fit and the noise level are the
-    /// second run's ([`ModelQuality::from_run`]). The commands must agree
-    /// (to a millionth of their range; else [`Error::DifferentPrograms`]).
+    /// as the model's error. The rounding both runs share is taken out too
+    /// (`shared_rounding`): from the positions' own grid where they lie on
+    /// one, else from `encoder`, the encoder's resolution \[m\] as its data
+    /// sheet gives it (`None`: unknown). The position fit and the noise
+    /// level are the second run's ([`ModelQuality::from_run`]). The
+    /// commands must agree (to a millionth of their range; else
+    /// [`Error::DifferentPrograms`]).
     ///
     /// ```
     /// use feedid::compensate::ModelQuality;
@@ -215,7 +224,7 @@ impl ModelQuality {
     /// // two runs with independent "noise" of ±0.01
     /// let y1: Vec<f64> = y.iter().enumerate().map(|(k, v)| v + 0.01 * ((k * 7 % 13) as f64 - 6.0) / 6.0).collect();
     /// let y2: Vec<f64> = y.iter().enumerate().map(|(k, v)| v + 0.01 * ((k * 5 % 11) as f64 - 5.0) / 5.0).collect();
-    /// let q = ModelQuality::from_two_runs(&m, (&u, &y1), (&u, &y2), 1e-3).unwrap();
+    /// let q = ModelQuality::from_two_runs(&m, (&u, &y1), (&u, &y2), 1e-3, None).unwrap();
     /// assert!(q.error_fit_percent.unwrap() > 95.0);
     /// ```
     pub fn from_two_runs(
@@ -223,7 +232,17 @@ impl ModelQuality {
         first: (&[f64], &[f64]),
         second: (&[f64], &[f64]),
         dt: f64,
+        encoder: Option<f64>,
     ) -> Result<Self> {
+        if let Some(q) = encoder {
+            if !(q.is_finite() && q > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name: "encoder resolution",
+                    value: q,
+                    reason: "must be a positive length",
+                });
+            }
+        }
         let (u1, y1) = first;
         let (u2, y2) = second;
         for (what, u, y) in [
@@ -262,7 +281,15 @@ impl ModelQuality {
             rr += a.residual[k] * b.residual[k];
             ff += (a.following[k] - mf1) * (b.following[k] - mf2);
         }
-        rr -= n * shared_rounding(y1, y2);
+        rr = match shared_rounding(y1, y2, encoder, &b.travel) {
+            Rounding::Grid(v) => rr - n * v,
+            // counted on the model's trajectory, not the axis's: off by as
+            // much as itself where the motion spans few counts, so it
+            // takes out at most three quarters of the cross-products
+            // (the model's error at least half their rms)
+            Rounding::Travel(v) => (rr - n * v).max(rr / 4.0),
+            Rounding::None => rr,
+        };
         let error_fit =
             (ff > 0.0 && rr.is_finite()).then(|| 100.0 * (1.0 - (rr.max(0.0) / ff).sqrt()));
         Ok(Self {
@@ -274,27 +301,54 @@ impl ModelQuality {
 }
 
 /// The encoder's rounding that two runs of one program share, per sample
-/// \[m²\]: where the noise before the encoder is below its resolution `q`
-/// the rounding repeats from run to run, and the cross-products count it as
-/// the model's error (it is not the axis's: the true position has none).
-/// Its share is what the rounding's `q²/12` leaves beyond half the variance
-/// of the runs' difference (the part of rounding and noise that does not
-/// repeat): `max(0, q²/12 − var(y₁ − y₂)/2)`; 0 when the positions are not
-/// quantised to one resolution.
-fn shared_rounding(y1: &[f64], y2: &[f64]) -> f64 {
-    let (Some(q1), Some(q2)) = (resolution(y1), resolution(y2)) else {
-        return 0.0;
-    };
-    if (q1 - q2).abs() > 1e-6 * q1.max(q2) {
-        return 0.0;
-    }
+/// \[m²\] (it is not the axis's error: the true position has none, but
+/// the cross-products count it as the model's).
+///
+/// * Positions on a grid ([`resolution`] of both runs, one `q`): the noise
+///   is before the encoder's count, and where it is below `q` the rounding
+///   repeats from run to run. Its share is what the rounding's `q²/12`
+///   leaves beyond half the variance of the runs' difference (the part of
+///   rounding and noise that does not repeat): `max(0, q²/12 − var(y₁ −
+///   y₂)/2)`.
+/// * Positions off any grid, with the encoder's resolution `q` given: the
+///   noise is after the count (an analogue chain, an interpolator) and does
+///   not change which count the same trajectory reads, so the rounding
+///   repeats whole. The true trajectory is not known; the model's, `travel`
+///   (its position from the start, where the axis rests on a count), is
+///   counted instead: `mean((q·round(d/q) − d)²)` over its samples — `q²/12`
+///   in motion over many counts, nothing while the axis rests at its start.
+/// * Otherwise 0.
+fn shared_rounding(y1: &[f64], y2: &[f64], encoder: Option<f64>, travel: &[f64]) -> Rounding {
     let n = y1.len().min(y2.len());
     if n == 0 {
-        return 0.0;
+        return Rounding::None;
     }
-    let mean = (0..n).map(|k| y1[k] - y2[k]).sum::<f64>() / n as f64;
-    let var = (0..n).map(|k| (y1[k] - y2[k] - mean).powi(2)).sum::<f64>() / n as f64;
-    (q1 * q1 / 12.0 - var / 2.0).max(0.0)
+    match (resolution(y1), resolution(y2), encoder) {
+        (Some(q1), Some(q2), _) if (q1 - q2).abs() <= 1e-6 * q1.max(q2) => {
+            let mean = (0..n).map(|k| y1[k] - y2[k]).sum::<f64>() / n as f64;
+            let var = (0..n).map(|k| (y1[k] - y2[k] - mean).powi(2)).sum::<f64>() / n as f64;
+            Rounding::Grid((q1 * q1 / 12.0 - var / 2.0).max(0.0))
+        }
+        (None, None, Some(q)) if !travel.is_empty() => Rounding::Travel(
+            travel
+                .iter()
+                .map(|d| (q * (d / q).round() - d).powi(2))
+                .sum::<f64>()
+                / travel.len() as f64,
+        ),
+        _ => Rounding::None,
+    }
+}
+
+/// The rounding two runs share, per sample \[m²\], and how it was found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Rounding {
+    /// From the positions' own grid.
+    Grid(f64),
+    /// From the encoder's resolution, counted on the model's trajectory.
+    Travel(f64),
+    /// None found.
+    None,
 }
 
 /// A check recording sampled every `dt` \[s\] must be at a discrete
@@ -316,6 +370,8 @@ fn at_model_rate(model: &LinearModel, dt: f64) -> Result<()> {
 struct FreeRun {
     residual: Vec<f64>,
     following: Vec<f64>,
+    /// The model's position from its start, `ŷ − y₀`.
+    travel: Vec<f64>,
     /// `Σ (y − ȳ)²`.
     ssy: f64,
 }
@@ -366,14 +422,17 @@ impl FreeRun {
         let mut ssy = 0.0;
         let mut residual = Vec::with_capacity(rows.len());
         let mut following = Vec::with_capacity(rows.len());
+        let mut travel = Vec::with_capacity(rows.len());
         for (k, &i) in rows.iter().enumerate() {
             residual.push(position[k] - (y0 + yd[i]));
             following.push(position[k] - command[k]);
+            travel.push(yd[i]);
             ssy += (position[k] - mean_y).powi(2);
         }
         Ok(Self {
             residual,
             following,
+            travel,
             ssy,
         })
     }
@@ -681,7 +740,8 @@ mod tests {
         for (slow, levels) in [(false, [1e-7, 1e-6, 2e-6]), (true, [1e-7, 3e-7, 5e-7])] {
             for noise in levels {
                 let (model, u, _, y1, y2) = two_noisy_runs(noise, slow);
-                let q = ModelQuality::from_two_runs(&model, (&u, &y1), (&u, &y2), 1e-3).unwrap();
+                let q =
+                    ModelQuality::from_two_runs(&model, (&u, &y1), (&u, &y2), 1e-3, None).unwrap();
                 let m = missed(q);
                 assert!(
                     m < 1.5 * exact && m > exact / 1.5,
@@ -715,7 +775,7 @@ mod tests {
                     .collect()
             };
             let (y1, y2) = (run(), run());
-            let m = ModelQuality::from_two_runs(&axis, (&u, &y1), (&u, &y2), 1e-3).unwrap();
+            let m = ModelQuality::from_two_runs(&axis, (&u, &y1), (&u, &y2), 1e-3, None).unwrap();
             1.0 - m.error_fit_percent.unwrap() / 100.0
         };
         // what the rounding alone would leave as the model's error
@@ -728,8 +788,9 @@ mod tests {
             let m = missed(noise, seed);
             assert!(m < 0.25 * rounding, "noise {noise}: {m} against {rounding}");
         }
-        // without the grid (noise after the encoder) nothing is taken out
-        assert_eq!(shared_rounding(&y, &y), 0.0);
+        // without the grid (noise after the encoder) and no resolution
+        // given, nothing is taken out
+        assert_eq!(shared_rounding(&y, &y, None, &y), Rounding::None);
     }
 
     #[test]
@@ -737,13 +798,69 @@ mod tests {
         let (model, u, _, y1, y2) = two_noisy_runs(1e-7, false);
         let mut other = u.clone();
         other[1000] += 1e-4;
-        let e = ModelQuality::from_two_runs(&model, (&u, &y1), (&other, &y2), 1e-3).unwrap_err();
+        let e =
+            ModelQuality::from_two_runs(&model, (&u, &y1), (&other, &y2), 1e-3, None).unwrap_err();
         assert!(
             matches!(e, Error::DifferentPrograms { sample: 1000, .. }),
             "{e}"
         );
-        let e = ModelQuality::from_two_runs(&model, (&u, &y1), (&u[..10], &y2[..10]), 1e-3)
+        let e = ModelQuality::from_two_runs(&model, (&u, &y1), (&u[..10], &y2[..10]), 1e-3, None)
             .unwrap_err();
         assert!(matches!(e, Error::LengthMismatch { .. }), "{e}");
+        // an encoder resolution that is no length
+        for q in [0.0, -1e-6, f64::NAN] {
+            let e = ModelQuality::from_two_runs(&model, (&u, &y1), (&u, &y2), 1e-3, Some(q))
+                .unwrap_err();
+            assert!(matches!(e, Error::InvalidParameter { .. }), "{e}");
+        }
+    }
+
+    #[test]
+    fn rounding_under_noise_after_the_count_is_taken_out_with_the_encoders_resolution() {
+        // a model that misses a share of the following error; the positions
+        // counted by an encoder whose rounding is half that share, and
+        // noise of a fifth of a count added after the count (an analogue
+        // chain): off any grid, the rounding repeats whole in both runs
+        use rand::{Rng, SeedableRng};
+        let (model, u, y, _, _) = two_noisy_runs(0.0, false);
+        let missed = |q: ModelQuality| 1.0 - q.error_fit_percent.unwrap() / 100.0;
+        let exact = missed(ModelQuality::from_run(&model, &u, &y, 1e-3).unwrap());
+        let f = &y.iter().zip(&u).map(|(a, b)| a - b).collect::<Vec<_>>();
+        let mean = f.iter().sum::<f64>() / f.len() as f64;
+        let ff = (f.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / f.len() as f64).sqrt();
+        let q = 0.5 * exact * ff * 12.0_f64.sqrt();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let mut run = || -> Vec<f64> {
+            y.iter()
+                .map(|v| {
+                    let n = 0.2 * q * 3.0_f64.sqrt() * (2.0 * rng.random::<f64>() - 1.0);
+                    q * (v / q).round() + n
+                })
+                .collect()
+        };
+        let (y1, y2) = (run(), run());
+        assert_eq!(resolution(&y1), None);
+        let with = |encoder: Option<f64>| {
+            missed(
+                ModelQuality::from_two_runs(&model, (&u, &y1), (&u, &y2), 1e-3, encoder).unwrap(),
+            )
+        };
+        // unknown: the rounding counts as the model's error
+        let unknown = with(None);
+        assert!(unknown > 1.15 * exact, "{unknown} against {exact}");
+        // known: most of it taken out (counted on the model's trajectory,
+        // whose rounding at the final rest is not the axis's)
+        let known = with(Some(q));
+        assert!(
+            (known - exact).abs() < 0.35 * (unknown - exact),
+            "{known} against {exact} ({unknown} unknown)"
+        );
+        // an encoder far coarser than the model's error: what is taken out
+        // leaves at least half the cross-products' rms
+        let coarse = with(Some(20.0 * q));
+        assert!(
+            coarse >= 0.5 * unknown * 0.999,
+            "{coarse} against {unknown}"
+        );
     }
 }

@@ -133,6 +133,17 @@ impl StructureParam {
     fn logarithmic(self) -> bool {
         self != StructureParam::Offset
     }
+
+    /// What an estimate `value` is measured against for [`PINNED`]: its
+    /// size, and for a constant force (which may be near 0) at least the
+    /// drive's unit of output, `drive_gain`.
+    fn size(self, value: f64, drive_gain: f64) -> f64 {
+        if self.logarithmic() {
+            value.abs()
+        } else {
+            value.abs().max(drive_gain)
+        }
+    }
 }
 
 impl FromStr for StructureParam {
@@ -403,13 +414,7 @@ impl DriveStructure {
                 let value = from_p(p, xi);
                 // d value / d x: value for a logarithm, the scale otherwise
                 let std_error = si * if p.logarithmic() { value } else { scale_of(p) };
-                // a constant force is measured against the drive's unit of
-                // output as well (it may be near 0)
-                let size = if p.logarithmic() {
-                    value.abs()
-                } else {
-                    value.abs().max(scale_of(p))
-                };
+                let size = p.size(value, self.drive.gain);
                 StructureEstimate {
                     param: p,
                     start: p.get(self),
@@ -574,11 +579,7 @@ impl DriveStructure {
                 e.restart_spread = Some(e.restart_spread.map_or(rel, |s| s.max(rel)));
                 // apart beyond the noise (three standard errors), and in
                 // any case beyond what an identifiable estimate may be off
-                let size = if e.param.logarithmic() {
-                    magnitude
-                } else {
-                    magnitude.max(self.drive.gain)
-                };
+                let size = e.param.size(e.value, self.drive.gain);
                 let tolerance = ((3.0 * e.std_error).min(PINNED * size) / magnitude).max(1e-3);
                 if rel.is_nan() || rel > tolerance {
                     e.verdict = StructureVerdict::NotIdentifiable;

@@ -1012,6 +1012,11 @@ fn compensate_does_not_count_an_encoders_rounding_as_the_models_error() {
     assert!(without > 4e-3 * plain, "{without} of {plain}");
     let (o, _) = compensate(&["--encoder-resolution", "50e-6"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("the encoder's rounding they share"),
+        "{}",
+        stdout(&o)
+    );
     let with = json(&summary)["benefit"]["model_error_rms_m"]
         .as_f64()
         .unwrap();

@@ -118,7 +118,13 @@ pub fn run(a: &CompensateArgs) -> Result<()> {
         rec.len(),
         rec.rate_hz()
     );
-    describe(&mut text, &comp, &cfg.quality, a.check.len());
+    describe(
+        &mut text,
+        &comp,
+        &cfg.quality,
+        a.check.len(),
+        a.encoder_resolution.is_some(),
+    );
 
     let command = Command {
         rec: &rec,
@@ -391,7 +397,7 @@ fn json_limit(v: f64) -> serde_json::Value {
     }
 }
 
-fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checks: usize) {
+fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checks: usize, encoder: bool) {
     let count = |h: ZeroHandling| c.zeros.iter().filter(|z| z.handling == h).count();
     let _ = writeln!(
         t,
@@ -427,6 +433,7 @@ fn describe(t: &mut String, c: &Compensation, q: &ModelQuality, checks: usize) {
                     ModelErrorSource::ErrorFit => match checks {
                         0 => "the share of the following error it does not explain on its identification recording; --check run.csv measures it on this program",
                         1 => "the share of the following error it does not explain on --check; two runs of the program (--check a.csv --check b.csv) take the noise out exactly",
+                        _ if encoder => "the share of the following error it does not explain on the two --check runs, without their noise (cross-products) and the encoder's rounding they share",
                         _ => "the share of the following error it does not explain on the two --check runs, without their noise (cross-products)",
                     },
                     ModelErrorSource::PositionFit => "its free-run fit scaled to this motion; --check run.csv measures it on the axis",

@@ -854,6 +854,17 @@ fn compensate_slews_a_slow_axis_to_its_lead_within_the_limits_and_says_so() {
     assert!(benefit > 4.0, "{benefit}");
 }
 
+/// The model file of the 10 ms lag of [`lag_run`], written in `dir`.
+fn lag_model(dir: &Path) -> std::path::PathBuf {
+    let model = dir.join("lag.json");
+    std::fs::write(
+        &model,
+        r#"{"model": {"kind": "continuous", "num": [1.0], "den": [0.01, 1.0]}}"#,
+    )
+    .unwrap();
+    model
+}
+
 /// A run of a 0.1 m/s ramp through a 10 ms lag at 1 kHz (the exact
 /// zero-order-hold sampling of `1/(0.01·s + 1)`), with white noise of
 /// `noise` m from a seeded generator; `shift` moves the ramp's start.
@@ -892,12 +903,7 @@ fn counted_lag_run(path: &Path, seed: u64, noise: f64, shift: usize, q: f64) {
 #[test]
 fn compensate_checks_the_model_on_two_runs_of_the_program_without_their_noise() {
     let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("lag.json");
-    std::fs::write(
-        &model,
-        r#"{"model": {"kind": "continuous", "num": [1.0], "den": [0.01, 1.0]}}"#,
-    )
-    .unwrap();
+    let model = lag_model(dir.path());
     let (run1, run2, other) = (
         dir.path().join("run1.csv"),
         dir.path().join("run2.csv"),
@@ -961,12 +967,7 @@ fn compensate_does_not_count_an_encoders_rounding_as_the_models_error() {
     // the exact model; two runs counted by a 50 µm encoder with 5 µm of
     // noise after the count: the rounding repeats in both runs
     let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("lag.json");
-    std::fs::write(
-        &model,
-        r#"{"model": {"kind": "continuous", "num": [1.0], "den": [0.01, 1.0]}}"#,
-    )
-    .unwrap();
+    let model = lag_model(dir.path());
     let (run1, run2) = (dir.path().join("run1.csv"), dir.path().join("run2.csv"));
     let q = 50e-6;
     counted_lag_run(&run1, 1, 5e-6, 0, q);

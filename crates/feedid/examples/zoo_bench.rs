@@ -434,6 +434,17 @@ fn loses_significantly(y: &[f64], a: &Predictions, b: &Predictions, scored: &[bo
 /// Fewest scored samples of a command regime for its coverage to count.
 const MIN_REGIME: usize = 200;
 
+/// The regime with at least [`MIN_REGIME`] scored samples whose coverage
+/// is lowest on a row, and that coverage \[%\].
+fn worst_regime(r: &Row) -> Option<(Regime, f64)> {
+    Regime::ALL
+        .iter()
+        .zip(r.by_regime.iter())
+        .filter(|(_, &(total, _))| total >= MIN_REGIME)
+        .map(|(&g, &(total, inside))| (g, 100.0 * inside as f64 / total as f64))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+}
+
 #[derive(Clone)]
 struct Row {
     member: usize,
@@ -454,6 +465,9 @@ struct Row {
     beaten_by: Option<&'static str>,
     baseline_ratio: Option<f64>,
     interval_coverage: Option<f64>,
+    /// Median half-width of the intervals over the rms error, on the same
+    /// scored samples (1.96 for Gaussian errors of a constant spread).
+    width_ratio: Option<f64>,
     /// Scored samples and of them inside their interval, per command regime.
     by_regime: [(usize, usize); 5],
     /// At the samples of a start of motion: the squared errors of the method
@@ -503,6 +517,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
         beaten_by: None,
         baseline_ratio: None,
         interval_coverage: None,
+        width_ratio: None,
         by_regime: [(0, 0); 5],
         starts: (0.0, 0.0, 0),
         first_starts: (0.0, 0.0, 0),
@@ -632,11 +647,15 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                 .windows(2)
                 .position(|w| (w[1] - w[0]).abs() > 0.0183 * top)
                 .map_or(n, |k| k + 1);
+            let mut width_ratio = None;
             let interval_coverage = p.interval.as_ref().map(|(lo, hi, regime)| {
                 let (mut inside, mut total) = (0usize, 0usize);
+                let (mut half, mut squares) = (Vec::new(), 0.0);
                 for k in 0..n {
                     if p.has[k] && scored[k] {
                         total += 1;
+                        half.push(0.5 * (hi[k] - lo[k]));
+                        squares += (y[k] - p.value[k]).powi(2);
                         let i = usize::from(lo[k] <= y[k] && y[k] <= hi[k]);
                         inside += i;
                         let r = &mut by_regime[regime[k].index()];
@@ -654,6 +673,10 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                         }
                     }
                 }
+                let rms = (squares / total.max(1) as f64).sqrt();
+                width_ratio = quantile(&half, 0.5)
+                    .map(|w| w / rms)
+                    .filter(|q| q.is_finite());
                 100.0 * inside as f64 / total.max(1) as f64
             });
             Row {
@@ -667,6 +690,7 @@ fn score(m: &ZooMember, zoo: &Zoo) -> Vec<Row> {
                 beaten_by: worst.filter(|w| w.1 > 1.0).map(|w| w.0),
                 baseline_ratio: worst.map(|w| w.1),
                 interval_coverage,
+                width_ratio,
                 by_regime,
                 starts,
                 first_starts,
@@ -843,11 +867,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut text = String::from(
             "member,method,plant,command,samples,predicted,coverage_percent,\
              coverage_after_first_window_percent,rms_m,max_m,ratio_to_best_fixed,beaten_by_baseline,worst_baseline_ratio,loses_significantly,interval_coverage_percent,\
-             seconds,note,disturbance,candidate_ratio,candidate,label\n",
+             worst_regime,worst_regime_coverage_percent,seconds,note,disturbance,candidate_ratio,candidate,label\n",
         );
         for r in &rows {
             text += &format!(
-                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{:.6},\"{}\",{},{},\"{}\",\"{}\"\n",
+                "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{:.6},\"{}\",{},{},\"{}\",\"{}\"\n",
                 r.member,
                 r.method,
                 r.plant,
@@ -863,6 +887,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.baseline_ratio.map_or(String::new(), |v| v.to_string()),
                 u8::from(r.significant),
                 fmt(r.interval_coverage, 2),
+                worst_regime(r).map_or("", |w| w.0.name()),
+                fmt(worst_regime(r).map(|w| w.1), 2),
                 r.seconds,
                 r.note.replace('"', "'"),
                 r.disturbance.unwrap_or(""),
@@ -919,8 +945,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "\nPrediction intervals and largest errors: members whose 95 % interval coverage is \
          within [90, 98] %; (member, command regime) pairs with ≥ {MIN_REGIME} scored samples \
-         and of them those below 80 %; members whose largest error is at most 1.5× the \
-         hold's on the same member:\n"
+         and of them those below 80 %; the median over the members of the median interval \
+         half-width over the rms error on the same samples (1.96 for Gaussian errors of one \
+         spread; lower where the intervals are tight at rest and wide where the errors are); \
+         members whose largest error is at most 1.5× the hold's on the same member:\n"
     );
     interval_table(&scored);
     candidate_table(&scored);
@@ -1133,9 +1161,14 @@ fn candidate_table(scored: &[&Row]) {
 /// Intervals and largest errors: coverage per member and per regime, the
 /// largest error against the hold's, the starts of motion.
 fn interval_table(scored: &[&Row]) {
-    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median | first starts: members (above the hold's) | first starts: rms / hold's, median |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | median half-width / rms, median | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median | first starts: members (above the hold's) | first starts: rms / hold's, median |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for method in LIBRARY {
+        let widths: Vec<f64> = scored
+            .iter()
+            .filter(|r| r.method == method)
+            .filter_map(|r| r.width_ratio)
+            .collect();
         let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == method).collect();
         let within = mine
             .iter()
@@ -1178,7 +1211,7 @@ fn interval_table(scored: &[&Row]) {
             .collect();
         let first_above = first_ratios.iter().filter(|&&q| q > 1.0).count();
         println!(
-            "| {method} | {within} of {} | {} | {below} | {} | {bounded} of {} | {} | {} ({above}) | {} | {} ({first_above}) | {} |",
+            "| {method} | {within} of {} | {} | {below} | {} | {} | {bounded} of {} | {} | {} ({above}) | {} | {} ({first_above}) | {} |",
             mine.len(),
             pairs.len(),
             if worst_regime.is_finite() {
@@ -1186,6 +1219,7 @@ fn interval_table(scored: &[&Row]) {
             } else {
                 "–".into()
             },
+            fmt(quantile(&widths, 0.5), 2),
             ratios.len(),
             fmt(
                 ratios

@@ -58,33 +58,54 @@ fn coverage_after_first_window(r: &SlidingResult) -> f64 {
     rest.iter().filter(|&&h| h).count() as f64 / rest.len().max(1) as f64
 }
 
-/// Largest difference of two runs' predictions and interval bounds, the
-/// second mapped back by `back`, relative to `scale`, and the share of the
-/// predicted samples within [`TOL`].
+/// How two runs agree, the second mapped back by `back`, relative to
+/// `scale`: the largest difference of their predictions, the share of the
+/// predicted samples whose prediction is within [`TOL`], and the share whose
+/// interval bounds are.
 fn worst_relative(
     a: &SlidingResult,
     b: &SlidingResult,
     back: impl Fn(f64) -> f64,
     scale: f64,
-) -> (f64, f64) {
+) -> (f64, f64, f64) {
     assert_eq!(a.has_prediction, b.has_prediction);
-    let (mut worst, mut within, mut count) = (0.0f64, 0usize, 0usize);
+    let (mut worst, mut within, mut bounds_within, mut count) = (0.0f64, 0usize, 0usize, 0usize);
     for k in 0..a.predicted.len() {
         if a.has_prediction[k] {
-            let mut d = 0.0f64;
-            for (x, y) in [
-                (a.predicted[k], b.predicted[k]),
-                (a.lower[k], b.lower[k]),
-                (a.upper[k], b.upper[k]),
-            ] {
-                d = d.max((x - back(y)).abs() / scale);
-            }
+            let d = (a.predicted[k] - back(b.predicted[k])).abs() / scale;
+            let bounds = [(a.lower[k], b.lower[k]), (a.upper[k], b.upper[k])]
+                .iter()
+                .map(|&(x, y)| (x - back(y)).abs() / scale)
+                .fold(0.0f64, f64::max);
             worst = worst.max(d);
             within += usize::from(d <= TOL);
+            bounds_within += usize::from(bounds <= TOL);
             count += 1;
         }
     }
-    (worst, within as f64 / count.max(1) as f64)
+    let n = count.max(1) as f64;
+    (worst, within as f64 / n, bounds_within as f64 / n)
+}
+
+/// The intervals of two runs of one recording in different units: their
+/// coverage within 0.5 percentage points and median widths (mapped back by
+/// `unit`) within 2 %. An interval's width is calibrated by whether the
+/// earlier ones held, so where a measured sample lies on a bound to the
+/// last bits, the two runs may take different steps from there on.
+fn assert_same_intervals(a: &SlidingResult, b: &SlidingResult, unit: f64, what: &str) {
+    let (ca, cb) = (
+        a.interval_coverage_percent().unwrap(),
+        b.interval_coverage_percent().unwrap(),
+    );
+    assert!((ca - cb).abs() <= 0.5, "{what}: coverage {ca} vs {cb}");
+    let (wa, wb) = (
+        a.interval_median_width().unwrap(),
+        unit * b.interval_median_width().unwrap(),
+    );
+    assert!(
+        (wa - wb).abs() <= 0.02 * wa,
+        "{what}: median width {wa} vs {wb}"
+    );
 }
 
 #[test]
@@ -104,8 +125,11 @@ fn the_same_recording_in_other_units_offsets_and_time_units_gives_the_same_predi
             let us: Vec<f64> = u.iter().map(|v| v / unit).collect();
             let ys: Vec<f64> = y.iter().map(|v| v / unit).collect();
             let r = run("auto", &Signals::new(&t, &us, &ys, dt, 0.0));
-            let (w, share) = worst_relative(&base, &r, |v| v * unit, range);
-            println!("{scenario:?} unit {unit}: worst {w:e} of the range, {share} within {TOL:e}");
+            let (w, share, bounds) = worst_relative(&base, &r, |v| v * unit, range);
+            println!(
+                "{scenario:?} unit {unit}: worst {w:e} of the range, {share} within {TOL:e} \
+                 ({bounds} of the intervals)"
+            );
             // smooth motions: every sample within TOL; the 3 s chirp drifts
             // apart after thousands of recursive updates (still within TOL_WORST)
             let min_share = if scenario == Scenario::Chirp {
@@ -117,20 +141,31 @@ fn the_same_recording_in_other_units_offsets_and_time_units_gives_the_same_predi
                 w <= TOL_WORST && share >= min_share,
                 "{scenario:?} unit {unit}: worst {w:e} of the range, {share} within {TOL:e}"
             );
+            // the intervals: the same on nearly every sample of the smooth
+            // motions, the same coverage and widths on all
+            if scenario != Scenario::Chirp {
+                assert!(
+                    bounds >= 0.99,
+                    "{scenario:?} unit {unit}: {bounds} of the intervals"
+                );
+            }
+            assert_same_intervals(&base, &r, unit, &format!("{scenario:?} unit {unit}"));
             assert_eq!(base.outliers, r.outliers);
         }
         // time in milliseconds
         let tm: Vec<f64> = t.iter().map(|v| v * 1e3).collect();
         let r = run("auto", &Signals::new(&tm, &u, &y, dt * 1e3, 0.0));
-        let (w, _) = worst_relative(&base, &r, |v| v, range);
-        println!("{scenario:?} time in ms: {w:e} of the range");
+        let (w, _, bounds) = worst_relative(&base, &r, |v| v, range);
+        println!("{scenario:?} time in ms: {w:e} of the range ({bounds} of the intervals)");
+        assert_eq!(bounds, 1.0, "{scenario:?} time in ms");
         assert!(w <= 1e-9, "{scenario:?} time in ms: {w:e} of the range");
         // a 1 km offset (1e-9 of the position itself; 1 km carries ~1e-13 m of rounding)
         let (uo, yo): (Vec<f64>, Vec<f64>) =
             u.iter().zip(&y).map(|(a, b)| (a + 1e3, b + 1e3)).unzip();
         let r = run("auto", &Signals::new(&t, &uo, &yo, dt, 0.0));
-        let (w, _) = worst_relative(&base, &r, |v| v - 1e3, 1e3);
-        println!("{scenario:?} 1 km offset: {w:e} of the position");
+        let (w, _, bounds) = worst_relative(&base, &r, |v| v - 1e3, 1e3);
+        println!("{scenario:?} 1 km offset: {w:e} of the position ({bounds} of the intervals)");
+        assert_eq!(bounds, 1.0, "{scenario:?} 1 km offset");
         assert!(w <= 1e-9, "{scenario:?} 1 km offset: {w:e} of the position");
     }
 }

@@ -870,6 +870,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
              worst_regime,worst_regime_coverage_percent,seconds,note,disturbance,candidate_ratio,candidate,label\n",
         );
         for r in &rows {
+            let worst = worst_regime(r);
             text += &format!(
                 "{},{},{},{},{},{},{:.3},{:.3},{},{},{},{},{},{},{},{},{},{:.6},\"{}\",{},{},\"{}\",\"{}\"\n",
                 r.member,
@@ -887,8 +888,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.baseline_ratio.map_or(String::new(), |v| v.to_string()),
                 u8::from(r.significant),
                 fmt(r.interval_coverage, 2),
-                worst_regime(r).map_or("", |w| w.0.name()),
-                fmt(worst_regime(r).map(|w| w.1), 2),
+                worst.map_or("", |w| w.0.name()),
+                fmt(worst.map(|w| w.1), 2),
                 r.seconds,
                 r.note.replace('"', "'"),
                 r.disturbance.unwrap_or(""),

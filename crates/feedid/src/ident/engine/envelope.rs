@@ -291,6 +291,67 @@ mod tests {
     use super::*;
 
     #[test]
+    fn tracking_equals_the_figures_counted_over_every_pair_afresh() {
+        // seeded random walks with rests and restarts, every horizon 1 … 6,
+        // against the definitions counted over all pairs of the samples
+        // since the last restart
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for h in 1..=6 {
+            for whole_only in [false, true] {
+                let mut e = if whole_only {
+                    Envelope::horizon_only(h)
+                } else {
+                    Envelope::new(h)
+                };
+                let (mut reach, mut swerve, mut pairs) = (vec![0.0; h], vec![0.0; h], vec![0; h]);
+                let mut seg: Vec<f64> = Vec::new();
+                let mut x = 0.0;
+                for i in 0..600 {
+                    if i % 250 == 249 {
+                        e.restart();
+                        seg.clear();
+                    }
+                    x += if rng.random::<f64>() < 0.3 {
+                        0.0
+                    } else {
+                        rng.random::<f64>() - 0.4
+                    };
+                    e.track(x);
+                    seg.push(x);
+                    let k = seg.len() - 1;
+                    let first = if whole_only { h } else { 1 };
+                    for j in first..=h.min(k) {
+                        reach[j - 1] = f64::max(reach[j - 1], (x - seg[k - j]).abs());
+                        pairs[j - 1] += 1;
+                        // the ring keeps 2H + 1 samples: a swerve needs j + H
+                        // of them before the newest
+                        if k >= j + h && j + h <= 2 * h {
+                            let v = (seg[k - j] - seg[k - j - h]) / h as f64;
+                            swerve[j - 1] =
+                                f64::max(swerve[j - 1], (x - seg[k - j] - j as f64 * v).abs());
+                        }
+                    }
+                    for j in 1..=h {
+                        let (r, s) = e.seen(j);
+                        assert!(
+                            (r - reach[j - 1]).abs() <= 1e-12,
+                            "h {h} j {j} reach {r} {}",
+                            reach[j - 1]
+                        );
+                        assert!(
+                            (s - swerve[j - 1]).abs() <= 1e-12,
+                            "h {h} j {j} swerve {s} {}",
+                            swerve[j - 1]
+                        );
+                    }
+                    assert_eq!(e.pairs, pairs);
+                }
+            }
+        }
+    }
+
+    #[test]
     fn reach_and_swerve_are_the_largest_displacement_and_departure_seen() {
         // a parabola y = k²/2 (acceleration 1 per sample²): D_j over samples
         // 0..=20 is the largest |y[k] − y[k−j]|, S_j = j²/2 exactly

@@ -1165,12 +1165,8 @@ fn interval_table(scored: &[&Row]) {
     println!("| method | coverage within [90, 98] % | regimes with ≥ {MIN_REGIME} samples | of which below 80 % | worst regime coverage [%] | median half-width / rms, median | largest error ≤ 1.5× hold's | worst ratio to hold's | members with starts of motion (of them above the hold's rms there) | at starts: rms / hold's, median | first starts: members (above the hold's) | first starts: rms / hold's, median |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for method in LIBRARY {
-        let widths: Vec<f64> = scored
-            .iter()
-            .filter(|r| r.method == method)
-            .filter_map(|r| r.width_ratio)
-            .collect();
         let mine: Vec<&&Row> = scored.iter().filter(|r| r.method == method).collect();
+        let widths: Vec<f64> = mine.iter().filter_map(|r| r.width_ratio).collect();
         let within = mine
             .iter()
             .filter(|r| {

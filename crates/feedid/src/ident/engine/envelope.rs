@@ -324,9 +324,9 @@ mod tests {
                     for j in first..=h.min(k) {
                         reach[j - 1] = f64::max(reach[j - 1], (x - seg[k - j]).abs());
                         pairs[j - 1] += 1;
-                        // the ring keeps 2H + 1 samples: a swerve needs j + H
-                        // of them before the newest
-                        if k >= j + h && j + h <= 2 * h {
+                        // a swerve needs j + H samples before the newest
+                        // (within the ring's 2H + 1)
+                        if k >= j + h {
                             let v = (seg[k - j] - seg[k - j - h]) / h as f64;
                             swerve[j - 1] =
                                 f64::max(swerve[j - 1], (x - seg[k - j] - j as f64 * v).abs());

@@ -11,7 +11,9 @@
 //!
 //! Arguments: a method name (`arx`, `oe`, `rls`, `auto`, `paper` (QR,
 //! motion origin: the defaults), `paper-window` (window origin),
-//! `paper-simplex`, `paper-simplex-previous`) and a repetition count. The workload is the
+//! `paper-simplex`, `paper-simplex-previous`), a repetition count and,
+//! optionally, `no-runaway` (the engine's guard without its runaway cut:
+//! the difference is the cut's cost). The workload is the
 //! benches' (`benches/methods.rs`, `benches/paper_window.rs`): the virtual
 //! rig's chirp (1 s at 5 kHz, seed 1) through the sliding engine with the
 //! method's default window, H = 10, hop 10; the paper variants on the ramp
@@ -19,8 +21,10 @@
 //! window (indicative only).
 
 use feedid::drive::{RigParams, VirtualRig};
-use feedid::ident::engine::run;
-use feedid::ident::{EngineConfig, Method, PaperConfig, SimplexStart, Solver, TimeOrigin};
+use feedid::ident::engine::run_with;
+use feedid::ident::{
+    EngineConfig, GuardConfig, Method, PaperConfig, SimplexStart, Solver, TimeOrigin,
+};
 use feedid::signal::Scenario;
 use feedid::Recording;
 
@@ -37,6 +41,14 @@ fn main() -> feedid::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let name = args.get(1).map_or("arx", String::as_str);
     let reps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
+    let guard = GuardConfig {
+        runaway: if args.get(3).map(String::as_str) == Some("no-runaway") {
+            None
+        } else {
+            GuardConfig::default().runaway
+        },
+        ..GuardConfig::default()
+    };
     let (spec, rec) = if let Some(rest) = name.strip_prefix("paper") {
         let mut cfg = PaperConfig::default();
         if rest.contains("simplex") {
@@ -62,7 +74,7 @@ fn main() -> feedid::Result<()> {
     let mut windows = 0;
     let mut rms = 0.0;
     for _ in 0..reps {
-        let r = run(est.as_mut(), &signals, &cfg)?;
+        let r = run_with(est.as_mut(), &signals, &cfg, &guard, None)?;
         total += r.elapsed.as_secs_f64();
         windows += r.windows.len();
         rms = r.stats.rms;

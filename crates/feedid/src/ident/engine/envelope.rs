@@ -70,12 +70,16 @@
 #[derive(Debug, Clone)]
 pub struct Envelope {
     horizon: usize,
-    /// `D_j`, index `j − 1`.
+    /// `D_j`, index `H − j` (the order of the ring's samples `j` back, so
+    /// that tracking reads the ring forwards).
     reach: Vec<f64>,
-    /// `S_j`, index `j − 1`.
+    /// `S_j`, index `H − j`.
     swerve: Vec<f64>,
-    /// Pairs seen per step ahead (reach; swerve needs one more sample).
-    pairs: Vec<usize>,
+    /// `j` as a float, index `H − j`.
+    steps: Vec<f64>,
+    /// Whether a pair of samples `j` apart was seen, index `j − 1` (once
+    /// the ring is full, every `j` has been).
+    paired: Vec<bool>,
     /// The last `m = 2H + 1` samples, a ring (`head` = next write) stored
     /// twice (`recent[i]` = `recent[i + m]`), so that reading back needs no
     /// modulo.
@@ -94,7 +98,8 @@ impl Envelope {
             horizon,
             reach: vec![0.0; horizon],
             swerve: vec![0.0; horizon],
-            pairs: vec![0; horizon],
+            steps: (0..horizon).map(|i| (horizon - i) as f64).collect(),
+            paired: vec![false; horizon],
             recent: vec![0.0; 2 * (2 * horizon + 1)],
             head: 0,
             len: 0,
@@ -115,7 +120,7 @@ impl Envelope {
     pub fn reset(&mut self) {
         self.reach.fill(0.0);
         self.swerve.fill(0.0);
-        self.pairs.fill(0);
+        self.paired.fill(false);
         self.restart();
     }
 
@@ -146,26 +151,64 @@ impl Envelope {
         let h = self.horizon;
         // the newest sample sits at `newest`; j samples before it at `newest − j`
         let newest = self.head + m - 1;
-        let (recent, reach, swerve, pairs) = (
+        let (recent, reach, swerve, paired) = (
             &self.recent,
             &mut self.reach,
             &mut self.swerve,
-            &mut self.pairs,
+            &mut self.paired,
         );
         let inv_h = 1.0 / h as f64;
+        if self.len == m && !self.whole_only {
+            // every pair is there (the ring is full): no flags, no
+            // branches on the ring's length, the ring read forwards
+            // (`i = H − j`: the sample `j` back is `bases[i]`, and `H`
+            // before it `olds[i]`)
+            let bases = &recent[newest - h..newest];
+            let olds = &recent[newest - 2 * h..newest - h];
+            let steps = &self.steps[..h];
+            for ((((r, sw), &base), &old), &jf) in reach[..h]
+                .iter_mut()
+                .zip(swerve[..h].iter_mut())
+                .zip(bases)
+                .zip(olds)
+                .zip(steps)
+            {
+                // (finite samples only: a select, not `f64::max`'s NaN
+                // handling, and the loop vectorises)
+                let d = (y - base).abs();
+                *r = if d > *r { d } else { *r };
+                let v = (base - old) * inv_h;
+                let s = (y - base - jf * v).abs();
+                *sw = if s > *sw { s } else { *sw };
+            }
+            return;
+        }
+        if self.len == m {
+            // the whole horizon only, every pair there
+            let (base, old) = (recent[newest - h], recent[newest - 2 * h]);
+            let d = (y - base).abs();
+            if d > reach[0] {
+                reach[0] = d;
+            }
+            let s = (y - base - h as f64 * ((base - old) * inv_h)).abs();
+            if s > swerve[0] {
+                swerve[0] = s;
+            }
+            return;
+        }
         let first = if self.whole_only { h } else { 1 };
         for j in first..=h.min(self.len.saturating_sub(1)) {
             let base = recent[newest - j];
             let d = (y - base).abs();
-            if d > reach[j - 1] {
-                reach[j - 1] = d;
+            if d > reach[h - j] {
+                reach[h - j] = d;
             }
-            pairs[j - 1] += 1;
+            paired[j - 1] = true;
             if self.len > j + h {
                 let v = (base - recent[newest - j - h]) * inv_h;
                 let s = (y - base - j as f64 * v).abs();
-                if s > swerve[j - 1] {
-                    swerve[j - 1] = s;
+                if s > swerve[h - j] {
+                    swerve[h - j] = s;
                 }
             }
         }
@@ -175,7 +218,10 @@ impl Envelope {
     /// before any was seen).
     pub fn seen(&self, j: usize) -> (f64, f64) {
         match j.checked_sub(1) {
-            Some(i) if i < self.horizon => (self.reach[i], self.swerve[i]),
+            Some(i) if i < self.horizon => {
+                let i = self.horizon - 1 - i;
+                (self.reach[i], self.swerve[i])
+            }
             _ => (0.0, 0.0),
         }
     }
@@ -216,13 +262,30 @@ impl Envelope {
         last: f64,
         widths: impl Fn(usize, f64, f64) -> (f64, f64),
     ) -> Option<(f64, f64)> {
-        if j == 0 || j > self.horizon || self.pairs[j - 1] == 0 || !last.is_finite() {
+        self.bounds_at(j, last, self.velocity(), widths)
+    }
+
+    /// The recent velocity (over the last `H` tracked samples), if tracked.
+    fn velocity(&self) -> Option<f64> {
+        (self.len > self.horizon)
+            .then(|| (self.ago(0) - self.ago(self.horizon)) / self.horizon as f64)
+    }
+
+    /// [`Envelope::bounds`] with the recent velocity given.
+    fn bounds_at(
+        &self,
+        j: usize,
+        last: f64,
+        velocity: Option<f64>,
+        widths: impl Fn(usize, f64, f64) -> (f64, f64),
+    ) -> Option<(f64, f64)> {
+        if j == 0 || j > self.horizon || !self.paired[j - 1] || !last.is_finite() {
             return None;
         }
-        let (reach, swerve) = widths(j, self.reach[j - 1], self.swerve[j - 1]);
+        let (seen_reach, seen_swerve) = self.seen(j);
+        let (reach, swerve) = widths(j, seen_reach, seen_swerve);
         let (mut lo, mut hi) = (last - reach, last + reach);
-        if self.len > self.horizon && self.swerve[j - 1] > 0.0 {
-            let v = (self.ago(0) - self.ago(self.horizon)) / self.horizon as f64;
+        if let (Some(v), true) = (velocity, seen_swerve > 0.0) {
             let c = last + j as f64 * v;
             let (a, b) = (lo.max(c - swerve), hi.min(c + swerve));
             if a <= b {
@@ -254,13 +317,14 @@ impl Envelope {
     ) -> usize {
         let mut cut = 0;
         let mut run_away = false;
+        let velocity = self.velocity();
         for (i, ((v, lo), hi)) in values
             .iter_mut()
             .zip(lower.iter_mut())
             .zip(upper.iter_mut())
             .enumerate()
         {
-            let Some((a, b)) = self.bounds(i + 1, last, &widths) else {
+            let Some((a, b)) = self.bounds_at(i + 1, last, velocity, &widths) else {
                 continue;
             };
             // (bounds that are not ordered, NaN included, cut nothing)
@@ -345,7 +409,7 @@ mod tests {
                             swerve[j - 1]
                         );
                     }
-                    assert_eq!(e.pairs, pairs);
+                    assert_eq!(e.paired, pairs.iter().map(|&c| c > 0).collect::<Vec<_>>());
                 }
             }
         }
@@ -361,15 +425,12 @@ mod tests {
         }
         for j in 1..=5 {
             let d = 0.5 * (400 - (20 - j) * (20 - j)) as f64;
-            assert!((e.reach[j - 1] - d).abs() < 1e-12, "{j}");
+            let (reach, swerve) = e.seen(j);
+            assert!((reach - d).abs() < 1e-12, "{j}");
             // the mean velocity over the 5 samples before k−j lags 2.5
             // samples: y[k] − y[k−j] − j·v = j²/2 + 2.5·j
             let s = 0.5 * (j * j) as f64 + 2.5 * j as f64;
-            assert!(
-                (e.swerve[j - 1] - s).abs() < 1e-12,
-                "{j}: {}",
-                e.swerve[j - 1]
-            );
+            assert!((swerve - s).abs() < 1e-12, "{j}: {swerve}");
         }
     }
 

@@ -296,20 +296,34 @@ impl StepErrors {
     fn push(&mut self, e: f64) {
         let len = self.n.min(SCALE_MEMORY);
         let sorted = &mut self.sorted;
-        // take the oldest out of the sorted values once the memory is full
-        let len = if len == SCALE_MEMORY {
+        if len == SCALE_MEMORY {
+            // the memory is full: the oldest's place in the sorted values
+            // moves to where the new error belongs
             let old = self.ring[self.next];
-            let i = sorted[..len].partition_point(|&v| v < old).min(len - 1);
-            sorted.copy_within(i + 1..len, i);
-            len - 1
+            let mut i = sorted.partition_point(|&v| v < old).min(len - 1);
+            if e > old {
+                while i + 1 < len && sorted[i + 1] < e {
+                    sorted[i] = sorted[i + 1];
+                    i += 1;
+                }
+            } else {
+                while i > 0 && sorted[i - 1] > e {
+                    sorted[i] = sorted[i - 1];
+                    i -= 1;
+                }
+            }
+            sorted[i] = e;
         } else {
-            len
-        };
-        let i = sorted[..len].partition_point(|&v| v < e);
-        sorted.copy_within(i..len, i + 1);
-        sorted[i] = e;
+            let i = sorted[..len].partition_point(|&v| v < e);
+            sorted.copy_within(i..len, i + 1);
+            sorted[i] = e;
+        }
         self.ring[self.next] = e;
-        self.next = (self.next + 1) % SCALE_MEMORY;
+        self.next = if self.next + 1 == SCALE_MEMORY {
+            0
+        } else {
+            self.next + 1
+        };
         self.n += 1;
     }
 
@@ -574,8 +588,10 @@ impl Guard {
             None => {
                 // nothing was predicted before the first window ends; its
                 // samples show the motion so far
-                for k in start..end {
-                    self.envelope.track(position(k));
+                if self.config.runaway.is_some() {
+                    for k in start..end {
+                        self.envelope.track(position(k));
+                    }
                 }
                 self.checked = Some(end);
                 return;
@@ -667,7 +683,9 @@ impl Guard {
                 self.step = self.step.max((y_clean - p).abs());
             }
             self.last_clean = Some(y_clean);
-            self.envelope.track(y_clean);
+            if self.config.runaway.is_some() {
+                self.envelope.track(y_clean);
+            }
             if !outlier {
                 let w = OUTLIER_MEMORY;
                 for s in 0..self.count {
@@ -735,8 +753,8 @@ impl Guard {
         upper: &mut [f64],
         regimes: &mut [Regime],
     ) -> usize {
-        let len = values
-            .len()
+        let given = values.len();
+        let len = given
             .min(self.horizon)
             .min(lower.len())
             .min(upper.len())
@@ -756,7 +774,19 @@ impl Guard {
         } else {
             &command[..command.len() - len]
         };
-        let (asked_reach, asked_swerve) = self.command_seen.whole_horizon_of(asked, len);
+        let (asked_reach, asked_swerve) = if self.config.runaway.is_some() {
+            self.command_seen.whole_horizon_of(asked, len)
+        } else {
+            (0.0, 0.0)
+        };
+        // index in the recording of the command's first sample, and how
+        // many of its samples are the recording's own
+        let first = (start + given).saturating_sub(command.len());
+        let own = if horizon_known || command.len() < len + 2 {
+            command.len()
+        } else {
+            command.len() - len
+        };
         let command = if horizon_known || command.len() < len + 2 {
             command
         } else {
@@ -771,7 +801,8 @@ impl Guard {
             &self.command[..]
         };
         if command.len() >= len {
-            self.classifier.classify(command, self.horizon, regimes);
+            self.classifier
+                .classify(command, first, own, self.horizon, regimes);
         } else {
             regimes.fill(Regime::Rest);
         }
@@ -809,15 +840,14 @@ impl Guard {
         }
         // the commands up to H samples before the window's end (those the
         // axis has had a horizon to answer) join the command's envelope
-        let first = start.saturating_sub(command.len().saturating_sub(len));
-        let answered = start.saturating_sub(self.horizon);
-        let from = self.command_tracked.unwrap_or(first).max(first);
-        for k in from..answered {
-            self.command_seen.track(command[k - first]);
-        }
-        self.command_tracked = Some(answered.max(from));
         let cut = match self.config.runaway {
             Some(k) => {
+                let answered = start.saturating_sub(self.horizon);
+                let from = self.command_tracked.unwrap_or(first).max(first);
+                for i in from..answered {
+                    self.command_seen.track(command[i - first]);
+                }
+                self.command_tracked = Some(answered.max(from));
                 // the command's whole-horizon figures now and as answered
                 let (reach, swerve) = (asked_reach, asked_swerve);
                 let (r, s) = self.command_seen.seen(self.horizon);
@@ -971,13 +1001,18 @@ mod tests {
 
     #[test]
     fn the_kept_median_equals_the_median_of_the_last_errors_sorted_afresh() {
-        // seeded errors with many ties (a coarse grid) and exact zeros
+        // seeded errors with many ties (a coarse grid) and exact zeros,
+        // mixed with errors off the grid
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         let mut s = StepErrors::NEW;
         let mut all = Vec::new();
-        for _ in 0..2000 {
-            let e = (rng.random::<f64>() * 6.0).floor() * 0.5;
+        for _ in 0..4000 {
+            let e = if rng.random_bool(0.7) {
+                (rng.random::<f64>() * 6.0).floor() * 0.5
+            } else {
+                rng.random::<f64>() * 3.0
+            };
             s.push(e);
             all.push(e);
             let mut last: Vec<f64> = all[all.len().saturating_sub(SCALE_MEMORY)..].to_vec();

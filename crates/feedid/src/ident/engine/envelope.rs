@@ -47,10 +47,12 @@
 //! outside it are *cut back* to its edge and their interval is widened to
 //! span the hold and the cut value; a sample beyond `κ` times the edge's
 //! distance marks the prediction as run away, and from it on the horizon
-//! holds the last position (see [`Envelope::cut`]): a model that has left
-//! the envelope that far says nothing about where the axis goes, and the
-//! edge, on the side it ran to, would still be wrong by `(1 + κ)·D_j` where
-//! the axis goes the other way.
+//! holds the last position (see
+//! [`Envelope::cut`]): a model that has left the envelope that far says
+//! nothing about where the axis goes, and the edge, on the side it ran to,
+//! would still be wrong by `(1 + κ)·D_j` where the axis goes the other way.
+//! The envelope says how far, not where: the guard intersects it with the
+//! command hull ([`CommandHull`](super::CommandHull)), which does.
 //!
 //! Why these bounds: a position servo's speed and acceleration are limited
 //! (by its drive, its gains and its mass), and the recording shows them.
@@ -88,6 +90,8 @@ pub struct Envelope {
     len: usize,
     /// Track the whole horizon (`j = H`) only.
     whole_only: bool,
+    /// `1 / H`.
+    inv_h: f64,
 }
 
 impl Envelope {
@@ -104,6 +108,7 @@ impl Envelope {
             head: 0,
             len: 0,
             whole_only: false,
+            inv_h: 1.0 / horizon as f64,
         }
     }
 
@@ -139,6 +144,7 @@ impl Envelope {
     }
 
     /// Take the next measured (cleaned) sample into the envelope.
+    #[inline]
     pub fn track(&mut self, y: f64) {
         if !y.is_finite() {
             return;
@@ -157,7 +163,7 @@ impl Envelope {
             &mut self.swerve,
             &mut self.paired,
         );
-        let inv_h = 1.0 / h as f64;
+        let inv_h = self.inv_h;
         if self.len == m && !self.whole_only {
             // every pair is there (the ring is full): no flags, no
             // branches on the ring's length, the ring read forwards
@@ -166,20 +172,16 @@ impl Envelope {
             let bases = &recent[newest - h..newest];
             let olds = &recent[newest - 2 * h..newest - h];
             let steps = &self.steps[..h];
-            for ((((r, sw), &base), &old), &jf) in reach[..h]
-                .iter_mut()
-                .zip(swerve[..h].iter_mut())
-                .zip(bases)
-                .zip(olds)
-                .zip(steps)
-            {
+            let (reach, swerve) = (&mut reach[..h], &mut swerve[..h]);
+            for i in 0..h {
                 // (finite samples only: a select, not `f64::max`'s NaN
                 // handling, and the loop vectorises)
+                let (base, old) = (bases[i], olds[i]);
                 let d = (y - base).abs();
-                *r = if d > *r { d } else { *r };
+                reach[i] = if d > reach[i] { d } else { reach[i] };
                 let v = (base - old) * inv_h;
-                let s = (y - base - jf * v).abs();
-                *sw = if s > *sw { s } else { *sw };
+                let s = (y - base - steps[i] * v).abs();
+                swerve[i] = if s > swerve[i] { s } else { swerve[i] };
             }
             return;
         }
@@ -265,8 +267,9 @@ impl Envelope {
         self.bounds_at(j, last, self.velocity(), widths)
     }
 
-    /// The recent velocity (over the last `H` tracked samples), if tracked.
-    fn velocity(&self) -> Option<f64> {
+    /// The recent velocity (over the last `H` tracked samples, per
+    /// sample), if tracked.
+    pub fn velocity(&self) -> Option<f64> {
         (self.len > self.horizon)
             .then(|| (self.ago(0) - self.ago(self.horizon)) / self.horizon as f64)
     }
@@ -300,18 +303,26 @@ impl Envelope {
     /// into the envelope, its reach and swerve at step `j` allowed as
     /// `widths(j, D_j, S_j)` (see [`Envelope::bounds`]). A sample outside is
     /// set to the envelope's edge; a sample farther from `last` than `far`
-    /// times the edge marks the prediction as run away, and it and every
+    /// times the envelope's edge marks the prediction as run away, and it
+    /// and every
     /// later sample of the horizon become the hold (`last`, within the
     /// envelope). The interval of a changed sample becomes
     /// `[min(last, ŷ) − q, max(last, ŷ) + q]` with `ŷ` its new value and `q`
-    /// its half-width before (from `lower`/`upper`).
+    /// its half-width before (from `lower`/`upper`). `hull`, where given,
+    /// bounds step `j` (index `j − 1`) further, by where the command goes
+    /// ([`CommandHull::widen`](super::hull::CommandHull::widen); NaN: no
+    /// bound): the bounds are the intersection of the two, or the hull's
+    /// alone where they do not meet; the hull cuts but never marks a
+    /// runaway.
     /// Returns the number of samples changed.
+    #[allow(clippy::too_many_arguments)]
     pub fn cut(
         &self,
         values: &mut [f64],
         last: f64,
         widths: impl Fn(usize, f64, f64) -> (f64, f64),
         far: f64,
+        hull: Option<(&[f64], &[f64])>,
         lower: &mut [f64],
         upper: &mut [f64],
     ) -> usize {
@@ -324,7 +335,15 @@ impl Envelope {
             .zip(upper.iter_mut())
             .enumerate()
         {
-            let Some((a, b)) = self.bounds_at(i + 1, last, velocity, &widths) else {
+            let reach = self.bounds_at(i + 1, last, velocity, &widths);
+            let along = hull
+                .and_then(|(l, h)| Some((*l.get(i)?, *h.get(i)?)))
+                .filter(|(l, h)| l <= h);
+            let Some((a, b)) = (match (reach, along) {
+                (Some((a, b)), Some((c, d))) if a.max(c) <= b.min(d) => Some((a.max(c), b.min(d))),
+                (_, Some(cd)) => Some(cd),
+                (ab, None) => ab,
+            }) else {
                 continue;
             };
             // (bounds that are not ordered, NaN included, cut nothing)
@@ -333,10 +352,19 @@ impl Envelope {
                 continue;
             }
             let edge = v.clamp(a, b);
-            // (a NaN prediction is as far as it gets)
+            // a runaway is judged on the envelope alone, against its edge's
+            // distance: the hull only cuts (where it is tight, a noise-free
+            // axis at rest before a step, a model's least excess over it
+            // would otherwise void the rest of the horizon); a NaN
+            // prediction is as far as it gets
             let distance = (*v - last).abs();
-            let near =
-                matches!(distance.partial_cmp(&(far * (edge - last).abs())), Some(o) if o.is_le());
+            let near = match reach.filter(|(ea, eb)| ea <= eb) {
+                Some((ea, eb)) => {
+                    let allowed = far * (v.clamp(ea, eb) - last).abs();
+                    matches!(distance.partial_cmp(&allowed), Some(o) if o.is_le())
+                }
+                None => !distance.is_nan(),
+            };
             if !near {
                 run_away = true;
             }
@@ -471,6 +499,7 @@ mod tests {
             last,
             |_, d, s| (1.5 * d, 1.5 * s),
             f64::INFINITY,
+            None,
             &mut lo,
             &mut hi,
         );
@@ -509,6 +538,7 @@ mod tests {
             last,
             |_, d, s| (1.5 * d, 1.5 * s),
             1.5,
+            None,
             &mut lo,
             &mut hi,
         );
@@ -546,6 +576,7 @@ mod tests {
             49.0,
             |_, d, s| (1.5 * d, 1.5 * s),
             1.5,
+            None,
             &mut lo,
             &mut hi,
         );
@@ -568,6 +599,7 @@ mod tests {
                 0.0,
                 |_, d, s| (1.5 * d, 1.5 * s),
                 f64::INFINITY,
+                None,
                 &mut lo,
                 &mut hi
             ),
@@ -593,6 +625,7 @@ mod tests {
                 y[79] * scale,
                 |_, d, s| (1.5 * d, 1.5 * s),
                 f64::INFINITY,
+                None,
                 &mut lo,
                 &mut hi,
             );

@@ -67,10 +67,14 @@
 //! A prediction whose samples leave the envelope of the motion the axis has
 //! shown ([`Envelope`]: `κ` times the largest distance travelled and the
 //! largest departure from the last velocity in `j` samples, `κ` =
-//! [`GuardConfig::runaway`]) is cut back to the envelope's edge, and the
-//! interval of a cut sample spans the hold and the cut value; from a sample
-//! beyond `κ` times the edge's distance on, the prediction has run away and
-//! the rest of its horizon holds the last position. It applies to
+//! [`GuardConfig::runaway`]) or the hull of where its command goes
+//! ([`CommandHull`]: between the last position, where it would coast at its
+//! recent velocity and the command since, widened by the largest overshoot
+//! past it seen) is cut back to the edge, and the interval of a cut sample
+//! spans the hold and the cut value; from a sample beyond `κ` times the
+//! envelope's edge on, the prediction has run away and the rest of its
+//! horizon holds the last position. The hull follows the
+//! command the method reads ([`CommandBasis`]). It applies to
 //! every method (the paper's reproduction turns it off to stay as
 //! published); the windows and samples cut are counted.
 //!
@@ -133,6 +137,7 @@
 
 use crate::error::{Error, Result};
 use crate::ident::engine::envelope::Envelope;
+use crate::ident::engine::hull::CommandHull;
 use crate::ident::engine::regime::{Regime, RegimeClassifier};
 
 /// Errors needed at a step ahead before outliers are detected there.
@@ -179,9 +184,10 @@ pub struct GuardConfig {
     /// restarts; `None` keeps every prediction; default `Some(4.0)`.
     pub plausibility: Option<f64>,
     /// A predicted sample farther from the last measured position than this
-    /// many times the motion the axis has shown in as many samples (see the
-    /// module doc, *Runaway predictions*) is cut back; `None` keeps every
-    /// prediction as the method made it; default `Some(1.5)`.
+    /// many times the motion the axis has shown in as many samples, or
+    /// outside the hull of where its command goes, is cut back (see the
+    /// module doc, *Runaway predictions*); `None` keeps every prediction as
+    /// the method made it (and tracks neither); default `Some(1.5)`.
     pub runaway: Option<f64>,
 }
 
@@ -243,6 +249,21 @@ impl GuardConfig {
         }
         Ok(())
     }
+}
+
+/// How the method has the command over its horizon, for the runaway cut's
+/// command hull ([`CommandHull`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CommandBasis {
+    /// The command measured (a recording's, or a stream's led far enough
+    /// or awaited).
+    #[default]
+    Measured,
+    /// Not read by the method: the guard goes on at the command's last
+    /// velocity, and so does the hull.
+    Extrapolated,
+    /// A guess of the caller's (a stream's extrapolation): no hull.
+    Other,
 }
 
 /// A per-regime factor on the per-step scales: multiplied by
@@ -379,6 +400,11 @@ struct Pending {
     calibrated: Vec<bool>,
     /// Each value's regime.
     regime: Vec<Regime>,
+    /// The command hull of each value (NaN: none) and the measured
+    /// sample's departure from it, once scored.
+    hull_lower: Vec<f64>,
+    hull_upper: Vec<f64>,
+    departure: Vec<f64>,
 }
 
 /// The engine's interval and outlier state for one run (see the module doc).
@@ -432,6 +458,13 @@ pub struct Guard {
     command_tracked: Option<usize>,
     /// The command with its horizon extrapolated (scratch).
     command: Vec<f64>,
+    /// Where the command goes, on the basis of the command the method is
+    /// given (`None`: the horizon's command is neither measured nor the
+    /// guard's own extrapolation, and bounds nothing).
+    hull: Option<CommandHull>,
+    /// The hull's bounds of the current horizon (scratch).
+    hull_lower: Vec<f64>,
+    hull_upper: Vec<f64>,
     /// Windows and samples cut back as runaways since the reset.
     runaway_windows: usize,
     runaway_samples: usize,
@@ -458,6 +491,9 @@ impl Guard {
                     upper: vec![0.0; horizon],
                     calibrated: vec![false; horizon],
                     regime: vec![Regime::Rest; horizon],
+                    hull_lower: vec![f64::NAN; horizon],
+                    hull_upper: vec![f64::NAN; horizon],
+                    departure: vec![f64::NAN; horizon],
                 })
                 .collect(),
             first: 0,
@@ -479,9 +515,26 @@ impl Guard {
             command_seen: Envelope::horizon_only(horizon),
             command_tracked: None,
             command: Vec::new(),
+            hull: config.runaway.map(|_| CommandHull::new(horizon, false)),
+            hull_lower: vec![f64::NAN; horizon],
+            hull_upper: vec![f64::NAN; horizon],
             runaway_windows: 0,
             runaway_samples: 0,
         })
+    }
+
+    /// The guard for a method given the horizon's command as `basis` says
+    /// (default [`CommandBasis::Measured`]): the runaway cut's command hull
+    /// is measured and applied on that basis, or not at all (and not with
+    /// the runaway cut off).
+    pub fn with_command_basis(mut self, basis: CommandBasis) -> Self {
+        self.hull = match basis {
+            _ if self.config.runaway.is_none() => None,
+            CommandBasis::Measured => Some(CommandHull::new(self.horizon, false)),
+            CommandBasis::Extrapolated => Some(CommandHull::new(self.horizon, true)),
+            CommandBasis::Other => None,
+        };
+        self
     }
 
     /// The settings.
@@ -518,6 +571,9 @@ impl Guard {
         self.envelope.reset();
         self.command_seen.reset();
         self.command_tracked = None;
+        if let Some(h) = &mut self.hull {
+            h.reset();
+        }
     }
 
     /// Set the outlier count to 0.
@@ -686,12 +742,25 @@ impl Guard {
             if self.config.runaway.is_some() {
                 self.envelope.track(y_clean);
             }
-            if !outlier {
-                let w = OUTLIER_MEMORY;
-                for s in 0..self.count {
-                    let p = &self.slots[wrap(self.first + s, n_slots)];
-                    if k >= p.start && k < p.start + p.len {
-                        let j = k - p.start;
+            let w = OUTLIER_MEMORY;
+            for s in 0..self.count {
+                let p = &mut self.slots[wrap(self.first + s, n_slots)];
+                if k >= p.start && k < p.start + p.len {
+                    let j = k - p.start;
+                    // the sample's departure from the prediction's command
+                    // hull (an outlier's is not known)
+                    if let Some(hull) = &mut self.hull {
+                        let d = if outlier {
+                            f64::NAN
+                        } else {
+                            CommandHull::departure(p.hull_lower[j], p.hull_upper[j], c.y)
+                        };
+                        if j > 0 {
+                            hull.score(j + 1, p.departure[j - 1], d);
+                        }
+                        p.departure[j] = d;
+                    }
+                    if !outlier {
                         let e = (c.y - p.values[j]).abs();
                         if e.is_finite() {
                             if p.calibrated[j] {
@@ -787,7 +856,8 @@ impl Guard {
         } else {
             command.len() - len
         };
-        let command = if horizon_known || command.len() < len + 2 {
+        let extrapolated = !(horizon_known || command.len() < len + 2);
+        let command = if !extrapolated {
             command
         } else {
             // the command over the horizon as the method knows it: going on
@@ -873,11 +943,39 @@ impl Guard {
                         k * seen
                     }
                 };
+                // where the command goes, on the basis the hull was tracked
+                // on (the measured command, or the guard's extrapolation)
+                // (the hull as given is kept with the prediction: the
+                // departures of the measured samples from it are the
+                // overshoot)
+                let (lo, hi) = (&mut self.hull_lower[..len], &mut self.hull_upper[..len]);
+                let slot = &mut self.slots[slot_index];
+                let hull = match &self.hull {
+                    Some(h)
+                        if h.extrapolated() == extrapolated
+                            && (horizon_known || extrapolated)
+                            && command.len() > len =>
+                    {
+                        let u = &command[command.len() - len - 1..];
+                        let (raw_lo, raw_hi) =
+                            (&mut slot.hull_lower[..len], &mut slot.hull_upper[..len]);
+                        CommandHull::hull(last, self.envelope.velocity(), u, raw_lo, raw_hi);
+                        h.widen(raw_lo, raw_hi, lo, hi);
+                        Some((&self.hull_lower[..len], &self.hull_upper[..len]))
+                    }
+                    _ => {
+                        slot.hull_lower.fill(f64::NAN);
+                        slot.hull_upper.fill(f64::NAN);
+                        None
+                    }
+                };
+                slot.departure.fill(f64::NAN);
                 self.envelope.cut(
                     values,
                     last,
                     |_, d, sw| (allow(d, reach, r), allow(sw, swerve, s)),
                     k,
+                    hull,
                     lower,
                     upper,
                 )
@@ -1171,9 +1269,12 @@ mod tests {
         u: &[f64],
         h: usize,
         horizon_known: bool,
+        basis: CommandBasis,
         predict: impl Fn(usize) -> Vec<f64>,
     ) -> Vec<(usize, Vec<f64>)> {
-        let mut g = Guard::new(GuardConfig::default(), h, h).unwrap();
+        let mut g = Guard::new(GuardConfig::default(), h, h)
+            .unwrap()
+            .with_command_basis(basis);
         let (mut lo, mut hi) = (vec![0.0; h], vec![0.0; h]);
         let mut regimes = vec![Regime::Rest; h];
         let mut out = Vec::new();
@@ -1224,7 +1325,7 @@ mod tests {
                 .map(|j| y[start - 1] - 1e-6 * 2f64.powi(j as i32 + 4))
                 .collect()
         };
-        for (start, pred) in guard_predictions(&y, &u, h, true, runaway) {
+        for (start, pred) in guard_predictions(&y, &u, h, true, CommandBasis::Measured, runaway) {
             let travel = u[start + h - 1] - u[start.saturating_sub(2 * h)];
             let allowed = 1.5 * (2e-6 + travel.abs() + 2e-6) + 1e-12;
             for v in &pred {
@@ -1254,7 +1355,14 @@ mod tests {
             let (a, b) = (u[start - 2], u[start - 1]);
             (1..=h).map(|j| b + j as f64 * (b - a)).collect()
         };
-        let guarded = guard_predictions(&y, &u, h, false, follow_the_guess);
+        let guarded = guard_predictions(
+            &y,
+            &u,
+            h,
+            false,
+            CommandBasis::Extrapolated,
+            follow_the_guess,
+        );
         // the steps at 119, 179, 239, … fall on the last sample of a window
         let at_steps: Vec<_> = guarded
             .iter()
@@ -1267,6 +1375,82 @@ mod tests {
                     (v - y[start - 1]).abs() <= 1.5 + 1e-12,
                     "start {start}: {v}"
                 );
+            }
+        }
+    }
+
+    /// A first-order follower (no overshoot) of a command stepping by 1 at
+    /// `steps`, with a noise of ±1e-4.
+    fn follower(n: usize, steps: &[usize]) -> (Vec<f64>, Vec<f64>) {
+        let mut c = 0.0;
+        let u: Vec<f64> = (0..n)
+            .map(|k| {
+                if steps.contains(&k) {
+                    c = 1.0 - c;
+                }
+                c
+            })
+            .collect();
+        let mut x = 0.0;
+        let y = (0..n)
+            .map(|k| {
+                x += 0.4 * (u[k.saturating_sub(1)] - x);
+                x + 1e-4 * ((k * 7 % 5) as f64 - 2.0) / 2.0
+            })
+            .collect();
+        (u, y)
+    }
+
+    #[test]
+    fn a_prediction_at_rest_does_not_travel_as_far_as_an_earlier_move() {
+        // after a move of 1, command and axis at rest: a model that predicts
+        // the axis travelling 0.1 per sample (as far as it moved before) is
+        // cut back to the overshoot the axis has shown (its noise), where
+        // the envelope of the motion alone lets it travel most of the way
+        let h = 10;
+        let (u, y) = follower(300, &[45]);
+        let travel =
+            |start: usize| -> Vec<f64> { (1..=h).map(|j| y[start - 1] - 0.1 * j as f64).collect() };
+        let farthest = |basis| {
+            let mut far = 0.0f64;
+            for (start, pred) in guard_predictions(&y, &u, h, true, basis, travel) {
+                if start >= 120 {
+                    for v in pred {
+                        far = far.max((v - y[start - 1]).abs());
+                    }
+                }
+            }
+            far
+        };
+        let with_hull = farthest(CommandBasis::Measured);
+        assert!(with_hull <= 1e-3, "{with_hull}");
+        assert!(farthest(CommandBasis::Other) >= 0.5);
+    }
+
+    #[test]
+    fn a_prediction_the_wrong_way_at_a_step_is_cut_at_the_axis() {
+        // the command steps up by 1 two samples into a horizon; a model
+        // that predicts the axis going down is cut back to where the axis
+        // is (within its overshoot seen, the noise): nothing below it
+        let h = 10;
+        let (u, y) = follower(400, &[122, 222, 322]);
+        let wrong_way = |start: usize| -> Vec<f64> {
+            let down = if u[start + 2] > u[start - 1] {
+                0.2
+            } else {
+                0.0
+            };
+            (1..=h).map(|j| y[start - 1] - down * j as f64).collect()
+        };
+        for (start, pred) in guard_predictions(&y, &u, h, true, CommandBasis::Measured, wrong_way) {
+            if start == 220 || start == 320 {
+                for v in pred {
+                    assert!(
+                        v >= y[start - 1] - 1e-3,
+                        "start {start}: {v} from {}",
+                        y[start - 1]
+                    );
+                }
             }
         }
     }

@@ -4,6 +4,7 @@
 mod envelope;
 mod estimator;
 mod guard;
+mod hull;
 mod regime;
 mod signals;
 mod sliding;
@@ -15,7 +16,8 @@ mod test_estimators;
 pub use envelope::Envelope;
 pub(crate) use estimator::rate_changed;
 pub use estimator::{Estimator, FitStatus, PredictStatus, WindowFit, WindowOutcome};
-pub use guard::{Guard, GuardConfig, MIN_HISTORY};
+pub use guard::{CommandBasis, Guard, GuardConfig, MIN_HISTORY};
+pub use hull::CommandHull;
 pub use regime::{Regime, RegimeClassifier, MOVING_SHARE};
 pub use signals::{Samples, Signals};
 #[cfg(test)]

@@ -50,7 +50,7 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use crate::error::{Error, Result};
-use crate::ident::engine::guard::{Guard, GuardConfig};
+use crate::ident::engine::guard::{CommandBasis, Guard, GuardConfig};
 use crate::ident::engine::regime::Regime;
 use crate::ident::engine::{Estimator, PredictStatus, Signals, WindowOutcome};
 use crate::stats::{ErrorAccumulator, ErrorStats};
@@ -395,7 +395,13 @@ pub fn run_with<E: Estimator + ?Sized>(
     let mut lo = vec![0.0; config.horizon];
     let mut hi = vec![0.0; config.horizon];
     let mut reg = vec![Regime::Rest; config.horizon];
-    let mut guard = Guard::new(*guard, config.horizon, config.hop())?;
+    let mut guard = Guard::new(*guard, config.horizon, config.hop())?.with_command_basis(
+        if estimator.uses_future_command() {
+            CommandBasis::Measured
+        } else {
+            CommandBasis::Extrapolated
+        },
+    );
     let raw = signals.all();
     // what the estimator sees: the measured position with outliers replaced
     // (a copy made at the first outlier)

@@ -17,8 +17,11 @@
 //! benches' (`benches/methods.rs`, `benches/paper_window.rs`): the virtual
 //! rig's chirp (1 s at 5 kHz, seed 1) through the sliding engine with the
 //! method's default window, H = 10, hop 10; the paper variants on the ramp
-//! (0.8 s) with W = 20. Prints the windows and the mean wall time per
-//! window (indicative only).
+//! (0.8 s) with W = 20. A method name followed by `@hour` (`auto@hour`)
+//! runs on the one-hour benchmark's recording instead (`benches/batch_hour.rs`:
+//! one 1.4 s period of a 30 mm back-and-forth move simulated once and
+//! tiled), three periods of it. Prints the windows and the mean wall time
+//! per window (indicative only).
 
 use feedid::drive::{RigParams, VirtualRig};
 use feedid::ident::engine::run_with;
@@ -37,6 +40,41 @@ fn recording(scenario: Scenario, seconds: f64) -> feedid::Result<Recording> {
     Recording::new(out.time, out.command, out.position)
 }
 
+/// The one-hour benchmark's recording, `periods` periods of it: 50 ms at
+/// rest, 30 mm forward at 50 mm/s, 100 ms held, back, 50 ms at rest (at 5
+/// kHz), simulated once and tiled.
+fn hour_recording(periods: usize) -> feedid::Result<Recording> {
+    let rate = 5000.0f64;
+    let (rest, hold, v, d) = (0.05f64, 0.1, 0.05, 0.03);
+    let ramp = d / v;
+    let n = ((2.0 * rest + 2.0 * ramp + hold) * rate).round() as usize;
+    let cmd: Vec<f64> = (0..n)
+        .map(|k| {
+            let t = k as f64 / rate;
+            if t < rest {
+                0.0
+            } else if t < rest + ramp {
+                v * (t - rest)
+            } else if t < rest + ramp + hold {
+                d
+            } else if t < rest + 2.0 * ramp + hold {
+                d - v * (t - rest - ramp - hold)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let sim = VirtualRig::new(RigParams::default())
+        .with_seed(1)
+        .simulate(&cmd, rate)?;
+    let m = n * periods;
+    Recording::new(
+        (0..m).map(|k| k as f64 / rate).collect(),
+        (0..m).map(|k| cmd[k % n]).collect(),
+        (0..m).map(|k| sim.position[k % n]).collect(),
+    )
+}
+
 fn main() -> feedid::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let name = args.get(1).map_or("arx", String::as_str);
@@ -49,7 +87,9 @@ fn main() -> feedid::Result<()> {
         },
         ..GuardConfig::default()
     };
-    let (spec, rec) = if let Some(rest) = name.strip_prefix("paper") {
+    let (spec, rec) = if let Some(method) = name.strip_suffix("@hour") {
+        (method.parse::<Method>()?, hour_recording(3)?)
+    } else if let Some(rest) = name.strip_prefix("paper") {
         let mut cfg = PaperConfig::default();
         if rest.contains("simplex") {
             cfg.solver = Solver::Simplex;

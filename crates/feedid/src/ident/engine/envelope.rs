@@ -144,7 +144,7 @@ impl Envelope {
     }
 
     /// Take the next measured (cleaned) sample into the envelope.
-    #[inline]
+    #[inline(always)]
     pub fn track(&mut self, y: f64) {
         if !y.is_finite() {
             return;
@@ -329,52 +329,98 @@ impl Envelope {
         let mut cut = 0;
         let mut run_away = false;
         let velocity = self.velocity();
-        for (i, ((v, lo), hi)) in values
-            .iter_mut()
-            .zip(lower.iter_mut())
-            .zip(upper.iter_mut())
-            .enumerate()
-        {
-            let reach = self.bounds_at(i + 1, last, velocity, &widths);
-            let along = hull
-                .and_then(|(l, h)| Some((*l.get(i)?, *h.get(i)?)))
-                .filter(|(l, h)| l <= h);
-            let Some((a, b)) = (match (reach, along) {
-                (Some((a, b)), Some((c, d))) if a.max(c) <= b.min(d) => Some((a.max(c), b.min(d))),
-                (_, Some(cd)) => Some(cd),
-                (ab, None) => ab,
-            }) else {
-                continue;
-            };
-            // (bounds that are not ordered, NaN included, cut nothing)
-            let ordered = matches!(a.partial_cmp(&b), Some(o) if o.is_le());
+        let h = self.horizon;
+        let n = values.len().min(lower.len()).min(upper.len()).min(h);
+        let (hull_lo, hull_hi) = hull.unwrap_or((&[], &[]));
+        let known = last.is_finite();
+        for i in 0..n {
+            let v = &mut values[i];
+            // the envelope's bounds (NaN: none; see `bounds_at`)
+            let (mut ea, mut eb) = (f64::NAN, f64::NAN);
+            if known && self.paired[i] {
+                let (seen_reach, seen_swerve) = (self.reach[h - 1 - i], self.swerve[h - 1 - i]);
+                let (reach, swerve) = widths(i + 1, seen_reach, seen_swerve);
+                (ea, eb) = (last - reach, last + reach);
+                if let (Some(vel), true) = (velocity, seen_swerve > 0.0) {
+                    let c = last + (i + 1) as f64 * vel;
+                    let (a, b) = (larger(ea, c - swerve), smaller(eb, c + swerve));
+                    if a <= b {
+                        (ea, eb) = (a, b);
+                    }
+                }
+            }
+            // with the hull's: their intersection, or the hull's alone
+            // where they do not meet (bounds that are not ordered, NaN
+            // included, cut nothing)
+            let (mut a, mut b) = (ea, eb);
+            if let (Some(&c), Some(&d)) = (hull_lo.get(i), hull_hi.get(i)) {
+                if c <= d {
+                    let (x, y) = (larger(ea, c), smaller(eb, d));
+                    (a, b) = if ea <= eb && x <= y { (x, y) } else { (c, d) };
+                }
+            }
+            let ordered = a <= b;
             if !ordered || (!run_away && *v >= a && *v <= b) {
                 continue;
             }
-            let edge = v.clamp(a, b);
+            let (lo, hi) = (&mut lower[i], &mut upper[i]);
+            let edge = within(*v, a, b);
             // a runaway is judged on the envelope alone, against its edge's
             // distance: the hull only cuts (where it is tight, a noise-free
             // axis at rest before a step, a model's least excess over it
             // would otherwise void the rest of the horizon); a NaN
             // prediction is as far as it gets
             let distance = (*v - last).abs();
-            let near = match reach.filter(|(ea, eb)| ea <= eb) {
-                Some((ea, eb)) => {
-                    let allowed = far * (v.clamp(ea, eb) - last).abs();
-                    matches!(distance.partial_cmp(&allowed), Some(o) if o.is_le())
-                }
-                None => !distance.is_nan(),
+            let near = if ea <= eb {
+                let allowed = far * (within(*v, ea, eb) - last).abs();
+                distance <= allowed
+            } else {
+                !distance.is_nan()
             };
             if !near {
                 run_away = true;
             }
             let q = 0.5 * (*hi - *lo).abs();
-            *v = if run_away { last.clamp(a, b) } else { edge };
+            *v = if run_away { within(last, a, b) } else { edge };
             *lo = last.min(*v) - q;
             *hi = last.max(*v) + q;
             cut += 1;
         }
         cut
+    }
+}
+
+/// The larger of two numbers by a select, cheaper than `f64::max`: a NaN
+/// `a` gives `b` as `f64::max` does, a NaN `b` gives NaN (callers pass a
+/// number as `b`).
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The smaller of two numbers by a select (as [`larger`]: `b` a number).
+#[inline(always)]
+fn smaller(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `v` within `[a, b]` (`a ≤ b`), by selects: a NaN `v` stays NaN.
+#[inline(always)]
+fn within(v: f64, a: f64, b: f64) -> f64 {
+    if v < a {
+        a
+    } else if v > b {
+        b
+    } else {
+        v
     }
 }
 

@@ -401,10 +401,10 @@ struct Pending {
     /// Each value's regime.
     regime: Vec<Regime>,
     /// The command hull of each value (NaN: none) and the measured
-    /// sample's departure from it, once scored.
+    /// sample, once scored (NaN: an outlier).
     hull_lower: Vec<f64>,
     hull_upper: Vec<f64>,
-    departure: Vec<f64>,
+    measured: Vec<f64>,
 }
 
 /// The engine's interval and outlier state for one run (see the module doc).
@@ -493,7 +493,7 @@ impl Guard {
                     regime: vec![Regime::Rest; horizon],
                     hull_lower: vec![f64::NAN; horizon],
                     hull_upper: vec![f64::NAN; horizon],
-                    departure: vec![f64::NAN; horizon],
+                    measured: vec![f64::NAN; horizon],
                 })
                 .collect(),
             first: 0,
@@ -747,19 +747,9 @@ impl Guard {
                 let p = &mut self.slots[wrap(self.first + s, n_slots)];
                 if k >= p.start && k < p.start + p.len {
                     let j = k - p.start;
-                    // the sample's departure from the prediction's command
-                    // hull (an outlier's is not known)
-                    if let Some(hull) = &mut self.hull {
-                        let d = if outlier {
-                            f64::NAN
-                        } else {
-                            CommandHull::departure(p.hull_lower[j], p.hull_upper[j], c.y)
-                        };
-                        if j > 0 {
-                            hull.score(j + 1, p.departure[j - 1], d);
-                        }
-                        p.departure[j] = d;
-                    }
+                    // kept for the hull's overshoot (an outlier's value is
+                    // not known)
+                    p.measured[j] = if outlier { f64::NAN } else { c.y };
                     if !outlier {
                         let e = (c.y - p.values[j]).abs();
                         if e.is_finite() {
@@ -786,10 +776,15 @@ impl Guard {
         if let Some(c) = self.batch.last() {
             self.previous_exceeds = c.exceeds;
         }
-        // drop the predictions whose samples are all checked
+        // drop the predictions whose samples are all checked, their
+        // samples' departures from the hull taken into its overshoot
         while self.count > 0 {
             let p = &self.slots[self.first];
             if p.start + p.len <= end {
+                if let Some(hull) = &mut self.hull {
+                    let n = p.len;
+                    hull.score(&p.hull_lower[..n], &p.hull_upper[..n], &p.measured[..n]);
+                }
                 self.first = (self.first + 1) % n_slots;
                 self.count -= 1;
             } else {
@@ -938,7 +933,10 @@ impl Guard {
                 // that has barely moved would otherwise grow it without end
                 let allow = |seen: f64, now: f64, before: f64| {
                     if before > floor && now > before {
-                        k * seen.max((seen * (now / before)).min(now + lag))
+                        // (numbers only: selects, not `f64::max`)
+                        let grown = seen * (now / before);
+                        let grown = if grown < now + lag { grown } else { now + lag };
+                        k * if grown > seen { grown } else { seen }
                     } else {
                         k * seen
                     }
@@ -969,7 +967,7 @@ impl Guard {
                         None
                     }
                 };
-                slot.departure.fill(f64::NAN);
+                slot.measured.fill(f64::NAN);
                 self.envelope.cut(
                     values,
                     last,

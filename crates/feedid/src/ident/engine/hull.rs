@@ -119,29 +119,30 @@ impl CommandHull {
         lower: &mut [f64],
         upper: &mut [f64],
     ) {
-        let mut valid = last.is_finite() && command.first().is_some_and(|u| u.is_finite());
-        let (mut lo, mut hi) = match command.first() {
-            Some(&u0) if valid => (last.min(u0), last.max(u0)),
-            _ => (f64::NAN, f64::NAN),
-        };
-        let v = velocity.filter(|v| v.is_finite());
-        for (i, (l, h)) in lower.iter_mut().zip(upper.iter_mut()).enumerate() {
-            let j = i + 1;
-            match command.get(j) {
-                Some(&u) if valid && u.is_finite() => {
-                    lo = lo.min(u);
-                    hi = hi.max(u);
-                    let c = v.map_or(last, |v| last + j as f64 * v);
-                    *l = lo.min(c);
-                    *h = hi.max(c);
+        let n = lower.len().min(upper.len());
+        let u0 = command.first().copied().unwrap_or(f64::NAN);
+        // (without a velocity the axis stays: `last + j·0`)
+        let v = velocity.filter(|v| v.is_finite()).unwrap_or(0.0);
+        let mut from = 0;
+        if last.is_finite() && u0.is_finite() {
+            // (numbers only here: selects, not `f64::min`)
+            let (mut lo, mut hi) = if u0 < last { (u0, last) } else { (last, u0) };
+            let steps = n.min(command.len().saturating_sub(1));
+            while from < steps {
+                let u = command[from + 1];
+                if !u.is_finite() {
+                    break;
                 }
-                _ => {
-                    valid = false;
-                    *l = f64::NAN;
-                    *h = f64::NAN;
-                }
+                lo = if u < lo { u } else { lo };
+                hi = if u > hi { u } else { hi };
+                let c = last + (from + 1) as f64 * v;
+                lower[from] = if c < lo { c } else { lo };
+                upper[from] = if c > hi { c } else { hi };
+                from += 1;
             }
         }
+        lower[from..n].fill(f64::NAN);
+        upper[from..n].fill(f64::NAN);
     }
 
     /// A hull (from [`CommandHull::hull`]) widened by the overshoot seen at
@@ -173,27 +174,40 @@ impl CommandHull {
     /// a step without a hull).
     #[inline]
     pub fn departure(lower: f64, upper: f64, y: f64) -> f64 {
-        (y - upper).max(lower - y)
+        // (a select: both differences are NaN together, or neither)
+        let (above, below) = (y - upper, lower - y);
+        if above > below {
+            above
+        } else {
+            below
+        }
     }
 
-    /// Take the departures measured at `j − 1` and `j` (1-based `j ≥ 2`)
-    /// samples after the same window's end: where the axis was outside
-    /// the hull at both, the smaller departure joins the overshoot at both
-    /// steps. A NaN departure (no hull, no sample) counts nothing.
-    #[inline]
-    pub fn score(&mut self, j: usize, before: f64, now: f64) {
-        let Some(i) = j.checked_sub(2).filter(|&i| i + 1 < self.overshoot.len()) else {
-            return;
-        };
-        if before.is_nan() || now.is_nan() {
-            return;
-        }
-        let d = before.min(now).max(0.0);
-        for k in [i, i + 1] {
-            self.seen[k] = true;
-            if d > self.overshoot[k] {
-                self.overshoot[k] = d;
+    /// Take a prediction's measured samples (`measured[j − 1]` `j` samples
+    /// after the window's end; NaN: not known) and the hull it was bounded
+    /// by: where the axis was outside the hull at two steps in a row, the
+    /// smaller departure joins the overshoot at both steps. A NaN departure
+    /// (no hull, no sample) counts nothing.
+    pub fn score(&mut self, lower: &[f64], upper: &[f64], measured: &[f64]) {
+        let n = lower
+            .len()
+            .min(upper.len())
+            .min(measured.len())
+            .min(self.overshoot.len());
+        let mut before = f64::NAN;
+        for i in 0..n {
+            let now = Self::departure(lower[i], upper[i], measured[i]);
+            if i > 0 && !before.is_nan() && !now.is_nan() {
+                let d = if before < now { before } else { now };
+                let d = if d > 0.0 { d } else { 0.0 };
+                for k in [i - 1, i] {
+                    self.seen[k] = true;
+                    if d > self.overshoot[k] {
+                        self.overshoot[k] = d;
+                    }
+                }
             }
+            before = now;
         }
     }
 }
@@ -225,6 +239,14 @@ mod tests {
         assert!(lo[1..].iter().chain(&hi[1..]).all(|v| v.is_nan()));
     }
 
+    /// Score departures `d` (with a hull of [−1, 1], the samples `1 + d`
+    /// for `d ≥ −1`; NaN: no sample).
+    fn score_departures(hull: &mut CommandHull, d: &[f64]) {
+        let n = d.len();
+        let measured: Vec<f64> = d.iter().map(|d| 1.0 + d).collect();
+        hull.score(&vec![-1.0; n], &vec![1.0; n], &measured);
+    }
+
     #[test]
     fn the_overshoot_is_the_largest_departure_held_two_samples() {
         // brute force over seeded random departures (some inside, some
@@ -238,17 +260,14 @@ mod tests {
         for _ in 0..200 {
             let d: Vec<f64> = (0..h)
                 .map(|_| {
-                    let r: f64 = rng.random();
-                    if r < 0.1 {
+                    if rng.random::<f64>() < 0.1 {
                         f64::NAN
                     } else {
-                        rng.random::<f64>() * 2.0 - 1.5
+                        rng.random::<f64>() * 1.5 - 1.0
                     }
                 })
                 .collect();
-            for j in 2..=h {
-                hull.score(j, d[j - 2], d[j - 1]);
-            }
+            score_departures(&mut hull, &d);
             windows.push(d);
             for j in 1..=h {
                 let mut want: Option<f64> = None;
@@ -262,7 +281,11 @@ mod tests {
                         }
                     }
                 }
-                assert_eq!(hull.seen(j), want, "j {j}");
+                let got = hull.seen(j);
+                assert_eq!(got.is_some(), want.is_some(), "j {j}");
+                if let (Some(g), Some(w)) = (got, want) {
+                    assert!((g - w).abs() < 1e-12, "j {j}: {g} {w}");
+                }
             }
         }
     }
@@ -271,24 +294,18 @@ mod tests {
     fn a_glitch_is_no_overshoot_and_an_excursion_is() {
         let mut hull = CommandHull::new(4, false);
         // one wild sample 0.5 outside at step 2
-        let glitch = [0.0, 0.5, 0.0, 0.0];
-        for j in 2..=4 {
-            hull.score(j, glitch[j - 2], glitch[j - 1]);
-        }
+        score_departures(&mut hull, &[0.0, 0.5, 0.0, 0.0]);
         assert!((1..=4).all(|j| hull.seen(j) == Some(0.0)));
-        // an excursion 0.1 outside at steps 2 and 3
-        let excursion = [0.0, 0.1, 0.12, -0.3];
-        for j in 2..=4 {
-            hull.score(j, excursion[j - 2], excursion[j - 1]);
-        }
+        // an excursion 0.125 outside at steps 2 and 3
+        score_departures(&mut hull, &[0.0, 0.125, 0.25, -0.5]);
         assert_eq!(hull.seen(1), Some(0.0));
-        assert_eq!(hull.seen(2), Some(0.1));
-        assert_eq!(hull.seen(3), Some(0.1));
+        assert_eq!(hull.seen(2), Some(0.125));
+        assert_eq!(hull.seen(3), Some(0.125));
         assert_eq!(hull.seen(4), Some(0.0));
         let (mut lo, mut hi) = ([0.0; 4], [0.0; 4]);
         hull.widen(&[0.0; 4], &[1.0; 4], &mut lo, &mut hi);
-        assert_eq!(lo, [0.0, -0.1, -0.1, 0.0]);
-        assert_eq!(hi, [1.0, 1.1, 1.1, 1.0]);
+        assert_eq!(lo, [0.0, -0.125, -0.125, 0.0]);
+        assert_eq!(hi, [1.0, 1.125, 1.125, 1.0]);
         // a hull that has seen nothing bounds nothing
         CommandHull::new(4, true).widen(&[0.0; 4], &[1.0; 4], &mut lo, &mut hi);
         assert!(lo.iter().chain(&hi).all(|v| v.is_nan()));

@@ -1,6 +1,7 @@
 //! The estimator trait and what drives it: the sliding-window engine over a
 //! whole recording, and the streaming engine fed one sample at a time.
 
+mod calibration;
 mod envelope;
 mod estimator;
 mod guard;

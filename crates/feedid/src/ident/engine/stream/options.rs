@@ -7,7 +7,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
-use crate::ident::engine::GuardConfig;
+use crate::ident::engine::{CommandBasis, GuardConfig};
 use crate::recording::DEFAULT_JITTER_TOLERANCE;
 
 /// Relative deviation of a sampling interval from the expected one beyond
@@ -180,6 +180,21 @@ impl Default for StreamOptions {
 }
 
 impl StreamOptions {
+    /// The command the runaway cut's hull is over, for a method that reads
+    /// the horizon's command (`future`) or not, with horizons of `horizon`
+    /// samples: measured where it is led far enough or awaited, the guard's
+    /// own extrapolation where the method reads none, and none where the
+    /// stream fills the horizon with its guess.
+    pub fn command_basis(&self, future: bool, horizon: usize) -> CommandBasis {
+        if !future {
+            CommandBasis::Extrapolated
+        } else if self.command_lead >= horizon || self.extrapolation == CommandExtrapolation::Wait {
+            CommandBasis::Measured
+        } else {
+            CommandBasis::Other
+        }
+    }
+
     /// Check the values (a positive finite `dt`, a finite non-negative tolerance).
     pub fn validate(&self) -> Result<()> {
         self.guard.validate()?;

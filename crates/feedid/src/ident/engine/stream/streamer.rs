@@ -9,7 +9,7 @@ use crate::ident::engine::stream::options::{
     Arrival, CommandExtrapolation, HorizonCommand, Interval, Jump, StreamOptions,
 };
 use crate::ident::engine::{
-    fit_and_predict, CommandBasis, EngineConfig, Estimator, Guard, Regime, Signals, WindowOutcome,
+    fit_and_predict, EngineConfig, Estimator, Guard, Regime, Signals, WindowOutcome,
 };
 use crate::recording::MOTION_THRESHOLD;
 use crate::stats::{ErrorAccumulator, ErrorStats};
@@ -291,18 +291,7 @@ impl<E: Estimator> Streamer<E> {
         };
         let cap = 2 * span;
         let ncoef = estimator.coefficient_names().len();
-        // the hull of the runaway cut follows the command the method reads:
-        // measured (led far enough, or awaited), the guard's own
-        // extrapolation (a method that reads none), or a guess (none)
-        let basis = if !estimator.uses_future_command() {
-            CommandBasis::Extrapolated
-        } else if options.command_lead >= config.horizon
-            || options.extrapolation == CommandExtrapolation::Wait
-        {
-            CommandBasis::Measured
-        } else {
-            CommandBasis::Other
-        };
+        let basis = options.command_basis(estimator.uses_future_command(), config.horizon);
         let guard = Guard::new(options.guard, config.horizon, hop)?.with_command_basis(basis);
         let mut s = Self {
             future: estimator.uses_future_command(),

@@ -707,3 +707,33 @@ fn an_implausible_prediction_is_withheld_in_the_stream_as_in_batch() {
         .collect();
     assert_eq!(withheld, [11]);
 }
+
+#[test]
+fn the_runaway_hull_follows_the_command_the_method_reads() {
+    use crate::ident::engine::CommandBasis;
+    let with = |command_lead, extrapolation| StreamOptions {
+        command_lead,
+        extrapolation,
+        ..StreamOptions::default()
+    };
+    // a method that reads no horizon command: the guard's own extrapolation
+    for lead in [0, 4, 10] {
+        assert_eq!(
+            with(lead, CommandExtrapolation::Velocity).command_basis(false, 10),
+            CommandBasis::Extrapolated
+        );
+    }
+    // one that does: measured when led a whole horizon or awaited, no hull
+    // over the stream's own guess
+    assert_eq!(
+        with(10, CommandExtrapolation::Hold).command_basis(true, 10),
+        CommandBasis::Measured
+    );
+    assert_eq!(
+        with(0, CommandExtrapolation::Wait).command_basis(true, 10),
+        CommandBasis::Measured
+    );
+    for x in [CommandExtrapolation::Hold, CommandExtrapolation::Velocity] {
+        assert_eq!(with(9, x).command_basis(true, 10), CommandBasis::Other);
+    }
+}

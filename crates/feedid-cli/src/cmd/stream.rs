@@ -519,7 +519,7 @@ fn summary(
     }
     if st.runaway_windows > 0 {
         o += &format!(
-            "cut back as runaways: {} windows ({} samples): they left the motion the axis has shown\n",
+            "cut back as runaways: {} windows ({} samples): they left the motion the axis has shown or where its command goes\n",
             st.runaway_windows, st.runaway_samples
         );
     }

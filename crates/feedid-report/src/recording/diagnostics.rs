@@ -324,7 +324,8 @@ impl RecordingAnalysis {
                 "The {} % prediction intervals: the share of the predicted samples inside \
                  their interval, in all and by the command's regime at the sample (calibrated per \
                  step ahead and per regime from the method's own recent errors), their median \
-                 width, and the windows whose prediction left the motion the axis has shown and \
+                 width, and the windows whose prediction left the motion the axis has shown or \
+                 where its command goes and \
                  was cut back (their interval spans the hold).{left_out}",
                 feedid::error::short_number(interval)
             ),

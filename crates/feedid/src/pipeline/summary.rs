@@ -72,7 +72,8 @@ pub struct IdentifySummary {
     /// ([`crate::ident::Regime`]), for the regimes with predicted samples.
     pub interval_by_regime: Vec<RegimeInterval>,
     /// Windows whose prediction was cut back as a runaway: it left the
-    /// envelope of the motion the axis has shown (see
+    /// envelope of the motion the axis has shown or the hull of where its
+    /// command goes (see
     /// [`GuardConfig::runaway`](crate::ident::GuardConfig::runaway)).
     pub runaway_windows: usize,
     /// Predicted samples cut back as runaways.
@@ -233,7 +234,7 @@ impl fmt::Display for IdentifySummary {
             writeln!(
                 f,
                 "  {} window(s) cut back as runaways ({} samples, {:.2} % of the predicted): \
-                 they left the motion the axis has shown",
+                 they left the motion the axis has shown or where its command goes",
                 self.runaway_windows,
                 self.runaway_samples,
                 100.0 * self.runaway_samples as f64 / self.samples_predicted.max(1) as f64

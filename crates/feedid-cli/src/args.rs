@@ -308,8 +308,9 @@ pub struct IdentifyArgs {
     #[arg(long, value_name = "P", default_value_t = 95.0)]
     pub interval: f64,
     /// Cut back a predicted sample that leaves FACTOR times the motion the
-    /// axis has shown in as many samples (its interval widened to the hold);
-    /// `off` keeps every prediction as the method made it.
+    /// axis has shown in as many samples, or the hull of where its command
+    /// goes (its interval widened to the hold); `off` keeps every prediction
+    /// as the method made it.
     #[arg(long, value_name = "FACTOR|off", default_value = "1.5")]
     pub runaway: Runaway,
     /// Rig parameters of the nominal simulation model (TOML); default: the built-in rig.
@@ -418,8 +419,9 @@ pub struct StreamArgs {
     #[arg(long, value_name = "P", default_value_t = 95.0)]
     pub interval: f64,
     /// Cut back a predicted sample that leaves FACTOR times the motion the
-    /// axis has shown in as many samples (its interval widened to the hold);
-    /// `off` keeps every prediction as the method made it.
+    /// axis has shown in as many samples, or the hull of where its command
+    /// goes (its interval widened to the hold); `off` keeps every prediction
+    /// as the method made it.
     #[arg(long, value_name = "FACTOR|off", default_value = "1.5")]
     pub runaway: Runaway,
     /// How to read the lines (as a recording file; without a header and
